@@ -1,0 +1,15 @@
+#pragma once
+// The wul3d command: one file per subcommand, each registering its options on the CLI11 app
+// and turning them into library parameters. No algorithm lives here.
+#include <CLI/CLI.hpp>
+#include <exception>
+
+namespace wul3d::cli {
+
+/// Registers `wul3d run` on `app`; the returned callback runs it after parsing.
+void add_run_command(CLI::App& app);
+
+/// Prints "wul3d: <message>" as one line on stderr and returns `code`.
+int report(const std::exception& e, int code);
+
+}  // namespace wul3d::cli

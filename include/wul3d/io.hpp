@@ -1,0 +1,109 @@
+#pragma once
+/// @file io.hpp
+/// Reading RGB-D recordings and writing outputs. Readers check everything a user can get
+/// wrong (missing file, truncated PNG, bit depth, sizes) and throw InputError with the path;
+/// writers write to a temporary name and rename, so no output is ever half-written.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "wul3d/backprojection.hpp"
+#include "wul3d/clustering.hpp"
+#include "wul3d/frame.hpp"
+#include "wul3d/registration.hpp"
+
+namespace wul3d {
+
+// ---- single files -------------------------------------------------------------------
+
+/// A 16-bit single-channel PNG. Throws InputError if missing, unreadable, truncated or not
+/// 16-bit (an 8-bit depth image is rejected: its units cannot be known).
+DepthImage read_depth_png(const std::string& path, float scale_m_per_unit);
+/// An 8-bit PNG or JPEG, colour (converted to RGB) or grey (expanded to RGB).
+ColorImage read_color_image(const std::string& path);
+/// A 16-bit single-channel PNG of labels (ground truth or our own labels.png).
+LabelImage read_label_png(const std::string& path);
+
+/// `intrinsics.json`: {"fx","fy","cx","cy","width","height","depth_scale_m_per_unit"}.
+struct IntrinsicsFile {
+    PinholeIntrinsics intrinsics;
+    float depth_scale_m_per_unit = 0.001f;
+};
+IntrinsicsFile read_intrinsics_json(const std::string& path);
+
+/// Calibration JSON of an unregistered sensor (format in docs/INPUTS.md):
+/// {"depth": {intrinsics}, "color": {intrinsics},
+///  "depth_to_color": {"rotation": [9, row-major], "translation_m": [3]},
+///  "depth_scale_m_per_unit": 0.001}
+StereoCalibration read_calibration_json(const std::string& path);
+void write_calibration_json(const std::string& path, const StereoCalibration& calib);
+
+// ---- outputs (atomic: temporary name, then rename) ------------------------------------
+
+void write_label_png(const std::string& path, const LabelImage& labels);      ///< 16-bit
+void write_color_png(const std::string& path, const ColorImage& image);       ///< 8-bit RGB
+void write_mask_png(const std::string& path, int width, int height,
+                    const std::vector<std::uint8_t>& mask);                   ///< 8-bit
+void write_depth_png(const std::string& path, const DepthImage& depth);       ///< 16-bit
+/// Binary little-endian PLY of the labelled points: x y z (float, metres), red green blue
+/// (uchar, the eq. 9 display colour), label (ushort).
+void write_ply(const std::string& path, const OrganizedCloud& cloud, const LabelImage& labels,
+               const ColorImage& colors);
+/// Writes text (JSON) atomically.
+void write_text_file(const std::string& path, const std::string& text);
+
+// ---- sequences ----------------------------------------------------------------------
+
+enum class InputFormat {
+    Auto,          ///< decided from the path, see open_source
+    Frames,        ///< frame folders: color.png, depth.png, intrinsics.json [, label.png]
+    Tum,           ///< TUM RGB-D: rgb.txt, depth.txt, rgb/, depth/
+    Unregistered,  ///< frame folders with colour and depth of different sizes + calibration
+};
+InputFormat parse_input_format(const std::string& name);  ///< auto|frames|tum|unregistered
+
+struct SourceOptions {
+    InputFormat format = InputFormat::Auto;
+    /// TUM only: intrinsics preset name (camera.hpp) or empty to pick from the folder name
+    /// (freiburg1/2/3 -> tum_fr1/2/3, else kinect_v1).
+    std::string tum_camera;
+    /// Overrides the intrinsics of every frame (any format but Unregistered).
+    std::optional<PinholeIntrinsics> intrinsics;
+    /// Unregistered only: a calibration JSON path, or "kinect_v2" for the built-in preset.
+    /// Empty: `calibration.json` in the input folder (or its parent).
+    std::string calibration;
+    RegistrationMode registration = RegistrationMode::DepthToColor;
+    double tum_max_dt_s = 0.02;  ///< TUM colour/depth association tolerance
+};
+
+/// One item of a sequence: either already registered (`frame`) or raw (`raw`), which the
+/// pipeline registers with `calibration()`.
+struct SourceItem {
+    bool is_raw = false;
+    RgbdFrame frame;
+    RawRgbdFrame raw;
+};
+
+/// A finite, ordered sequence of frames read from disk.
+class FrameSource {
+public:
+    virtual ~FrameSource() = default;
+    virtual std::size_t size() const = 0;   ///< number of frames
+    /// Reads frame i (0 <= i < size()) into `item`, reusing its buffers. Throws InputError.
+    virtual void read(std::size_t i, SourceItem& item) = 0;
+    virtual std::string name(std::size_t i) const = 0;  ///< frame name, for OUT/<name>/
+    virtual InputFormat format() const = 0;
+    /// The calibration of raw items (Unregistered only); nullptr otherwise.
+    virtual const StereoCalibration* calibration() const { return nullptr; }
+};
+
+/// Opens `path`. Auto-detection: a folder with rgb.txt and depth.txt is TUM; a folder
+/// with depth.png is one frame; a folder whose sub-folders hold depth.png is a sequence
+/// (sorted by name); either of the last two is Unregistered when a calibration is given or
+/// `calibration.json` lies beside the frames, else Frames. Throws InputError for a missing
+/// path or an empty sequence.
+std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOptions& options);
+
+}  // namespace wul3d

@@ -1,0 +1,36 @@
+#pragma once
+/// @file normals.hpp
+/// Step 4 of the paper: a normal per point from its grid neighbours, O(N) on the organized
+/// cloud. n = (P(u+r) - P(u-r)) x (P(v+r) - P(v-r)), oriented towards the camera.
+/// Across a depth discontinuity the difference is taken one-sided, on the pixel's own
+/// surface; with no usable neighbour pair the point gets no normal (valid = 0), never a
+/// made-up vector.
+#include <cstdint>
+#include <vector>
+
+#include "wul3d/backprojection.hpp"
+
+namespace wul3d {
+
+struct NormalParams {
+    int radius_px = 2;  ///< neighbour distance in pixels; >= 1. Larger smooths sensor noise.
+    /// Two neighbours belong to one surface when their depths differ by at most
+    /// max_depth_jump_rel * z * radius_px (scales with depth, like sensor noise); > 0.
+    float max_depth_jump_rel = 0.02f;
+
+    void validate() const;  ///< throws ParamError
+};
+
+/// Unit normals, structure of arrays, one per pixel; valid = 0 where none could be computed.
+struct NormalMap {
+    int width = 0;
+    int height = 0;
+    std::vector<float> nx, ny, nz;
+    std::vector<std::uint8_t> valid;
+
+    void resize(int w, int h);
+};
+
+void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, NormalMap& out);
+
+}  // namespace wul3d

@@ -1,0 +1,75 @@
+#pragma once
+/// @file pipeline.hpp
+/// The whole per-frame pipeline of the paper, stages in order:
+/// registration -> back-projection -> normals -> background -> clustering -> colours.
+/// Holds the stages' buffers (no allocation after the first frame) and the one object that
+/// lives across frames, ClusterState.
+#include <vector>
+
+#include "wul3d/background.hpp"
+#include "wul3d/backprojection.hpp"
+#include "wul3d/clustering.hpp"
+#include "wul3d/normals.hpp"
+#include "wul3d/registration.hpp"
+#include "wul3d/visualization.hpp"
+
+namespace wul3d {
+
+struct PipelineParams {
+    NormalParams normals;
+    DepthRange range;
+    ClusterParams cluster;
+
+    /// The paper's setting: ClusterParams::paper(), depth range 0.5-4.5 m (Kinect v2).
+    static PipelineParams paper();
+    void validate() const;
+};
+
+/// Milliseconds spent in each stage on one frame (0 for a stage that did not run).
+struct StageTimes {
+    double registration = 0, backprojection = 0, normals = 0, background = 0, clustering = 0,
+           colors = 0;
+    double total() const {
+        return registration + backprojection + normals + background + clustering + colors;
+    }
+};
+
+/// Everything one frame produced. Valid until the next process() call.
+struct FrameResult {
+    LabelImage labels;                  ///< 0 = no point, 1..k
+    ColorImage colors;                  ///< eq. (9) display colours over the scene
+    std::vector<std::uint8_t> active;   ///< points in the depth range
+    std::size_t active_points = 0;
+    FrameStats stats;
+    StageTimes times;
+};
+
+class Pipeline {
+public:
+    explicit Pipeline(const PipelineParams& params);  ///< validates params
+
+    /// Runs every stage on a registered frame.
+    const FrameResult& process(const RgbdFrame& frame);
+    /// Registers a raw two-camera frame first (timed as "registration").
+    const FrameResult& process(const RawRgbdFrame& raw, const StereoCalibration& calib,
+                               RegistrationMode mode);
+
+    const PipelineParams& params() const { return params_; }
+    const OrganizedCloud& cloud() const { return cloud_; }
+    const NormalMap& normals() const { return normals_; }
+    const ClusterState& state() const { return state_; }
+    const RgbdFrame& registered() const { return registered_; }  ///< last raw frame, registered
+
+private:
+    const FrameResult& run_stages(const RgbdFrame& frame, double registration_ms);
+
+    PipelineParams params_;
+    OrganizedCloud cloud_;
+    NormalMap normals_;
+    ClusterState state_;
+    RegistrationWorkspace registration_ws_;
+    RgbdFrame registered_;
+    FrameResult result_;
+};
+
+}  // namespace wul3d

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Installs what wul3d needs to build, test and benchmark on Debian 12 (bookworm).
+# Idempotent: when every package is already installed it touches nothing (no apt-get update),
+# so repeat runs take well under a second. Must run as root when something is missing.
+#
+#   build-essential ninja-build cmake pkg-config   compiler (GCC 12, with OpenMP), build tools
+#   git                                            source control
+#   libopencv-dev                                  PNG/JPEG reading and writing (core, imgproc,
+#                                                  imgcodecs); the only package with OpenCVConfig.cmake
+#   libeigen3-dev libtbb-dev                       linear algebra; parallel loops (STYLE.md: TBB or OpenMP)
+#   libcli11-dev nlohmann-json3-dev                command line, JSON (header-only)
+#   libgtest-dev libgmock-dev                      the test suite (tests/)
+#   libbenchmark-dev                               the benchmarks (bench/)
+#   python3                                        helper scripts
+set -euo pipefail
+
+packages=(
+  build-essential
+  cmake
+  ninja-build
+  pkg-config
+  git
+  libopencv-dev
+  libeigen3-dev
+  libcli11-dev
+  nlohmann-json3-dev
+  libgtest-dev
+  libgmock-dev
+  libbenchmark-dev
+  libtbb-dev
+  python3
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  if [[ "$status" != "installed" ]]; then
+    missing+=("$p")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+if [[ $(id -u) -ne 0 ]]; then
+  echo "install-deps: missing packages: ${missing[*]}" >&2
+  echo "install-deps: run as root (e.g. sudo $0) to install them" >&2
+  exit 1
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update
+apt-get install -y --no-install-recommends "${packages[@]}"

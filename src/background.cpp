@@ -1,0 +1,35 @@
+#include "wul3d/background.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "wul3d/error.hpp"
+
+namespace wul3d {
+
+void DepthRange::validate() const {
+    if (!(std::isfinite(zmin_m) && std::isfinite(zmax_m) && zmin_m >= 0 && zmax_m > zmin_m)) {
+        std::ostringstream msg;
+        msg << "depth range zmin = " << zmin_m << " m, zmax = " << zmax_m
+            << " m: need 0 <= zmin < zmax";
+        throw ParamError(msg.str());
+    }
+}
+
+std::size_t select_depth_range(const DepthRange& range, const OrganizedCloud& cloud,
+                               std::vector<std::uint8_t>& active) {
+    const std::size_t n = cloud.size();
+    active.resize(n);
+    const float lo = range.zmin_m, hi = range.zmax_m;
+    std::size_t count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count)
+    for (std::size_t p = 0; p < n; ++p) {
+        const float z = cloud.z[p];
+        const std::uint8_t keep = (cloud.valid[p] && z >= lo && z <= hi) ? 1 : 0;
+        active[p] = keep;
+        count += keep;
+    }
+    return count;
+}
+
+}  // namespace wul3d

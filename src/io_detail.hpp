@@ -1,0 +1,29 @@
+#pragma once
+// Private to src/io_*.cpp: image readers that reuse the caller's buffers, so that a
+// FrameSource allocates nothing per frame once the first frame has been read.
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "wul3d/clustering.hpp"
+#include "wul3d/frame.hpp"
+
+namespace wul3d::detail {
+
+/// Scratch of the image readers: the file's bytes and the decoded image.
+struct ImageScratch {
+    std::vector<unsigned char> bytes;
+    std::vector<unsigned char> cleaned;  ///< PNG without ancillary chunks, when it had any
+    cv::Mat decoded;
+};
+
+/// As read_depth_png / read_color_image / read_label_png, into `out` (buffers reused).
+void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageScratch& scratch,
+                         DepthImage& out);
+void read_color_image_into(const std::string& path, ImageScratch& scratch, ColorImage& out);
+void read_label_png_into(const std::string& path, ImageScratch& scratch, LabelImage& out);
+
+/// "WxH".
+inline std::string size_str(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+}  // namespace wul3d::detail

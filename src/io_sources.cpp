@@ -1,0 +1,462 @@
+// Frame sequences of io.hpp: frame folders, TUM RGB-D and unregistered frame folders.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "io_detail.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+
+namespace wul3d {
+
+namespace fs = std::filesystem;
+using detail::size_str;
+
+namespace {
+
+constexpr const char* kNoFramesHint =
+    "expected depth.png in the folder or in its sub-folders, or rgb.txt and depth.txt of a "
+    "TUM RGB-D sequence";
+
+bool is_file(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_regular_file(p, ec);
+}
+
+bool is_dir(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_directory(p, ec);
+}
+
+/// `p` made absolute and without a trailing separator, so that filename() and
+/// parent_path() mean the folder itself and its parent even for "." or "seq/".
+fs::path normalized(const fs::path& p) {
+    fs::path n = fs::absolute(p).lexically_normal();
+    if (n.filename().empty() && n.has_parent_path() && n != n.root_path()) n = n.parent_path();
+    return n;
+}
+
+const char* format_name(InputFormat f) {
+    switch (f) {
+        case InputFormat::Auto: return "auto";
+        case InputFormat::Frames: return "frames";
+        case InputFormat::Tum: return "tum";
+        case InputFormat::Unregistered: return "unregistered";
+    }
+    return "?";
+}
+
+// ---- frame folders --------------------------------------------------------------------
+
+struct FrameDirs {
+    std::vector<fs::path> dirs;
+    std::vector<std::string> names;
+    bool single = false;  ///< `root` itself is the one frame folder
+};
+
+/// A folder looks like a frame folder (and so must hold depth.png) when it holds any of
+/// the files of one.
+bool looks_like_frame(const fs::path& dir) {
+    return is_file(dir / "color.png") || is_file(dir / "intrinsics.json") ||
+           is_file(dir / "label.png");
+}
+
+FrameDirs find_frame_dirs(const std::string& path, const fs::path& root) {
+    FrameDirs found;
+    if (is_file(root / "depth.png")) {
+        found.single = true;
+        found.dirs.push_back(root);
+        found.names.push_back(normalized(root).filename().string());
+        return found;
+    }
+    std::vector<fs::path> subs;
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(root, ec)) {
+        if (!is_dir(entry.path())) continue;
+        if (is_file(entry.path() / "depth.png")) {
+            subs.push_back(entry.path());
+        } else if (looks_like_frame(entry.path())) {
+            throw InputError(entry.path().string() + ": frame folder has no depth.png");
+        }
+    }
+    if (ec) throw InputError(path + ": cannot list the folder (" + ec.message() + ")");
+    if (subs.empty()) {
+        if (looks_like_frame(root)) throw InputError(path + ": frame folder has no depth.png");
+        throw InputError(path + ": no frames found (" + kNoFramesHint + ")");
+    }
+    std::sort(subs.begin(), subs.end(), [](const fs::path& a, const fs::path& b) {
+        return a.filename().string() < b.filename().string();
+    });
+    for (const auto& s : subs) {
+        found.dirs.push_back(s);
+        found.names.push_back(s.filename().string());
+    }
+    return found;
+}
+
+void check_colour_size(const fs::path& dir, const ColorImage& c, const DepthImage& d) {
+    if (c.width != d.width || c.height != d.height) {
+        throw InputError(dir.string() + ": color.png is " + size_str(c.width, c.height) +
+                         " but depth.png is " + size_str(d.width, d.height) +
+                         "; give a calibration (--calibration) for unregistered input");
+    }
+}
+
+void clear_colour(ColorImage& c) {
+    c.width = c.height = 0;
+    c.rgb.clear();  // keeps the capacity for the next frame that has colour
+}
+
+void check_index(std::size_t i, std::size_t n) {
+    if (i >= n) {
+        throw std::out_of_range("frame " + std::to_string(i) + " of a sequence of " +
+                                std::to_string(n));
+    }
+}
+
+/// Registered frame folders: depth.png, intrinsics.json and optional color.png per frame.
+class FramesSource final : public FrameSource {
+public:
+    FramesSource(FrameDirs dirs, std::optional<PinholeIntrinsics> intrinsics)
+        : dirs_(std::move(dirs)), intrinsics_(std::move(intrinsics)) {}
+
+    std::size_t size() const override { return dirs_.dirs.size(); }
+    std::string name(std::size_t i) const override {
+        check_index(i, size());
+        return dirs_.names[i];
+    }
+    InputFormat format() const override { return InputFormat::Frames; }
+
+    void read(std::size_t i, SourceItem& item) override {
+        check_index(i, size());
+        const fs::path& dir = dirs_.dirs[i];
+        item.is_raw = false;
+        RgbdFrame& f = item.frame;
+        f.name = dirs_.names[i];
+
+        // Colour and depth first: a size mismatch is most likely unregistered input, and
+        // then the hint matters more than a missing intrinsics.json.
+        detail::read_depth_png_into((dir / "depth.png").string(), 0.001f, depth_scratch_, f.depth);
+        const fs::path color = dir / "color.png";
+        if (is_file(color)) {
+            detail::read_color_image_into(color.string(), color_scratch_, f.color);
+            check_colour_size(dir, f.color, f.depth);
+        } else {
+            clear_colour(f.color);
+        }
+
+        const fs::path intr = dir / "intrinsics.json";
+        const char* intr_from = "intrinsics.json";
+        if (intrinsics_) {
+            // The override replaces the camera; the file, if present, still gives the units.
+            f.intrinsics = *intrinsics_;
+            intr_from = "the given intrinsics";
+            if (is_file(intr)) {
+                f.depth.scale_m_per_unit = read_intrinsics_json(intr.string()).depth_scale_m_per_unit;
+            }
+        } else {
+            const IntrinsicsFile file = read_intrinsics_json(intr.string());
+            f.intrinsics = file.intrinsics;
+            f.depth.scale_m_per_unit = file.depth_scale_m_per_unit;
+        }
+        if (!f.intrinsics.same_size(f.depth.width, f.depth.height)) {
+            throw InputError(dir.string() + ": depth.png is " +
+                             size_str(f.depth.width, f.depth.height) + " but " + intr_from +
+                             " says " + size_str(f.intrinsics.width, f.intrinsics.height));
+        }
+    }
+
+private:
+    FrameDirs dirs_;
+    std::optional<PinholeIntrinsics> intrinsics_;
+    // One scratch per image kind: a shared one would be re-allocated at every type change.
+    detail::ImageScratch depth_scratch_, color_scratch_;
+};
+
+/// Frame folders of a two-camera sensor: colour and depth at their own resolutions,
+/// one StereoCalibration for the whole sequence. Items are raw; the pipeline registers them.
+class UnregisteredSource final : public FrameSource {
+public:
+    UnregisteredSource(FrameDirs dirs, StereoCalibration calib)
+        : dirs_(std::move(dirs)), calib_(calib) {}
+
+    std::size_t size() const override { return dirs_.dirs.size(); }
+    std::string name(std::size_t i) const override {
+        check_index(i, size());
+        return dirs_.names[i];
+    }
+    InputFormat format() const override { return InputFormat::Unregistered; }
+    const StereoCalibration* calibration() const override { return &calib_; }
+
+    void read(std::size_t i, SourceItem& item) override {
+        check_index(i, size());
+        const fs::path& dir = dirs_.dirs[i];
+        item.is_raw = true;
+        RawRgbdFrame& raw = item.raw;
+        raw.name = dirs_.names[i];
+        detail::read_depth_png_into((dir / "depth.png").string(), calib_.depth_scale_m_per_unit,
+                                    depth_scratch_, raw.depth);
+        if (!calib_.depth.same_size(raw.depth.width, raw.depth.height)) {
+            throw InputError(dir.string() + ": depth.png is " +
+                             size_str(raw.depth.width, raw.depth.height) +
+                             " but the calibration's depth camera is " +
+                             size_str(calib_.depth.width, calib_.depth.height));
+        }
+        const fs::path color = dir / "color.png";
+        if (is_file(color)) {
+            detail::read_color_image_into(color.string(), color_scratch_, raw.color);
+            if (!calib_.color.same_size(raw.color.width, raw.color.height)) {
+                throw InputError(dir.string() + ": color.png is " +
+                                 size_str(raw.color.width, raw.color.height) +
+                                 " but the calibration's colour camera is " +
+                                 size_str(calib_.color.width, calib_.color.height));
+            }
+        } else {
+            clear_colour(raw.color);
+        }
+    }
+
+private:
+    FrameDirs dirs_;
+    StereoCalibration calib_;
+    // One scratch per image kind: a shared one would be re-allocated at every type change.
+    detail::ImageScratch depth_scratch_, color_scratch_;
+};
+
+// ---- TUM RGB-D --------------------------------------------------------------------------
+
+struct Stamped {
+    double t = 0;
+    std::string stamp;  ///< as written in the file: the frame name
+    std::string file;   ///< relative to the sequence folder
+};
+
+/// `rgb.txt` / `depth.txt`: "timestamp filename" lines, '#' comments, blank lines skipped.
+std::vector<Stamped> read_tum_list(const fs::path& file) {
+    const std::string path = file.string();
+    if (!is_file(file)) throw InputError(path + ": no such file");
+    std::ifstream in(file);
+    if (!in) throw InputError(path + ": cannot read");
+    std::vector<Stamped> list;
+    std::string line;
+    for (int lineno = 1; std::getline(in, line); ++lineno) {
+        const auto first = line.find_first_not_of(" \t\r");
+        if (first == std::string::npos || line[first] == '#') continue;
+        std::istringstream fields(line);
+        Stamped s;
+        char* end = nullptr;
+        if (fields >> s.stamp >> s.file) s.t = std::strtod(s.stamp.c_str(), &end);
+        if (end == nullptr || *end != '\0' || !std::isfinite(s.t)) {
+            throw InputError(path + ":" + std::to_string(lineno) +
+                             ": expected 'timestamp filename', got '" + line + "'");
+        }
+        list.push_back(std::move(s));
+    }
+    return list;
+}
+
+struct TumPair {
+    std::string name;
+    fs::path depth, color;
+};
+
+/// Each depth frame takes the colour frame nearest in time, if within max_dt_s; depth
+/// frames without one are dropped. (A colour frame may serve two depth frames; at TUM's
+/// 30 Hz that does not happen within the default 20 ms.)
+std::vector<TumPair> associate(const fs::path& root, std::vector<Stamped> depth,
+                               std::vector<Stamped> rgb, double max_dt_s) {
+    auto by_time = [](const Stamped& a, const Stamped& b) { return a.t < b.t; };
+    std::stable_sort(depth.begin(), depth.end(), by_time);
+    std::stable_sort(rgb.begin(), rgb.end(), by_time);
+    std::vector<TumPair> pairs;
+    for (const Stamped& d : depth) {
+        auto it = std::lower_bound(rgb.begin(), rgb.end(), d, by_time);
+        const Stamped* best = nullptr;
+        if (it != rgb.end()) best = &*it;
+        if (it != rgb.begin()) {
+            const Stamped& prev = *(it - 1);
+            if (best == nullptr || d.t - prev.t <= best->t - d.t) best = &prev;
+        }
+        if (best != nullptr && std::abs(best->t - d.t) <= max_dt_s) {
+            pairs.push_back({d.stamp, root / d.file, root / best->file});
+        }
+    }
+    return pairs;
+}
+
+class TumSource final : public FrameSource {
+public:
+    TumSource(std::vector<TumPair> pairs, PinholeIntrinsics K, std::string intrinsics_from)
+        : pairs_(std::move(pairs)), K_(K), intrinsics_from_(std::move(intrinsics_from)) {}
+
+    std::size_t size() const override { return pairs_.size(); }
+    std::string name(std::size_t i) const override {
+        check_index(i, size());
+        return pairs_[i].name;
+    }
+    InputFormat format() const override { return InputFormat::Tum; }
+
+    void read(std::size_t i, SourceItem& item) override {
+        check_index(i, size());
+        const TumPair& pair = pairs_[i];
+        item.is_raw = false;
+        RgbdFrame& f = item.frame;
+        f.name = pair.name;
+        f.intrinsics = K_;
+        // TUM RGB-D: "depth images are scaled by a factor of 5000".
+        detail::read_depth_png_into(pair.depth.string(), kTumDepthScale, depth_scratch_, f.depth);
+        if (!K_.same_size(f.depth.width, f.depth.height)) {
+            throw InputError(pair.depth.string() + ": depth is " +
+                             size_str(f.depth.width, f.depth.height) + " but the intrinsics (" +
+                             intrinsics_from_ + ") are " + size_str(K_.width, K_.height));
+        }
+        detail::read_color_image_into(pair.color.string(), color_scratch_, f.color);
+        if (f.color.width != f.depth.width || f.color.height != f.depth.height) {
+            throw InputError(pair.color.string() + ": colour is " +
+                             size_str(f.color.width, f.color.height) + " but depth " +
+                             pair.depth.string() + " is " + size_str(f.depth.width, f.depth.height));
+        }
+    }
+
+    static constexpr float kTumDepthScale = 1.0f / 5000.0f;
+
+private:
+    std::vector<TumPair> pairs_;
+    PinholeIntrinsics K_;
+    std::string intrinsics_from_;
+    // One scratch per image kind: a shared one would be re-allocated at every type change.
+    detail::ImageScratch depth_scratch_, color_scratch_;
+};
+
+std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& root,
+                                      const SourceOptions& options) {
+    if (!(options.tum_max_dt_s >= 0.0) || !std::isfinite(options.tum_max_dt_s)) {
+        throw ParamError("SourceOptions.tum_max_dt_s = " + std::to_string(options.tum_max_dt_s) +
+                         ": must be >= 0");
+    }
+    std::vector<Stamped> rgb = read_tum_list(root / "rgb.txt");
+    std::vector<Stamped> depth = read_tum_list(root / "depth.txt");
+    if (depth.empty()) throw InputError(path + ": no frames found (depth.txt lists none)");
+    std::vector<TumPair> pairs = associate(root, std::move(depth), std::move(rgb), options.tum_max_dt_s);
+    if (pairs.empty()) {
+        std::ostringstream msg;
+        msg << path << ": no frames found (no depth.txt entry has an rgb.txt entry within "
+            << options.tum_max_dt_s << " s)";
+        throw InputError(msg.str());
+    }
+
+    PinholeIntrinsics K;
+    std::string from;
+    if (options.intrinsics) {
+        K = *options.intrinsics;
+        from = "given";
+    } else {
+        std::string preset = options.tum_camera;
+        if (preset.empty()) {
+            // TUM folders are named rgbd_dataset_freiburgN_<scene>: N picks the sensor.
+            const std::string folder = normalized(root).filename().string();
+            preset = folder.find("freiburg1") != std::string::npos   ? "tum_fr1"
+                     : folder.find("freiburg2") != std::string::npos ? "tum_fr2"
+                     : folder.find("freiburg3") != std::string::npos ? "tum_fr3"
+                                                                     : "kinect_v1";
+        }
+        K = intrinsics_preset(preset);
+        from = preset;
+    }
+    K.validate("TUM intrinsics (" + from + ")");
+    return std::make_unique<TumSource>(std::move(pairs), K, from);
+}
+
+// ---- calibration ------------------------------------------------------------------------
+
+/// Where calibration.json is looked for: the input folder, then its parent (beside a
+/// single frame folder, or above a sequence).
+std::optional<fs::path> find_calibration_file(const fs::path& root) {
+    const fs::path here = root / "calibration.json";
+    if (is_file(here)) return here;
+    const fs::path parent = normalized(root).parent_path() / "calibration.json";
+    if (is_file(parent)) return parent;
+    return std::nullopt;
+}
+
+}  // namespace
+
+InputFormat parse_input_format(const std::string& name) {
+    if (name == "auto") return InputFormat::Auto;
+    if (name == "frames") return InputFormat::Frames;
+    if (name == "tum") return InputFormat::Tum;
+    if (name == "unregistered") return InputFormat::Unregistered;
+    throw ParamError("unknown input format '" + name +
+                     "' (known: auto, frames, tum, unregistered)");
+}
+
+std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOptions& options) {
+    const fs::path root(path);
+    std::error_code ec;
+    const auto status = fs::status(root, ec);
+    if (!fs::exists(status)) throw InputError(path + ": no such file or directory");
+    if (!fs::is_directory(status)) {
+        throw InputError(path + ": not a folder (" + kNoFramesHint + ")");
+    }
+
+    InputFormat format = options.format;
+    if (format == InputFormat::Auto && is_file(root / "rgb.txt") && is_file(root / "depth.txt")) {
+        format = InputFormat::Tum;
+    }
+    if (format == InputFormat::Tum) {
+        if (!options.calibration.empty()) {
+            throw ParamError("a calibration is for unregistered input, but " + path +
+                             " is read as TUM RGB-D (registered)");
+        }
+        return open_tum(path, root, options);
+    }
+
+    FrameDirs dirs = find_frame_dirs(path, root);
+    // "Beside the frames": in the folder of a sequence's frame folders; for a single frame
+    // folder, in it or in its parent.
+    std::optional<fs::path> calib_file;
+    if (options.calibration.empty() && format != InputFormat::Frames) {
+        if (format == InputFormat::Unregistered || dirs.single) {
+            calib_file = find_calibration_file(root);
+        } else if (is_file(root / "calibration.json")) {
+            calib_file = root / "calibration.json";
+        }
+    }
+    if (format == InputFormat::Auto) {
+        format = (!options.calibration.empty() || calib_file) ? InputFormat::Unregistered
+                                                              : InputFormat::Frames;
+    }
+
+    if (format == InputFormat::Frames) {
+        if (!options.calibration.empty()) {
+            throw ParamError("a calibration is for unregistered input, but " + path +
+                             " is read as '" + format_name(format) + "'");
+        }
+        return std::make_unique<FramesSource>(std::move(dirs), options.intrinsics);
+    }
+
+    // Unregistered.
+    if (options.intrinsics) {
+        throw ParamError("intrinsics cannot be given for unregistered input: the calibration "
+                         "holds both cameras");
+    }
+    StereoCalibration calib;
+    if (options.calibration == "kinect_v2") {
+        calib = kinect_v2_default_calibration();
+    } else if (!options.calibration.empty()) {
+        calib = read_calibration_json(options.calibration);
+    } else if (calib_file) {
+        calib = read_calibration_json(calib_file->string());
+    } else {
+        throw InputError(path + ": unregistered input needs a calibration: give a calibration "
+                                "JSON file or 'kinect_v2' (--calibration), or put "
+                                "calibration.json beside the frames");
+    }
+    return std::make_unique<UnregisteredSource>(std::move(dirs), calib);
+}
+
+}  // namespace wul3d

@@ -1,0 +1,75 @@
+#include "wul3d/pipeline.hpp"
+
+#include <chrono>
+
+#include "wul3d/error.hpp"
+
+namespace wul3d {
+
+PipelineParams PipelineParams::paper() {
+    PipelineParams p;
+    p.cluster = ClusterParams::paper();
+    p.range.zmin_m = 0.5f;  // Kinect v2's working range (paper, section II.A)
+    p.range.zmax_m = 4.5f;
+    return p;
+}
+
+void PipelineParams::validate() const {
+    normals.validate();
+    range.validate();
+    cluster.validate();
+}
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+}  // namespace
+
+Pipeline::Pipeline(const PipelineParams& params)
+    : params_((params.validate(), params)), state_(params.cluster) {}
+
+const FrameResult& Pipeline::process(const RgbdFrame& frame) { return run_stages(frame, 0.0); }
+
+const FrameResult& Pipeline::process(const RawRgbdFrame& raw, const StereoCalibration& calib,
+                                     RegistrationMode mode) {
+    const auto t0 = Clock::now();
+    if (mode == RegistrationMode::DepthToColor)
+        register_depth_to_color(calib, raw, registration_ws_, registered_);
+    else
+        register_color_to_depth(calib, raw, registration_ws_, registered_);
+    return run_stages(registered_, ms_since(t0));
+}
+
+const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registration_ms) {
+    FrameResult& r = result_;
+    r.times = StageTimes{};
+    r.times.registration = registration_ms;
+    if (frame.width() <= 0 || frame.height() <= 0 || frame.depth.empty())
+        throw InputError(frame.name + ": empty depth image");
+
+    auto t = Clock::now();
+    const std::size_t valid = back_project(frame, cloud_);
+    r.times.backprojection = ms_since(t);
+    if (valid == 0) throw InputError(frame.name + ": depth has no valid pixel (all zero)");
+
+    t = Clock::now();
+    estimate_normals(params_.normals, cloud_, normals_);
+    r.times.normals = ms_since(t);
+
+    t = Clock::now();
+    r.active_points = select_depth_range(params_.range, cloud_, r.active);
+    r.times.background = ms_since(t);
+
+    t = Clock::now();
+    r.stats = state_.step(cloud_, normals_, r.active, r.labels);
+    r.times.clustering = ms_since(t);
+
+    t = Clock::now();
+    render_weight_colors(state_, r.labels, frame, r.colors);
+    r.times.colors = ms_since(t);
+    return r;
+}
+
+}  // namespace wul3d

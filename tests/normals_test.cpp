@@ -1,0 +1,129 @@
+#include "wul3d/normals.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "wul3d/error.hpp"
+
+using namespace wul3d;
+
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+const PinholeIntrinsics kK{320, 240, 280.0, 280.0, 159.5, 119.5};
+
+// An exact organized cloud: hit(dx, dy) returns the ray parameter t (= depth) or +inf.
+OrganizedCloud cast(const std::function<float(float, float)>& hit) {
+    OrganizedCloud c;
+    c.resize(kK.width, kK.height);
+    for (int v = 0; v < kK.height; ++v)
+        for (int u = 0; u < kK.width; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * kK.width + u;
+            const float dx = static_cast<float>((u - kK.cx) / kK.fx);
+            const float dy = static_cast<float>((v - kK.cy) / kK.fy);
+            const float t = hit(dx, dy);
+            c.valid[p] = std::isfinite(t) ? 1 : 0;
+            if (!c.valid[p]) continue;
+            c.x[p] = dx * t;
+            c.y[p] = dy * t;
+            c.z[p] = t;
+        }
+    return c;
+}
+
+double angle_deg(float ax, float ay, float az, double bx, double by, double bz) {
+    const double dot = ax * bx + ay * by + az * bz;
+    const double nb = std::sqrt(bx * bx + by * by + bz * bz);
+    return std::acos(std::clamp(dot / nb, -1.0, 1.0)) * 180.0 / M_PI;
+}
+}  // namespace
+
+TEST(Normals, TiltedPlaneWithin2Degrees) {
+    // Plane n . P = d with n facing the camera (tilted 30 deg about x and 20 about y).
+    const double nx = -0.30, ny = -0.45, nz = -0.84;
+    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const double d = nz / len * 1.5;  // passes through (0, 0, 1.5)
+    const OrganizedCloud c = cast([&](float dx, float dy) {
+        const double denom = (nx * dx + ny * dy + nz) / len;
+        const double t = d / denom;
+        return t > 0 ? static_cast<float>(t) : kInf;
+    });
+    NormalMap n;
+    estimate_normals(NormalParams{}, c, n);
+    std::size_t checked = 0;
+    for (std::size_t p = 0; p < c.size(); ++p) {
+        if (!c.valid[p]) continue;
+        ASSERT_TRUE(n.valid[p]) << p;
+        EXPECT_LT(angle_deg(n.nx[p], n.ny[p], n.nz[p], nx, ny, nz), 2.0) << p;
+        ++checked;
+    }
+    EXPECT_GT(checked, c.size() / 2);
+}
+
+TEST(Normals, SphereWithin2Degrees) {
+    const double cz = 1.0, r = 0.3;
+    const OrganizedCloud c = cast([&](float dx, float dy) {
+        // |t (dx, dy, 1) - (0, 0, cz)|^2 = r^2, nearest root
+        const double a = dx * dx + dy * dy + 1.0, b = -2.0 * cz, cc = cz * cz - r * r;
+        const double disc = b * b - 4 * a * cc;
+        if (disc < 0) return kInf;
+        return static_cast<float>((-b - std::sqrt(disc)) / (2 * a));
+    });
+    NormalMap n;
+    estimate_normals(NormalParams{}, c, n);
+    std::size_t checked = 0, interior = 0;
+    for (std::size_t p = 0; p < c.size(); ++p) {
+        if (!c.valid[p]) continue;
+        const double ex = c.x[p] / r, ey = c.y[p] / r, ez = (c.z[p] - cz) / r;
+        const double ray = std::sqrt(c.x[p] * c.x[p] + c.y[p] * c.y[p] + c.z[p] * c.z[p]);
+        const double facing = -(ex * c.x[p] + ey * c.y[p] + ez * c.z[p]) / ray;
+        if (facing < 0.5) continue;  // within 60 degrees of grazing: the rim, left out
+        ++interior;
+        if (!n.valid[p]) continue;
+        EXPECT_LT(angle_deg(n.nx[p], n.ny[p], n.nz[p], ex, ey, ez), 2.0) << p;
+        ++checked;
+    }
+    EXPECT_GT(interior, 5000u);
+    EXPECT_EQ(checked, interior);
+}
+
+TEST(Normals, NoneAcrossADepthStep) {
+    // Left half at 1.0 m, right half at 1.5 m: every normal must face straight back.
+    const OrganizedCloud c = cast([](float dx, float) { return dx < 0 ? 1.0f : 1.5f; });
+    NormalMap n;
+    estimate_normals(NormalParams{}, c, n);
+    std::size_t valid = 0;
+    for (std::size_t p = 0; p < c.size(); ++p) {
+        if (!n.valid[p]) continue;
+        ++valid;
+        EXPECT_LT(angle_deg(n.nx[p], n.ny[p], n.nz[p], 0, 0, -1), 0.1) << p;  // float rounding
+    }
+    EXPECT_EQ(valid, c.size());  // one-sided differences keep the pixels at the step
+}
+
+TEST(Normals, InvalidPixelsGetNoNormal) {
+    OrganizedCloud c = cast([](float, float) { return 2.0f; });
+    // An isolated valid pixel surrounded by holes has no neighbour: no normal.
+    for (int v = 100; v < 110; ++v)
+        for (int u = 100; u < 110; ++u) c.valid[static_cast<std::size_t>(v) * kK.width + u] = 0;
+    const std::size_t lone = static_cast<std::size_t>(105) * kK.width + 105;
+    c.valid[lone] = 1;
+    NormalMap n;
+    estimate_normals(NormalParams{}, c, n);
+    EXPECT_EQ(n.valid[lone], 0);
+    EXPECT_EQ(n.valid[static_cast<std::size_t>(101) * kK.width + 101], 0);
+    EXPECT_EQ(n.valid[static_cast<std::size_t>(50) * kK.width + 50], 1);
+}
+
+TEST(NormalParams, Validate) {
+    NormalParams p;
+    EXPECT_NO_THROW(p.validate());
+    p.radius_px = 0;
+    EXPECT_THROW(p.validate(), ParamError);
+    p.radius_px = 2;
+    p.max_depth_jump_rel = 0;
+    EXPECT_THROW(p.validate(), ParamError);
+}

@@ -1,0 +1,84 @@
+#include "wul3d/pipeline.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "test_support.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+
+using namespace wul3d;
+using namespace wul3d::test;
+
+// Real frames shipped in the repository (data/samples, MIT and BSD licensed).
+TEST(Pipeline, RealTabletopFramesGetLabelsOnEveryValidInRangePixel) {
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    ASSERT_EQ(source->size(), 4u);
+    PipelineParams params;
+    params.cluster.k = 10;
+    Pipeline pipeline(params);
+    SourceItem item;
+    for (std::size_t i = 0; i < source->size(); ++i) {
+        source->read(i, item);
+        ASSERT_FALSE(item.is_raw);
+        const FrameResult& r = pipeline.process(item.frame);
+        ASSERT_EQ(r.labels.width, 640);
+        ASSERT_EQ(r.labels.height, 480);
+        std::size_t in_range = 0;
+        std::vector<bool> used(11, false);
+        for (std::size_t p = 0; p < r.labels.labels.size(); ++p) {
+            const float z = static_cast<float>(item.frame.depth.data[p]) * item.frame.depth.scale_m_per_unit;
+            const bool expect = item.frame.depth.data[p] != 0 && z >= params.range.zmin_m &&
+                                z <= params.range.zmax_m;
+            in_range += expect;
+            if (expect) {
+                ASSERT_GE(r.labels.labels[p], 1);
+                ASSERT_LE(r.labels.labels[p], 10);
+                used[r.labels.labels[p]] = true;
+            } else {
+                ASSERT_EQ(r.labels.labels[p], 0);
+            }
+        }
+        EXPECT_EQ(in_range, r.active_points);
+        EXPECT_GT(in_range, 100000u);
+        EXPECT_EQ(std::count(used.begin() + 1, used.end(), true), 10) << "a cluster is empty";
+        EXPECT_EQ(r.colors.rgb.size(), 3u * 640 * 480);
+        EXPECT_GT(pipeline.normals().valid.size(), 0u);
+    }
+    EXPECT_EQ(pipeline.state().tau(), 4);
+}
+
+TEST(Pipeline, RealDepthOnlySequence) {
+    auto source = open_source((sample_dir() / "pcl_kinect" / "pairwise_seq").string(), SourceOptions{});
+    ASSERT_EQ(source->size(), 5u);
+    Pipeline pipeline(PipelineParams::paper());
+    SourceItem item;
+    for (std::size_t i = 0; i < source->size(); ++i) {
+        source->read(i, item);
+        ASSERT_FALSE(item.frame.has_color());
+        const FrameResult& r = pipeline.process(item.frame);
+        std::size_t labelled = 0;
+        for (auto l : r.labels.labels) labelled += l != 0;
+        EXPECT_EQ(labelled, r.active_points);
+        EXPECT_GT(labelled, 100000u);
+    }
+}
+
+TEST(Pipeline, AllInvalidDepthIsAnInputError) {
+    RgbdFrame f;
+    f.name = "zeros";
+    f.intrinsics = intrinsics_preset("kinect_v1");
+    f.depth.width = 640;
+    f.depth.height = 480;
+    f.depth.data.assign(640 * 480, 0);
+    Pipeline pipeline(PipelineParams{});
+    EXPECT_THROW(pipeline.process(f), InputError);
+}
+
+TEST(PipelineParams, PaperPresetValidates) {
+    const PipelineParams p = PipelineParams::paper();
+    EXPECT_NO_THROW(p.validate());
+    EXPECT_FLOAT_EQ(p.range.zmin_m, 0.5f);
+    EXPECT_FLOAT_EQ(p.range.zmax_m, 4.5f);
+}

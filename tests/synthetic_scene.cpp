@@ -1,0 +1,110 @@
+#include "synthetic_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+
+namespace wul3d::test {
+
+PinholeIntrinsics scene_intrinsics(int width, int height) {
+    return PinholeIntrinsics{width, height, 0.9 * width, 0.9 * width, width / 2.0 - 0.5,
+                             height / 2.0 - 0.5};
+}
+
+namespace {
+// Ray (dx, dy, 1) against an axis-aligned box; returns the entry t or +inf.
+float hit_box(float dx, float dy, float x0, float x1, float y0, float y1, float z0, float z1) {
+    float t0 = 0, t1 = std::numeric_limits<float>::infinity();
+    auto slab = [&](float dir, float lo, float hi) {
+        if (std::fabs(dir) < 1e-12f) return lo <= 0 && 0 <= hi;
+        float a = lo / dir, b = hi / dir;
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+        return t0 <= t1;
+    };
+    if (!slab(dx, x0, x1) || !slab(dy, y0, y1) || !slab(1.0f, z0, z1))
+        return std::numeric_limits<float>::infinity();
+    return t0 > 0 ? t0 : std::numeric_limits<float>::infinity();
+}
+}  // namespace
+
+RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
+    RgbdFrame f;
+    f.name = "synthetic";
+    f.intrinsics = scene_intrinsics(s.width, s.height);
+    f.depth.width = f.color.width = s.width;
+    f.depth.height = f.color.height = s.height;
+    f.depth.scale_m_per_unit = 0.0001f;
+    const std::size_t n = static_cast<std::size_t>(s.width) * s.height;
+    f.depth.data.assign(n, 0);
+    f.color.rgb.assign(3 * n, 0);
+    if (truth) truth->assign(n, 0);
+    std::mt19937 rng(s.noise_seed);
+    std::uniform_int_distribution<int> noise(-3, 3);
+
+    const auto& K = f.intrinsics;
+    for (int v = 0; v < s.height; ++v) {
+        for (int u = 0; u < s.width; ++u) {
+            const float dx = static_cast<float>((u - K.cx) / K.fx);
+            const float dy = static_cast<float>((v - K.cy) / K.fy);
+            float best = std::numeric_limits<float>::infinity();
+            int id = 0;
+            std::uint8_t rgb[3] = {0, 0, 0};
+            // Table: the plane y = table_y, a rectangle on it.
+            if (dy > 1e-6f) {
+                const float t = s.table_y / dy;
+                const float x = dx * t;
+                if (t >= s.table_near && t <= s.table_far && std::fabs(x) <= s.table_half_width) {
+                    best = t;
+                    id = kTruthTable;
+                    rgb[0] = 150; rgb[1] = 140; rgb[2] = 120;
+                }
+            }
+            if (s.wall && 2.4f < best) {
+                best = 2.4f;
+                id = kTruthWall;
+                rgb[0] = 90; rgb[1] = 110; rgb[2] = 140;
+            }
+            for (std::size_t i = 0; i < s.boxes.size(); ++i) {
+                const SceneBox& b = s.boxes[i];
+                const float t = hit_box(dx, dy, b.x - b.w / 2, b.x + b.w / 2, s.table_y - b.h,
+                                        s.table_y, b.z - b.d / 2, b.z + b.d / 2);
+                if (t < best) {
+                    best = t;
+                    id = kTruthBox0 + static_cast<int>(i);
+                    rgb[0] = b.r; rgb[1] = b.g; rgb[2] = b.b;
+                }
+            }
+            const std::size_t p = static_cast<std::size_t>(v) * s.width + u;
+            if (id == 0) continue;
+            f.depth.data[p] = static_cast<std::uint16_t>(std::lround(best / f.depth.scale_m_per_unit));
+            for (int q = 0; q < 3; ++q) {
+                const int c = rgb[q] + (s.noise_seed ? noise(rng) : 0);
+                f.color.rgb[3 * p + q] = static_cast<std::uint8_t>(std::clamp(c, 0, 255));
+            }
+            if (truth) (*truth)[p] = id;
+        }
+    }
+    return f;
+}
+
+double dominant_share(const std::vector<std::uint16_t>& labels, const std::vector<int>& truth,
+                      int id, int* dominant) {
+    std::map<int, std::size_t> counts;
+    std::size_t total = 0;
+    for (std::size_t p = 0; p < truth.size(); ++p)
+        if (truth[p] == id) {
+            ++counts[labels[p]];
+            ++total;
+        }
+    if (total == 0) return 0.0;
+    const auto best = std::max_element(counts.begin(), counts.end(),
+                                       [](auto& a, auto& b) { return a.second < b.second; });
+    if (dominant) *dominant = best->first;
+    return static_cast<double>(best->second) / static_cast<double>(total);
+}
+
+}  // namespace wul3d::test

@@ -1,0 +1,42 @@
+#pragma once
+// Synthetic RGB-D scenes whose answer is known: a table, coloured boxes standing on it and
+// a back wall, ray-cast exactly from a pinhole camera (x right, y down, z forward).
+#include <cstdint>
+#include <vector>
+
+#include "wul3d/backprojection.hpp"
+#include "wul3d/frame.hpp"
+
+namespace wul3d::test {
+
+struct SceneBox {
+    float x = 0, z = 1.2f;              ///< centre of the footprint on the table, metres
+    float w = 0.15f, h = 0.15f, d = 0.15f;  ///< size along x, y, z, metres
+    std::uint8_t r = 200, g = 30, b = 30;
+};
+
+struct Scene {
+    std::vector<SceneBox> boxes;
+    bool wall = false;          ///< a back wall at z = 2.4 m
+    float table_half_width = 0.6f;            ///< table spans x in [-w, w]
+    float table_near = 0.7f, table_far = 1.7f;  ///< and z in [near, far], metres
+    float table_y = 0.35f;      ///< table top height below the camera, metres
+    int width = 320, height = 240;
+    std::uint32_t noise_seed = 0;  ///< colour noise of +-3 levels when non-zero
+};
+
+/// Ground-truth ids: 0 nothing, 1 table, 2 wall, 10 + i box i.
+constexpr int kTruthTable = 1, kTruthWall = 2, kTruthBox0 = 10;
+
+/// Intrinsics used for every synthetic scene of that size.
+PinholeIntrinsics scene_intrinsics(int width, int height);
+
+/// Renders the scene; depth in 0.1 mm units. `truth` gets one id per pixel.
+RgbdFrame render_scene(const Scene& scene, std::vector<int>* truth = nullptr);
+
+/// The share of the pixels with truth id `id` whose label is the most common label among
+/// them; `dominant` gets that label.
+double dominant_share(const std::vector<std::uint16_t>& labels, const std::vector<int>& truth,
+                      int id, int* dominant = nullptr);
+
+}  // namespace wul3d::test

@@ -1,0 +1,41 @@
+#pragma once
+// Shared helpers of the test suite: where the shipped samples are, temporary folders, and
+// running the wul3d command.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace wul3d::test {
+
+/// data/samples of the source tree (shipped real frames, MIT and BSD licensed).
+std::filesystem::path sample_dir();
+/// Path of the built `wul3d` command.
+std::filesystem::path cli_path();
+
+/// A fresh folder under the system temp dir, removed with its contents on destruction.
+class TempDir {
+public:
+    TempDir();
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+private:
+    std::filesystem::path path_;
+};
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string out;  ///< stdout
+    std::string err;  ///< stderr
+};
+
+/// Runs the wul3d command with `args` (no shell quoting needed), stdin from /dev/null.
+CommandResult run_cli(const std::vector<std::string>& args);
+
+/// Every regular file under `dir`, relative paths, sorted.
+std::vector<std::string> list_files(const std::filesystem::path& dir);
+
+}  // namespace wul3d::test
