@@ -155,6 +155,10 @@ public:
             // The override replaces the camera; the file, if present, still gives the units.
             f.intrinsics = *intrinsics_;
             intr_from = "the given intrinsics";
+            if (f.intrinsics.width == 0 && f.intrinsics.height == 0) {
+                f.intrinsics.width = f.depth.width;  // no size given: the frame's own
+                f.intrinsics.height = f.depth.height;
+            }
             if (is_file(intr)) {
                 f.depth.scale_m_per_unit = read_intrinsics_json(intr.string()).depth_scale_m_per_unit;
             }
@@ -309,7 +313,11 @@ public:
         f.intrinsics = K_;
         // TUM RGB-D: "depth images are scaled by a factor of 5000".
         detail::read_depth_png_into(pair.depth.string(), kTumDepthScale, depth_scratch_, f.depth);
-        if (!K_.same_size(f.depth.width, f.depth.height)) {
+        if (K_.width == 0 && K_.height == 0) {
+            f.intrinsics.width = f.depth.width;  // given intrinsics without a size
+            f.intrinsics.height = f.depth.height;
+        }
+        if (!f.intrinsics.same_size(f.depth.width, f.depth.height)) {
             throw InputError(pair.depth.string() + ": depth is " +
                              size_str(f.depth.width, f.depth.height) + " but the intrinsics (" +
                              intrinsics_from_ + ") are " + size_str(K_.width, K_.height));
@@ -367,7 +375,9 @@ std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& r
         K = intrinsics_preset(preset);
         from = preset;
     }
-    K.validate("TUM intrinsics (" + from + ")");
+    PinholeIntrinsics check = K;
+    if (check.width == 0 && check.height == 0) check.width = check.height = 1;  // sized per frame
+    check.validate("TUM intrinsics (" + from + ")");
     return std::make_unique<TumSource>(std::move(pairs), K, from);
 }
 

@@ -179,12 +179,14 @@ void StereoCalibration::validate() const {
 }
 
 StereoCalibration kinect_v2_default_calibration() {
-    // Typical Kinect v2 values, not the calibration of any one device: the depth (IR) camera
-    // as libfreenect2 and the Kinect SDK commonly report it (fx = fy ~ 365.5, principal
-    // point at the image centre, 512x424), the colour camera's usual factory values
-    // (fx = fy ~ 1081.37, 1920x1080, principal point at the centre), no rotation and the
-    // colour camera 5.2 cm along the depth camera's x axis. Lens distortion is ignored.
-    // Per-device values differ by a few pixels and millimetres; see docs/INPUTS.md.
+    // Typical Kinect v2 values, not the calibration of any one device: the depth (IR)
+    // camera's focal length as Kinect v2 drivers commonly report it (fx = fy ~ 365.5 px,
+    // 512x424) with the principal point put at the image centre, the colour camera's widely
+    // used default (fx = fy = 1081.37 px, cx = 959.5, cy = 539.5, 1920x1080), no rotation and
+    // a 5.2 cm baseline along x: t = (0.052, 0, 0) puts the colour camera's centre at
+    // x = -5.2 cm in depth-camera coordinates (which side that is on the device depends on
+    // whether the driver mirrors the images). Lens distortion is ignored. Real devices
+    // differ by a few pixels and millimetres; see docs/INPUTS.md.
     StereoCalibration c;
     c.depth = PinholeIntrinsics{512, 424, 365.5, 365.5, 255.5, 211.5};
     c.color = PinholeIntrinsics{1920, 1080, 1081.37, 1081.37, 959.5, 539.5};

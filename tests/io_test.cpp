@@ -255,6 +255,41 @@ TEST(IoImages, ReaderErrors_TruncatedAndCorruptPng) {
                        {empty.string(), "cannot decode"});
 }
 
+/// CRC-32 of the PNG specification, to build chunks by hand.
+std::uint32_t crc32(const std::string& bytes) {
+    std::uint32_t c = 0xffffffffu;
+    for (unsigned char b : bytes) {
+        c ^= b;
+        for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xedb88320u ^ (c >> 1) : c >> 1;
+    }
+    return c ^ 0xffffffffu;
+}
+
+std::string be32(std::uint32_t v) {
+    return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
+            static_cast<char>(v)};
+}
+
+TEST(IoImages, PngWithAncillaryChunksReadsQuietly) {
+    TempDir tmp;
+    const fs::path path = tmp / "depth.png";
+    const wul3d::DepthImage d = ramp_depth(16, 9);
+    wul3d::write_depth_png(path.string(), d);
+    std::string bytes = slurp(path);
+    // A tEXt chunk and an unknown private ancillary chunk after IHDR (8 + 25 bytes).
+    std::string chunks;
+    using namespace std::string_literals;
+    for (const std::string& body : {"tEXtComment\0made by io_test"s, "prVtanything at all"s}) {
+        chunks += be32(static_cast<std::uint32_t>(body.size() - 4)) + body + be32(crc32(body));
+    }
+    bytes.insert(33, chunks);
+    spit(path, bytes);
+    testing::internal::CaptureStderr();
+    const wul3d::DepthImage back = wul3d::read_depth_png(path.string(), 0.001f);
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+    EXPECT_EQ(back.data, d.data);
+}
+
 TEST(IoImages, ReaderErrors_WrongBitDepth) {
     TempDir tmp;
     const fs::path mask = tmp / "mask.png";
@@ -411,6 +446,14 @@ TEST(OpenSource, IntrinsicsOverride) {
     EXPECT_DOUBLE_EQ(item.frame.intrinsics.fy, 501);
     EXPECT_FLOAT_EQ(item.frame.depth.scale_m_per_unit, 0.001f);
 
+    // No size given (as the CLI's --intrinsics fx,fy,cx,cy): each frame's own.
+    opt.intrinsics = wul3d::PinholeIntrinsics{0, 0, 500, 501, 320, 240};
+    src = wul3d::open_source((sample_dir() / "pcl_kinect/pairwise_seq").string(), opt);
+    src->read(0, item);
+    EXPECT_EQ(item.frame.intrinsics.width, 640);
+    EXPECT_EQ(item.frame.intrinsics.height, 480);
+    EXPECT_DOUBLE_EQ(item.frame.intrinsics.fy, 501);
+
     opt.intrinsics = wul3d::PinholeIntrinsics{512, 424, 365, 365, 256, 212};
     src = wul3d::open_source((sample_dir() / "uois_tabletop").string(), opt);
     expect_input_error([&] { src->read(0, item); }, {"image_0000", "640x480", "512x424"});
@@ -507,6 +550,11 @@ TEST(OpenSource, TumAssociationScaleAndIntrinsics) {
     src = wul3d::open_source(root.string(), opt);
     src->read(0, item);
     EXPECT_DOUBLE_EQ(item.frame.intrinsics.fx, 600.0);
+    opt.intrinsics = wul3d::PinholeIntrinsics{0, 0, 610, 610, 320, 240};
+    src = wul3d::open_source(root.string(), opt);
+    src->read(0, item);
+    EXPECT_DOUBLE_EQ(item.frame.intrinsics.fx, 610.0);
+    EXPECT_EQ(item.frame.intrinsics.width, 640);
 
     opt = {};
     opt.tum_max_dt_s = 0.001;

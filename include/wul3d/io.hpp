@@ -69,7 +69,8 @@ struct SourceOptions {
     /// TUM only: intrinsics preset name (camera.hpp) or empty to pick from the folder name
     /// (freiburg1/2/3 -> tum_fr1/2/3, else kinect_v1).
     std::string tum_camera;
-    /// Overrides the intrinsics of every frame (any format but Unregistered).
+    /// Overrides the intrinsics of every frame (any format but Unregistered). Width and
+    /// height 0 mean "each frame's own size".
     std::optional<PinholeIntrinsics> intrinsics;
     /// Unregistered only: a calibration JSON path, or "kinect_v2" for the built-in preset.
     /// Empty: `calibration.json` in the input folder (or its parent).
