@@ -271,37 +271,53 @@ void ClusterState::assign() {
     const float d2 = params_.delta * params_.delta;
     const float a2 = use_color_ ? params_.alpha * params_.alpha : 0.0f;
     const float gamma = params_.gamma;
-    const Centres& c = centres_;
     // 1 where the centre has a normal, so that the normal term drops out for it (eq. 6
     // needs both normals).
     for (int j = 0; j < k; ++j) centre_normal_[j] = centre_has_normal(j) ? 1.0f : 0.0f;
+    // Raw pointers: the compiler cannot otherwise prove that the stores to winner and f
+    // leave the centres alone, and reloads them for every point.
+    const float *cx = centres_.x.data(), *cy = centres_.y.data(), *cz = centres_.z.data();
+    const float *cr = centres_.r.data(), *cg = centres_.g.data(), *cb = centres_.b.data();
+    const float *cnx = centres_.nx.data(), *cny = centres_.ny.data(), *cnz = centres_.nz.data();
     const float* chn = centre_normal_.data();
+    const float *x = pts_.x.data(), *y = pts_.y.data(), *z = pts_.z.data();
+    const float *r = pts_.r.data(), *g = pts_.g.data(), *b = pts_.b.data();
+    const float *nx = pts_.nx.data(), *ny = pts_.ny.data(), *nz = pts_.nz.data();
+    const std::uint8_t* has_normal = pts_.has_normal.data();
+    int* winner = pts_.winner.data();
+    float* fmin = pts_.f.data();
     const auto n = static_cast<std::ptrdiff_t>(n_);
+    constexpr int kChunk = 64;  // centres per pass: f of a chunk first (vectorizes), then arg-min
 
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t i = 0; i < n; ++i) {
-        const float px = pts_.x[i], py = pts_.y[i], pz = pts_.z[i];
-        const float pr = pts_.r[i], pg = pts_.g[i], pb = pts_.b[i];
-        const float pnx = pts_.nx[i], pny = pts_.ny[i], pnz = pts_.nz[i];
-        const float gp = pts_.has_normal[i] ? gamma : 0.0f;
+        const float px = x[i], py = y[i], pz = z[i], pr = r[i], pg = g[i], pb = b[i];
+        const float pnx = nx[i], pny = ny[i], pnz = nz[i];
+        const float gp = has_normal[i] ? gamma : 0.0f;
         float best_f = INFINITY;
         int best = 0;
-        for (int j = 0; j < k; ++j) {
-            const float dx = px - c.x[j], dy = py - c.y[j], dz = pz - c.z[j];
-            const float dr = pr - c.r[j], dg = pg - c.g[j], db = pb - c.b[j];
-            // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
-            // arg-min of f is not the arg-min of the squared distance.
-            const float dist =
-                std::sqrt(d2 * (dx * dx + dy * dy + dz * dz) + a2 * (dr * dr + dg * dg + db * db));
-            const float cos_theta = pnx * c.nx[j] + pny * c.ny[j] + pnz * c.nz[j];
-            const float f = dist + gp * chn[j] * (1.0f - cos_theta);  // eq. (6)
-            if (f < best_f) {
-                best_f = f;
-                best = j;
+        for (int j0 = 0; j0 < k; j0 += kChunk) {
+            const int m = std::min(kChunk, k - j0);
+            float f[kChunk];
+            for (int q = 0; q < m; ++q) {
+                const int j = j0 + q;
+                const float dx = px - cx[j], dy = py - cy[j], dz = pz - cz[j];
+                const float dr = pr - cr[j], dg = pg - cg[j], db = pb - cb[j];
+                // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
+                // arg-min of f is not the arg-min of the squared distance.
+                const float dist = std::sqrt(d2 * (dx * dx + dy * dy + dz * dz) +
+                                             a2 * (dr * dr + dg * dg + db * db));
+                const float cos_theta = pnx * cnx[j] + pny * cny[j] + pnz * cnz[j];
+                f[q] = dist + gp * chn[j] * (1.0f - cos_theta);  // eq. (6)
             }
+            for (int q = 0; q < m; ++q)
+                if (f[q] < best_f) {
+                    best_f = f[q];
+                    best = j0 + q;
+                }
         }
-        pts_.winner[i] = best;
-        pts_.f[i] = best_f;
+        winner[i] = best;
+        fmin[i] = best_f;
     }
 }
 

@@ -451,6 +451,9 @@ struct ParamCase {
     const char* param;
 };
 
+// Names the case in test listings (ctest shows GetParam() through this, not as raw bytes).
+void PrintTo(const ParamCase& c, std::ostream* os) { *os << c.test_name; }
+
 class CliRunBadParam : public ::testing::TestWithParam<ParamCase> {};
 
 TEST_P(CliRunBadParam, RejectedWithExitCode2NamingTheParameter) {
