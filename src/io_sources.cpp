@@ -40,16 +40,6 @@ fs::path normalized(const fs::path& p) {
     return n;
 }
 
-const char* format_name(InputFormat f) {
-    switch (f) {
-        case InputFormat::Auto: return "auto";
-        case InputFormat::Frames: return "frames";
-        case InputFormat::Tum: return "tum";
-        case InputFormat::Unregistered: return "unregistered";
-    }
-    return "?";
-}
-
 // ---- frame folders --------------------------------------------------------------------
 
 struct FrameDirs {
@@ -395,6 +385,16 @@ std::optional<fs::path> find_calibration_file(const fs::path& root) {
 
 }  // namespace
 
+const char* input_format_name(InputFormat f) {
+    switch (f) {
+        case InputFormat::Auto: return "auto";
+        case InputFormat::Frames: return "frames";
+        case InputFormat::Tum: return "tum";
+        case InputFormat::Unregistered: return "unregistered";
+    }
+    return "?";
+}
+
 InputFormat parse_input_format(const std::string& name) {
     if (name == "auto") return InputFormat::Auto;
     if (name == "frames") return InputFormat::Frames;
@@ -444,7 +444,7 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
     if (format == InputFormat::Frames) {
         if (!options.calibration.empty()) {
             throw ParamError("a calibration is for unregistered input, but " + path +
-                             " is read as '" + format_name(format) + "'");
+                             " is read as '" + input_format_name(format) + "'");
         }
         return std::make_unique<FramesSource>(std::move(dirs), options.intrinsics);
     }

@@ -183,7 +183,6 @@ void run(const RunOptions& o) {
         const auto uv = parse_list("--select", o.select, 2);
         selection.emplace(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
     }
-    if (o.threads < 0) throw ParamError("--threads " + std::to_string(o.threads) + ": must be >= 1");
     if (o.threads > 0) omp_set_num_threads(o.threads);
 
     auto source = open_source(o.input, source_options);
@@ -257,7 +256,7 @@ void run(const RunOptions& o) {
     const auto& c = params.cluster;
     nlohmann::json summary;
     summary["input"] = o.input;
-    summary["format"] = o.format;
+    summary["format"] = input_format_name(source->format());
     summary["parameters"] = {{"k", c.k},
                              {"alpha", c.alpha},
                              {"delta", c.delta},
@@ -313,8 +312,10 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("--zmax", opts->zmax, "Farthest depth kept, metres (default 4.5)");
     cmd->add_option("--normal-radius", opts->normal_radius, "Normal neighbour distance, px (default 2)");
     cmd->add_option("--select", opts->select, "U,V: follow the object under this pixel of the first frame");
-    cmd->add_option("--frames", opts->max_frames, "Stop after N frames (default: all)");
-    cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)");
+    cmd->add_option("--frames", opts->max_frames, "Stop after N frames (default: all)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
+        ->check(CLI::PositiveNumber);
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
     cmd->add_option("--tum-camera", opts->tum_camera,

@@ -63,6 +63,7 @@ enum class InputFormat {
     Unregistered,  ///< frame folders with colour and depth of different sizes + calibration
 };
 InputFormat parse_input_format(const std::string& name);  ///< auto|frames|tum|unregistered
+const char* input_format_name(InputFormat format);       ///< the inverse of parse_input_format
 
 struct SourceOptions {
     InputFormat format = InputFormat::Auto;
