@@ -313,9 +313,9 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("--normal-radius", opts->normal_radius, "Normal neighbour distance, px (default 2)");
     cmd->add_option("--select", opts->select, "U,V: follow the object under this pixel of the first frame");
     cmd->add_option("--frames", opts->max_frames, "Stop after N frames (default: all)")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::Range(1, 1 << 30));
     cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
     cmd->add_option("--tum-camera", opts->tum_camera,
