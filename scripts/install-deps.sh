@@ -12,6 +12,11 @@
 #   libgtest-dev libgmock-dev                      the test suite (tests/)
 #   libbenchmark-dev                               the benchmarks (bench/)
 #   python3                                        helper scripts
+#   libglfw3-dev libgl-dev libimgui-dev            `wul3d view` (GLFW 3, OpenGL, Dear ImGui with its
+#                                                  GLFW/OpenGL 3 backends); built only when found
+#   xvfb xauth libgl1-mesa-dri                     the viewer's test: a virtual X server (xvfb-run)
+#                                                  and Mesa's software OpenGL
+#   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
 packages=(
@@ -29,6 +34,12 @@ packages=(
   libbenchmark-dev
   libtbb-dev
   python3
+  libglfw3-dev
+  libgl-dev
+  libimgui-dev
+  xvfb
+  xauth
+  libgl1-mesa-dri
 )
 
 missing=()

@@ -78,6 +78,43 @@ int update_weights(float* mu, int k, int winner, float psi) {
     return best;
 }
 
+int update_weights(PixelWeights& w, int winner, float psi) {
+    constexpr int S = PixelWeights::kSlots;
+    // A pixel whose whole weight is already on the winner stays so: (1 + psi) / (1 + psi).
+    // That is every pixel of a still scene, so it is worth checking first.
+    if (w.mu[0] == static_cast<std::uint16_t>(PixelWeights::kOne) && w.cluster[0] == winner)
+        return winner;
+    float m[S];
+    float sum = 0;
+    int slot = -1, smallest = 0;
+    for (int s = 0; s < S; ++s) {
+        m[s] = w.mu[s];
+        sum += m[s];
+        if (w.mu[s] > 0 && w.cluster[s] == winner) slot = s;
+        if (w.mu[s] < w.mu[smallest]) smallest = s;
+    }
+    if (slot < 0) {  // the winner is not kept: it takes the smallest slot, whose weight drops
+        slot = smallest;
+        sum -= m[slot];
+        m[slot] = 0;
+        w.cluster[slot] = static_cast<std::uint16_t>(winner);
+    }
+    // Paper eq. (2), then (7)-(8) on the kept weights, in units of kOne.
+    m[slot] += psi * PixelWeights::kOne;
+    const float scale = PixelWeights::kOne / (sum + psi * PixelWeights::kOne);
+    for (int s = 0; s < S; ++s)
+        w.mu[s] = static_cast<std::uint16_t>(std::min(PixelWeights::kOne, m[s] * scale + 0.5f));
+    int best = slot;  // ties go to the newest evidence
+    for (int s = 0; s < S; ++s)
+        if (w.mu[s] > w.mu[best]) best = s;
+    const std::uint16_t label = w.cluster[best];
+    if (w.mu[best] == static_cast<std::uint16_t>(PixelWeights::kOne) && best != 0) {
+        std::swap(w.cluster[0], w.cluster[best]);  // keeps the fast path above reachable
+        std::swap(w.mu[0], w.mu[best]);
+    }
+    return label;
+}
+
 // ---- ClusterState -----------------------------------------------------------------------
 
 namespace {
@@ -101,7 +138,7 @@ ClusterState::ClusterState(const ClusterParams& params) : params_(params) {
 }
 
 void ClusterState::reset() {
-    std::fill(mu_.begin(), mu_.end(), 0.0f);
+    std::fill(mu_.begin(), mu_.end(), PixelWeights{});
     centres_.resize(params_.k);
     tau_ = 0;
     seeded_ = false;
@@ -115,10 +152,13 @@ void ClusterState::allocate(int width, int height) {
     grid_w_ = (width + s - 1) / s;
     grid_h_ = (height + s - 1) / s;
     const std::size_t grid = static_cast<std::size_t>(grid_w_) * grid_h_;
-    mu_.assign(grid * params_.k, 0.0f);
+    mu_.assign(grid, PixelWeights{});
     grid_label_.assign(grid, 0);
     row_count_.assign(grid_h_ + 1, 0);
     pts_.resize(grid);
+    cumulative_.resize(grid);
+    candidate_f_.resize(grid);
+    best_candidate_f_.resize(grid);
     block_sums_.assign(static_cast<std::size_t>(kBlocks) * params_.k * kSums, 0.0);
     reset();
 }
@@ -162,6 +202,65 @@ void ClusterState::gather(const OrganizedCloud& cloud, const NormalMap& normals,
     }
 }
 
+namespace {
+
+/// What the assignment kernel reads: packed points and centres, structure of arrays.
+struct AssignInputs {
+    const float *x, *y, *z, *r, *g, *b, *nx, *ny, *nz;
+    const std::uint8_t* has_normal;
+    const float *cx, *cy, *cz, *cr, *cg, *cb, *cnx, *cny, *cnz;
+    const float* centre_has_normal;  ///< 1 or 0 per centre
+    int k;
+    float d2, a2, gamma;             ///< delta^2, alpha^2 (0 without colour), gamma
+};
+
+constexpr std::size_t kAssignBlock = 256;
+
+/// Winner (unless null) and f of points [i0, i0 + m), m <= kAssignBlock. Points in a block, centres in
+/// the outer loop (as FAISS does): the inner loop runs over contiguous points and
+/// vectorizes whatever k is. Built twice, for AVX2 and for baseline x86-64, picked at load
+/// time: baseline SSE2 has no blend, so GCC keeps the arg-min scalar there.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void assign_block(const AssignInputs& in, std::size_t i0, std::size_t m, int* winner,
+                  float* fmin) {
+    float best_f[kAssignBlock], gp[kAssignBlock];
+    int best[kAssignBlock];
+    for (std::size_t q = 0; q < m; ++q) {
+        best_f[q] = INFINITY;
+        best[q] = 0;
+        gp[q] = in.has_normal[i0 + q] ? in.gamma : 0.0f;
+    }
+    const float *X = in.x + i0, *Y = in.y + i0, *Z = in.z + i0;
+    const float *R = in.r + i0, *G = in.g + i0, *B = in.b + i0;
+    const float *NX = in.nx + i0, *NY = in.ny + i0, *NZ = in.nz + i0;
+    for (int j = 0; j < in.k; ++j) {
+        const float qx = in.cx[j], qy = in.cy[j], qz = in.cz[j];
+        const float qr = in.cr[j], qg = in.cg[j], qb = in.cb[j];
+        const float qnx = in.cnx[j], qny = in.cny[j], qnz = in.cnz[j];
+        const float qn = in.centre_has_normal[j];
+        for (std::size_t q = 0; q < m; ++q) {
+            const float dx = X[q] - qx, dy = Y[q] - qy, dz = Z[q] - qz;
+            const float dr = R[q] - qr, dg = G[q] - qg, db = B[q] - qb;
+            // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
+            // arg-min of f is not the arg-min of the squared distance.
+            const float dist = std::sqrt(in.d2 * (dx * dx + dy * dy + dz * dz) +
+                                         in.a2 * (dr * dr + dg * dg + db * db));
+            const float cos_theta = NX[q] * qnx + NY[q] * qny + NZ[q] * qnz;
+            const float f = dist + gp[q] * qn * (1.0f - cos_theta);  // eq. (6)
+            const bool better = f < best_f[q];
+            best_f[q] = better ? f : best_f[q];
+            best[q] = better ? j : best[q];
+        }
+    }
+    for (std::size_t q = 0; q < m; ++q) fmin[i0 + q] = best_f[q];
+    if (winner)
+        for (std::size_t q = 0; q < m; ++q) winner[i0 + q] = best[q];
+}
+
+}  // namespace
+
 void ClusterState::set_centre(int j, std::size_t i) {
     centres_.x[j] = pts_.x[i];
     centres_.y[j] = pts_.y[i];
@@ -175,149 +274,107 @@ void ClusterState::set_centre(int j, std::size_t i) {
     centres_.count[j] = 0;
 }
 
-float ClusterState::f_to(int j, std::size_t i) const {
-    const bool normals = pts_.has_normal[i] && centre_has_normal(j);
-    const double cos_theta = static_cast<double>(pts_.nx[i]) * centres_.nx[j] +
-                             static_cast<double>(pts_.ny[i]) * centres_.ny[j] +
-                             static_cast<double>(pts_.nz[i]) * centres_.nz[j];
-    return static_cast<float>(distance_f(params_, pts_.x[i], pts_.y[i], pts_.z[i], pts_.r[i],
-                                         pts_.g[i], pts_.b[i], centres_.x[j], centres_.y[j],
-                                         centres_.z[j], centres_.r[j], centres_.g[j],
-                                         centres_.b[j], cos_theta, normals, use_color_));
-}
-
-float ClusterState::f_between(std::size_t i, std::size_t c) const {
-    const bool normals = pts_.has_normal[i] && pts_.has_normal[c];
-    const double cos_theta = static_cast<double>(pts_.nx[i]) * pts_.nx[c] +
-                             static_cast<double>(pts_.ny[i]) * pts_.ny[c] +
-                             static_cast<double>(pts_.nz[i]) * pts_.nz[c];
-    return static_cast<float>(distance_f(params_, pts_.x[i], pts_.y[i], pts_.z[i], pts_.r[i],
-                                         pts_.g[i], pts_.b[i], pts_.x[c], pts_.y[c], pts_.z[c],
-                                         pts_.r[c], pts_.g[c], pts_.b[c], cos_theta, normals,
-                                         use_color_));
+void ClusterState::f_to_point(std::size_t c, std::vector<float>& out) const {
+    // Point c as the one centre of the assignment kernel.
+    const float one = pts_.has_normal[c] ? 1.0f : 0.0f;
+    const AssignInputs in{pts_.x.data(), pts_.y.data(), pts_.z.data(), pts_.r.data(),
+                          pts_.g.data(), pts_.b.data(), pts_.nx.data(), pts_.ny.data(),
+                          pts_.nz.data(), pts_.has_normal.data(),
+                          &pts_.x[c], &pts_.y[c], &pts_.z[c], &pts_.r[c], &pts_.g[c], &pts_.b[c],
+                          &pts_.nx[c], &pts_.ny[c], &pts_.nz[c], &one, 1,
+                          params_.delta * params_.delta,
+                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
+    const std::size_t n = n_;
+    const auto blocks = static_cast<std::ptrdiff_t>((n + kAssignBlock - 1) / kAssignBlock);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t blk = 0; blk < blocks; ++blk) {
+        const std::size_t i0 = static_cast<std::size_t>(blk) * kAssignBlock;
+        assign_block(in, i0, std::min(kAssignBlock, n - i0), nullptr, out.data());
+    }
 }
 
 std::size_t ClusterState::sample_by_f_squared() {
     // Greedy k-means++ (Arthur & Vassilvitskii 2007, section 6): draw a few candidates with
     // probability proportional to f^2, f being the distance to the nearest centre chosen so
-    // far, and keep the one that lowers the total f^2 most. The serial sums keep it
-    // reproducible across thread counts.
-    cumulative_.resize(n_);
+    // far, and keep the one that lowers the total f^2 most. Its distances are left in
+    // best_candidate_f_. Sums run serially or in fixed blocks, in order, so the choice does
+    // not depend on the thread count.
     double total = 0;
     for (std::size_t i = 0; i < n_; ++i) {
         total += static_cast<double>(pts_.f[i]) * pts_.f[i];
         cumulative_[i] = total;
     }
-    if (!(total > 0)) return std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_);
     const int trials = 2 + static_cast<int>(std::log(static_cast<double>(params_.k)));
-    std::size_t best = n_ - 1;
+    std::size_t best = 0;
     double best_potential = INFINITY;
     for (int t = 0; t < trials; ++t) {
-        const double target = std::uniform_real_distribution<double>(0.0, total)(rng_);
-        const std::size_t c = std::min<std::size_t>(
-            n_ - 1, static_cast<std::size_t>(
-                        std::upper_bound(cumulative_.begin(), cumulative_.begin() + n_, target) -
-                        cumulative_.begin()));
-        // Summed in fixed blocks, in block order: the same total whatever the thread count.
+        std::size_t c;
+        if (total > 0) {
+            const double target = std::uniform_real_distribution<double>(0.0, total)(rng_);
+            c = static_cast<std::size_t>(
+                std::upper_bound(cumulative_.begin(), cumulative_.begin() + n_, target) -
+                cumulative_.begin());
+            c = std::min(c, n_ - 1);
+        } else {  // every point sits on a centre: any point will do
+            c = std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_);
+        }
+        f_to_point(c, candidate_f_);
         double block_potential[kBlocks];
 #pragma omp parallel for schedule(static)
         for (int blk = 0; blk < kBlocks; ++blk) {
             double sum = 0;
             for (std::size_t i = n_ * blk / kBlocks; i < n_ * (blk + 1) / kBlocks; ++i) {
-                const double f = std::min(pts_.f[i], f_between(i, c));
+                const double f = std::min(pts_.f[i], candidate_f_[i]);
                 sum += f * f;
             }
             block_potential[blk] = sum;
         }
         double potential = 0;
-        for (double b : block_potential) potential += b;
+        for (double p : block_potential) potential += p;
         if (potential < best_potential) {
             best_potential = potential;
             best = c;
+            candidate_f_.swap(best_candidate_f_);
         }
     }
     return best;
 }
 
-void ClusterState::lower_f_with(int j) {
+void ClusterState::add_centre(int j) {
+    set_centre(j, sample_by_f_squared());
     const auto n = static_cast<std::ptrdiff_t>(n_);
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) {
-        const float fj = f_to(j, static_cast<std::size_t>(i));
-        if (fj < pts_.f[i]) {
-            pts_.f[i] = fj;
-            pts_.winner[i] = j;
-        }
-    }
+    for (std::ptrdiff_t i = 0; i < n; ++i) pts_.f[i] = std::min(pts_.f[i], best_candidate_f_[i]);
 }
 
 void ClusterState::seed_kmeanspp() {
     const std::size_t first = std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_);
     set_centre(0, first);
-    const auto n = static_cast<std::ptrdiff_t>(n_);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) {
-        pts_.f[i] = f_to(0, static_cast<std::size_t>(i));
-        pts_.winner[i] = 0;
-    }
-    for (int j = 1; j < params_.k; ++j) {
-        set_centre(j, sample_by_f_squared());
-        lower_f_with(j);
-    }
+    f_to_point(first, pts_.f);
+    for (int j = 1; j < params_.k; ++j) add_centre(j);
 }
 
 void ClusterState::assign() {
     const int k = params_.k;
-    const float d2 = params_.delta * params_.delta;
-    const float a2 = use_color_ ? params_.alpha * params_.alpha : 0.0f;
-    const float gamma = params_.gamma;
     // 1 where the centre has a normal, so that the normal term drops out for it (eq. 6
     // needs both normals).
     for (int j = 0; j < k; ++j) centre_normal_[j] = centre_has_normal(j) ? 1.0f : 0.0f;
-    // Raw pointers: the compiler cannot otherwise prove that the stores to winner and f
-    // leave the centres alone, and reloads them for every point.
-    const float *cx = centres_.x.data(), *cy = centres_.y.data(), *cz = centres_.z.data();
-    const float *cr = centres_.r.data(), *cg = centres_.g.data(), *cb = centres_.b.data();
-    const float *cnx = centres_.nx.data(), *cny = centres_.ny.data(), *cnz = centres_.nz.data();
-    const float* chn = centre_normal_.data();
-    const float *x = pts_.x.data(), *y = pts_.y.data(), *z = pts_.z.data();
-    const float *r = pts_.r.data(), *g = pts_.g.data(), *b = pts_.b.data();
-    const float *nx = pts_.nx.data(), *ny = pts_.ny.data(), *nz = pts_.nz.data();
-    const std::uint8_t* has_normal = pts_.has_normal.data();
+    const AssignInputs in{pts_.x.data(),  pts_.y.data(),  pts_.z.data(),  pts_.r.data(),
+                          pts_.g.data(),  pts_.b.data(),  pts_.nx.data(), pts_.ny.data(),
+                          pts_.nz.data(), pts_.has_normal.data(),
+                          centres_.x.data(), centres_.y.data(), centres_.z.data(),
+                          centres_.r.data(), centres_.g.data(), centres_.b.data(),
+                          centres_.nx.data(), centres_.ny.data(), centres_.nz.data(),
+                          centre_normal_.data(), k, params_.delta * params_.delta,
+                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
     int* winner = pts_.winner.data();
     float* fmin = pts_.f.data();
-    const auto n = static_cast<std::ptrdiff_t>(n_);
-    constexpr int kChunk = 64;  // centres per pass: f of a chunk first (vectorizes), then arg-min
-
+    const std::size_t n = n_;
+    const auto blocks = static_cast<std::ptrdiff_t>((n + kAssignBlock - 1) / kAssignBlock);
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) {
-        const float px = x[i], py = y[i], pz = z[i], pr = r[i], pg = g[i], pb = b[i];
-        const float pnx = nx[i], pny = ny[i], pnz = nz[i];
-        const float gp = has_normal[i] ? gamma : 0.0f;
-        float best_f = INFINITY;
-        int best = 0;
-        for (int j0 = 0; j0 < k; j0 += kChunk) {
-            const int m = std::min(kChunk, k - j0);
-            float f[kChunk];
-            for (int q = 0; q < m; ++q) {
-                const int j = j0 + q;
-                const float dx = px - cx[j], dy = py - cy[j], dz = pz - cz[j];
-                const float dr = pr - cr[j], dg = pg - cg[j], db = pb - cb[j];
-                // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
-                // arg-min of f is not the arg-min of the squared distance.
-                const float dist = std::sqrt(d2 * (dx * dx + dy * dy + dz * dz) +
-                                             a2 * (dr * dr + dg * dg + db * db));
-                const float cos_theta = pnx * cnx[j] + pny * cny[j] + pnz * cnz[j];
-                f[q] = dist + gp * chn[j] * (1.0f - cos_theta);  // eq. (6)
-            }
-            for (int q = 0; q < m; ++q)
-                if (f[q] < best_f) {
-                    best_f = f[q];
-                    best = j0 + q;
-                }
-        }
-        winner[i] = best;
-        fmin[i] = best_f;
+    for (std::ptrdiff_t blk = 0; blk < blocks; ++blk) {
+        const std::size_t i0 = static_cast<std::size_t>(blk) * kAssignBlock;
+        assign_block(in, i0, std::min(kAssignBlock, n - i0), winner, fmin);
     }
 }
 
@@ -379,24 +436,27 @@ int ClusterState::reseed_empty() {
     int reseeded = 0;
     for (int j = 0; j < params_.k; ++j) {
         if (centres_.count[j] != 0 || n_ == 0) continue;
-        set_centre(j, sample_by_f_squared());
-        lower_f_with(j);
+        add_centre(j);
         ++reseeded;
     }
     return reseeded;
 }
 
 void ClusterState::update_weights_and_labels() {
-    const int k = params_.k;
     const float psi = params_.psi;
     std::fill(grid_label_.begin(), grid_label_.end(), 0);
     const auto n = static_cast<std::ptrdiff_t>(n_);
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t i = 0; i < n; ++i) {
         const std::size_t g = static_cast<std::size_t>(pts_.grid[i]);
-        const int label = update_weights(mu_.data() + g * k, k, pts_.winner[i], psi);
+        const int label = update_weights(mu_[g], pts_.winner[i], psi);
         grid_label_[g] = static_cast<std::uint16_t>(label + 1);
     }
+}
+
+void ClusterState::last_winners(std::vector<int>& per_grid_point) const {
+    per_grid_point.assign(static_cast<std::size_t>(grid_w_) * grid_h_, -1);
+    for (std::size_t i = 0; i < n_; ++i) per_grid_point[pts_.grid[i]] = pts_.winner[i];
 }
 
 FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& normals,
@@ -442,8 +502,13 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
     for (int v = 0; v < H; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * W;
         const std::size_t grow = static_cast<std::size_t>(v / s) * grid_w_;
-        for (int u = 0; u < W; ++u)
-            labels.labels[row + u] = active[row + u] ? grid_label_[grow + u / s] : 0;
+        if (s == 1) {  // no division per pixel in the common case
+            for (int u = 0; u < W; ++u)
+                labels.labels[row + u] = active[row + u] ? grid_label_[grow + u] : 0;
+        } else {
+            for (int u = 0; u < W; ++u)
+                labels.labels[row + u] = active[row + u] ? grid_label_[grow + u / s] : 0;
+        }
     }
     return stats;
 }

@@ -64,3 +64,328 @@ void SelectedObject::update(const LabelImage& labels, std::vector<std::uint8_t>&
 }
 
 }  // namespace wul3d
+
+// ---- objects and tracks -----------------------------------------------------------------
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+namespace wul3d {
+
+namespace {
+template <class T>
+void require(bool ok, const char* name, T value, const char* range) {
+    if (ok) return;
+    std::ostringstream msg;
+    msg << "ObjectParams." << name << " = " << value << ": must be " << range;
+    throw ParamError(msg.str());
+}
+// Per-segment sums: count, x, y, z.
+constexpr int kSegSums = 4;
+// Per-object sums: count, x, y, z, xx, xy, xz, yy, yz, zz, r, g, b.
+constexpr int kObjSums = 13;
+}  // namespace
+
+void ObjectParams::validate() const {
+    if (!(psi > 0 && psi <= 1.0f)) {
+        std::ostringstream msg;
+        msg << "--object-psi " << psi << ": must be in (0, 1] (paper eq. 2)";
+        throw ParamError(msg.str());
+    }
+    require(max_tracks >= 2 && max_tracks <= 255, "max_tracks", max_tracks, "in [2, 255]");
+    require(min_overlap > 0 && min_overlap <= 1, "min_overlap", min_overlap, "in (0, 1]");
+    require(max_jump_m >= 0, "max_jump_m", max_jump_m, ">= 0");
+    require(max_lost_frames >= 0, "max_lost_frames", max_lost_frames, ">= 0");
+    require(min_points >= 1, "min_points", min_points, ">= 1");
+    require(scene_cut_share > 0 && scene_cut_share <= 1, "scene_cut_share", scene_cut_share, "in (0, 1]");
+}
+
+ObjectTracker::ObjectTracker(const ObjectParams& params) : params_(params) {
+    params_.validate();
+    tracks_.resize(static_cast<std::size_t>(params_.max_tracks));
+}
+
+void ObjectTracker::reset() {
+    std::fill(mu_.begin(), mu_.end(), 0.0f);
+    std::fill(has_mu_.begin(), has_mu_.end(), 0);
+    tracks_.assign(static_cast<std::size_t>(params_.max_tracks), Track{});
+    tau_ = 0;
+    next_id_ = 1;
+    scene_cuts_ = 0;
+}
+
+void ObjectTracker::free_slot(int slot) {
+    const std::size_t K = static_cast<std::size_t>(params_.max_tracks);
+    const std::size_t N = has_mu_.size();
+    for (std::size_t p = 0; p < N; ++p) mu_[p * K + static_cast<std::size_t>(slot)] = 0.0f;
+    tracks_[static_cast<std::size_t>(slot)] = Track{};
+}
+
+void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments,
+                         const LabelImage& clusters, LabelImage& objects,
+                         std::vector<DetectedObject>& out) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t N = cloud.size();
+    const int K = params_.max_tracks;
+    const std::size_t Kz = static_cast<std::size_t>(K);
+    if (W != width_ || H != height_) {
+        width_ = W;
+        height_ = H;
+        mu_.assign(N * Kz, 0.0f);
+        has_mu_.assign(N, 0);
+        slot_of_.assign(N, 0);
+        prev_z_.assign(N, 0.0f);
+        reset();
+    }
+    {
+        // A scene cut: most surfaces moved at once. Weights and tracks start afresh.
+        std::size_t both = 0, moved = 0;
+        for (std::size_t p = 0; p < N; ++p) {
+            const float z = cloud.valid[p] ? cloud.z[p] : 0.0f;
+            if (z > 0 && prev_z_[p] > 0) {
+                ++both;
+                moved += std::fabs(z - prev_z_[p]) > 0.05f;
+            }
+            prev_z_[p] = z;
+        }
+        if (tau_ > 0 && (both == 0 || static_cast<double>(moved) >
+                                          params_.scene_cut_share * static_cast<double>(both))) {
+            std::fill(mu_.begin(), mu_.end(), 0.0f);
+            std::fill(has_mu_.begin(), has_mu_.end(), 0);
+            tracks_.assign(Kz, Track{});
+            ++scene_cuts_;
+        }
+    }
+    ++tau_;
+    const int S = n_segments;
+
+    // 1. Each segment's votes for the track slots: the sum of its pixels' weights, i.e. the
+    //    overlap with the previous frames' objects as the paper's weights remember them.
+    votes_.assign(static_cast<std::size_t>(S + 1) * Kz, 0.0);
+    seg_sums_.assign(static_cast<std::size_t>(S + 1) * kSegSums, 0.0);
+    for (std::size_t p = 0; p < N; ++p) {
+        const int s = segments.labels[p];
+        if (s == 0) continue;
+        double* ss = seg_sums_.data() + static_cast<std::size_t>(s) * kSegSums;
+        ss[0] += 1;
+        ss[1] += cloud.x[p];
+        ss[2] += cloud.y[p];
+        ss[3] += cloud.z[p];
+        if (!has_mu_[p]) continue;
+        double* vs = votes_.data() + static_cast<std::size_t>(s) * Kz;
+        const float* m = mu_.data() + p * Kz;
+        for (int j = 0; j < K; ++j) vs[j] += m[j];
+    }
+
+    // 2. Greedy one-to-one matching by vote, largest first.
+    struct Pair {
+        double vote;
+        int s, j;
+    };
+    std::vector<Pair> pairs;
+    for (int s = 1; s <= S; ++s)
+        for (int j = 0; j < K; ++j) {
+            const Track& t = tracks_[static_cast<std::size_t>(j)];
+            const double v = votes_[static_cast<std::size_t>(s) * Kz + static_cast<std::size_t>(j)];
+            if (t.id == 0 || v <= 0) continue;
+            const double size = seg_sums_[static_cast<std::size_t>(s) * kSegSums];
+            if (v >= params_.min_overlap * std::min(size, static_cast<double>(t.pixels)))
+                pairs.push_back({v, s, j});
+        }
+    std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+        return a.vote != b.vote ? a.vote > b.vote : (a.s != b.s ? a.s < b.s : a.j < b.j);
+    });
+    seg_slot_.assign(static_cast<std::size_t>(S + 1), -1);
+    std::vector<std::uint8_t> slot_taken(Kz, 0);
+    for (const Pair& pr : pairs) {
+        if (seg_slot_[static_cast<std::size_t>(pr.s)] >= 0 || slot_taken[static_cast<std::size_t>(pr.j)]) continue;
+        seg_slot_[static_cast<std::size_t>(pr.s)] = pr.j;
+        slot_taken[static_cast<std::size_t>(pr.j)] = 1;
+    }
+    // 3. Segments left over: a track not matched this frame whose last centroid is near
+    //    (an object that moved faster than its overlap), else a new track.
+    for (int s = 1; s <= S; ++s) {
+        if (seg_slot_[static_cast<std::size_t>(s)] >= 0) continue;
+        const double* ss = seg_sums_.data() + static_cast<std::size_t>(s) * kSegSums;
+        const double cx = ss[1] / ss[0], cy = ss[2] / ss[0], cz = ss[3] / ss[0];
+        int best = -1;
+        double best_d = params_.max_jump_m;
+        for (int j = 0; j < K; ++j) {
+            const Track& t = tracks_[static_cast<std::size_t>(j)];
+            if (t.id == 0 || slot_taken[static_cast<std::size_t>(j)]) continue;
+            const double ratio = ss[0] / std::max<double>(1.0, static_cast<double>(t.pixels));
+            if (ratio < 0.33 || ratio > 3.0) continue;
+            const double d = std::sqrt((cx - t.x) * (cx - t.x) + (cy - t.y) * (cy - t.y) + (cz - t.z) * (cz - t.z));
+            if (d <= best_d) {
+                best_d = d;
+                best = j;
+            }
+        }
+        if (best < 0) {
+            // A free slot, else the one lost longest (ties: the smallest).
+            for (int j = 0; j < K && best < 0; ++j)
+                if (tracks_[static_cast<std::size_t>(j)].id == 0) best = j;
+            if (best < 0) {
+                for (int j = 0; j < K; ++j) {
+                    if (slot_taken[static_cast<std::size_t>(j)]) continue;
+                    const Track& t = tracks_[static_cast<std::size_t>(j)];
+                    if (best < 0 || t.lost > tracks_[static_cast<std::size_t>(best)].lost ||
+                        (t.lost == tracks_[static_cast<std::size_t>(best)].lost &&
+                         t.pixels < tracks_[static_cast<std::size_t>(best)].pixels))
+                        best = j;
+                }
+                if (best < 0) continue;  // more segments than slots: the segment is dropped
+                free_slot(best);
+            }
+            tracks_[static_cast<std::size_t>(best)].id = next_id_++;
+        }
+        seg_slot_[static_cast<std::size_t>(s)] = best;
+        slot_taken[static_cast<std::size_t>(best)] = 1;
+    }
+
+    // 4. The paper's weights on objects: each segment pixel adds psi to its track's weight
+    //    (eq. 2, 7, 8, the same update_weights as the clusters); its object is the arg-max.
+    //    A pixel with depth outside every object forgets its weights.
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) {
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            const int s = segments.labels[p];
+            const int slot = s ? seg_slot_[static_cast<std::size_t>(s)] : -1;
+            float* m = mu_.data() + p * Kz;
+            if (slot >= 0) {
+                slot_of_[p] = static_cast<std::uint8_t>(update_weights(m, K, slot, params_.psi) + 1);
+                has_mu_[p] = 1;
+            } else {
+                if (cloud.valid[p] && has_mu_[p]) {
+                    std::fill(m, m + K, 0.0f);
+                    has_mu_[p] = 0;
+                }
+                slot_of_[p] = 0;
+            }
+        }
+    }
+
+    // 5. Objects: sums per slot, then boxes.
+    obj_sums_.assign(Kz * kObjSums, 0.0);
+    std::vector<int> umin(Kz, W), vmin(Kz, H), umax(Kz, -1), vmax(Kz, -1);
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            if (!slot_of_[p]) continue;
+            const std::size_t j = slot_of_[p] - 1u;
+            double* o = obj_sums_.data() + j * kObjSums;
+            const double x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
+            o[0] += 1;
+            o[1] += x; o[2] += y; o[3] += z;
+            o[4] += x * x; o[5] += x * y; o[6] += x * z;
+            o[7] += y * y; o[8] += y * z; o[9] += z * z;
+            o[10] += cloud.r[p]; o[11] += cloud.g[p]; o[12] += cloud.b[p];
+            umin[j] = std::min(umin[j], u); umax[j] = std::max(umax[j], u);
+            vmin[j] = std::min(vmin[j], v); vmax[j] = std::max(vmax[j], v);
+        }
+    // Objects too small after weighting are dropped (their pixels become background).
+    std::vector<std::uint8_t> keep(Kz, 0);
+    for (std::size_t j = 0; j < Kz; ++j)
+        keep[j] = obj_sums_[j * kObjSums] >= params_.min_points && tracks_[j].id != 0;
+
+    objects.width = W;
+    objects.height = H;
+    objects.labels.resize(N);
+    out.clear();
+    std::vector<int> index_of(Kz, -1);
+    for (std::size_t j = 0; j < Kz; ++j) {
+        if (!keep[j]) continue;
+        const double* o = obj_sums_.data() + j * kObjSums;
+        const double n = o[0];
+        DetectedObject d;
+        d.track_id = d.id = tracks_[j].id;
+        d.pixels = static_cast<std::size_t>(n);
+        const Eigen::Vector3d c(o[1] / n, o[2] / n, o[3] / n);
+        d.centroid = {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
+        Eigen::Matrix3d m;
+        m(0, 0) = o[4] / n - c.x() * c.x();
+        m(0, 1) = m(1, 0) = o[5] / n - c.x() * c.y();
+        m(0, 2) = m(2, 0) = o[6] / n - c.x() * c.z();
+        m(1, 1) = o[7] / n - c.y() * c.y();
+        m(1, 2) = m(2, 1) = o[8] / n - c.y() * c.z();
+        m(2, 2) = o[9] / n - c.z() * c.z();
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                d.obb_axes[static_cast<std::size_t>(3 * a + b)] =
+                    static_cast<float>(eig.eigenvectors()(b, 2 - a));  // largest spread first
+        d.u_min = umin[j]; d.u_max = umax[j]; d.v_min = vmin[j]; d.v_max = vmax[j];
+        d.mean_rgb = {static_cast<float>(o[10] / n), static_cast<float>(o[11] / n), static_cast<float>(o[12] / n)};
+        d.aabb_min = {INFINITY, INFINITY, INFINITY};
+        d.aabb_max = {-INFINITY, -INFINITY, -INFINITY};
+        index_of[j] = static_cast<int>(out.size());
+        out.push_back(std::move(d));
+    }
+    // Second pass: boxes' extents, source clusters and segments, the label image.
+    std::vector<std::array<float, 6>> proj(out.size(), {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY});
+    int max_cluster = 0;
+    for (std::uint16_t l : clusters.labels) max_cluster = std::max<int>(max_cluster, l);
+    cluster_count_.assign(out.size() * static_cast<std::size_t>(max_cluster + 1), 0);
+    std::vector<std::vector<int>> seg_count(out.size());
+    for (std::size_t p = 0; p < N; ++p) {
+        const int i = slot_of_[p] ? index_of[slot_of_[p] - 1u] : -1;
+        if (i < 0) {
+            objects.labels[p] = 0;
+            continue;
+        }
+        DetectedObject& d = out[static_cast<std::size_t>(i)];
+        objects.labels[p] = static_cast<std::uint16_t>(std::min(d.id, 65535));
+        const float pt[3] = {cloud.x[p], cloud.y[p], cloud.z[p]};
+        for (int a = 0; a < 3; ++a) {
+            d.aabb_min[static_cast<std::size_t>(a)] = std::min(d.aabb_min[static_cast<std::size_t>(a)], pt[a]);
+            d.aabb_max[static_cast<std::size_t>(a)] = std::max(d.aabb_max[static_cast<std::size_t>(a)], pt[a]);
+            const float* ax = d.obb_axes.data() + 3 * a;
+            const float t = ax[0] * (pt[0] - d.centroid[0]) + ax[1] * (pt[1] - d.centroid[1]) + ax[2] * (pt[2] - d.centroid[2]);
+            auto& pr = proj[static_cast<std::size_t>(i)];
+            pr[static_cast<std::size_t>(a)] = std::min(pr[static_cast<std::size_t>(a)], t);
+            pr[static_cast<std::size_t>(a + 3)] = std::max(pr[static_cast<std::size_t>(a + 3)], t);
+        }
+        if (!clusters.labels.empty())
+            ++cluster_count_[static_cast<std::size_t>(i) * static_cast<std::size_t>(max_cluster + 1) + clusters.labels[p]];
+        const int s = segments.labels[p];
+        if (s) {
+            auto& sc = seg_count[static_cast<std::size_t>(i)];
+            if (std::find(sc.begin(), sc.end(), s) == sc.end()) sc.push_back(s);
+        }
+    }
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        DetectedObject& d = out[i];
+        const auto& pr = proj[i];
+        for (int a = 0; a < 3; ++a) {
+            const float mid = 0.5f * (pr[static_cast<std::size_t>(a)] + pr[static_cast<std::size_t>(a + 3)]);
+            d.obb_half_extent[static_cast<std::size_t>(a)] = 0.5f * (pr[static_cast<std::size_t>(a + 3)] - pr[static_cast<std::size_t>(a)]);
+            for (int b = 0; b < 3; ++b) d.obb_centre[static_cast<std::size_t>(b)] += mid * d.obb_axes[static_cast<std::size_t>(3 * a + b)];
+        }
+        for (int b = 0; b < 3; ++b) d.obb_centre[static_cast<std::size_t>(b)] += d.centroid[static_cast<std::size_t>(b)];
+        for (int l = 1; l <= max_cluster; ++l) {
+            const int cnt = cluster_count_[i * static_cast<std::size_t>(max_cluster + 1) + static_cast<std::size_t>(l)];
+            if (cnt > 0 && static_cast<double>(cnt) >= 0.05 * static_cast<double>(d.pixels)) d.source_clusters.push_back(l);
+        }
+        d.source_segments = seg_count[i];
+        std::sort(d.source_segments.begin(), d.source_segments.end());
+    }
+
+    // 6. Tracks: remember where each object is; count frames unseen; retire the long lost.
+    for (std::size_t j = 0; j < Kz; ++j) {
+        Track& t = tracks_[j];
+        if (t.id == 0) continue;
+        const double* o = obj_sums_.data() + j * kObjSums;
+        if (o[0] > 0) {
+            t.lost = 0;
+            t.pixels = static_cast<std::size_t>(o[0]);
+            t.x = static_cast<float>(o[1] / o[0]);
+            t.y = static_cast<float>(o[2] / o[0]);
+            t.z = static_cast<float>(o[3] / o[0]);
+        } else if (++t.lost > params_.max_lost_frames) {
+            free_slot(static_cast<int>(j));
+        }
+    }
+}
+
+}  // namespace wul3d

@@ -18,6 +18,9 @@ void PipelineParams::validate() const {
     normals.validate();
     range.validate();
     cluster.validate();
+    plane.validate();
+    segmentation.validate();
+    objects.validate();
 }
 
 namespace {
@@ -28,7 +31,7 @@ double ms_since(Clock::time_point t0) {
 }  // namespace
 
 Pipeline::Pipeline(const PipelineParams& params)
-    : params_((params.validate(), params)), state_(params.cluster) {}
+    : params_((params.validate(), params)), state_(params.cluster), tracker_(params.objects) {}
 
 const FrameResult& Pipeline::process(const RgbdFrame& frame) { return run_stages(frame, 0.0); }
 
@@ -69,6 +72,32 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
     t = Clock::now();
     render_weight_colors(state_, r.labels, frame, r.colors);
     r.times.colors = ms_since(t);
+
+    // Objects: the support plane goes (part of the paper's background step, done after the
+    // clustering so that labels.png keeps the paper's clusters), the rest is segmented and
+    // tracked.
+    t = Clock::now();
+    if (params_.remove_plane) {
+        r.plane = remove_support_plane(params_.plane, frame.intrinsics, cloud_, normals_,
+                                       r.active, plane_ws_, r.plane_classes);
+    } else {
+        r.plane = PlaneResult{};
+        r.plane_classes.resize(r.active.size());
+        for (std::size_t p = 0; p < r.active.size(); ++p)
+            r.plane_classes[p] = r.active[p] ? kPlaneObject : kPlaneRemoved;
+        r.plane.kept = r.active_points;
+    }
+    r.times.plane = ms_since(t);
+
+    t = Clock::now();
+    r.segment_stats = segment_objects(params_.segmentation, cloud_, normals_, r.plane_classes,
+                                      r.labels, segment_ws_, r.segments);
+    r.times.segmentation = ms_since(t);
+
+    t = Clock::now();
+    tracker_.step(cloud_, r.segments, r.segment_stats.segments, r.labels, r.objects,
+                  r.object_list);
+    r.times.objects = ms_since(t);
     return r;
 }
 

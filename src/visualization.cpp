@@ -40,22 +40,31 @@ void render_weight_colors(const ClusterState& state, const LabelImage& labels,
     std::vector<float> C(static_cast<std::size_t>(k) * 3);
     for (int j = 0; j < k; ++j) {
         const auto c = cluster_color(j);
-        for (int q = 0; q < 3; ++q) C[3 * j + q] = c[q];
+        for (int q = 0; q < 3; ++q) C[3 * j + q] = c[q] / PixelWeights::kOne;
     }
     const bool grey_ok = frame.has_color() && frame.color.width == W && frame.color.height == H;
     const std::uint8_t* rgb = grey_ok ? frame.color.rgb.data() : nullptr;
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
+        const int grid_row = state.grid_index(0, v);
+        const int stride = state.params().stride;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             std::uint8_t* o = out.rgb.data() + 3 * p;
             if (labels.labels[p] != 0) {
-                // Paper eq. (9): C_p = sum_j C_j mu_j
-                const float* mu = state.weights(state.grid_index(u, v));
+                // Paper eq. (9): C_p = sum_j C_j mu_j, over the kept weights (the others
+                // are 0 or negligible, see PixelWeights).
+                const PixelWeights& w = state.weights(grid_row + (stride == 1 ? u : u / stride));
                 float acc[3] = {0, 0, 0};
-                for (int j = 0; j < k; ++j)
-                    for (int q = 0; q < 3; ++q) acc[q] += C[3 * j + q] * mu[j];
+                for (int s = 0; s < PixelWeights::kSlots; ++s) {
+                    if (w.mu[s] == 0) continue;  // most slots of a still scene are empty
+                    const float m = static_cast<float>(w.mu[s]);
+                    const float* c = &C[3 * w.cluster[s]];
+                    acc[0] += c[0] * m;
+                    acc[1] += c[1] * m;
+                    acc[2] += c[2] * m;
+                }
                 for (int q = 0; q < 3; ++q)
                     o[q] = static_cast<std::uint8_t>(std::min(255.0f, acc[q] + 0.5f));
             } else if (rgb) {

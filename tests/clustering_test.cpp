@@ -4,10 +4,14 @@
 #include <omp.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <set>
 
 #include "synthetic_scene.hpp"
+#include "test_support.hpp"
+#include "wul3d/io.hpp"
+#include "wul3d/visualization.hpp"
 #include "wul3d/background.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/normals.hpp"
@@ -229,8 +233,8 @@ TEST(ClusterState, ObjectLeavingLosesItsWeightAfterOneFrame) {
     for (std::size_t p = 0; p < truth.size(); ++p) {
         if (truth_with[p] != kTruthBox0 || !run.active[p]) continue;
         const int u = static_cast<int>(p % run.labels.width), v = static_cast<int>(p / run.labels.width);
-        const float* mu = run.state.weights(run.state.grid_index(u, v));
-        EXPECT_LE(mu[red - 1], 0.5f + 1e-6f);
+        const PixelWeights& mu = run.state.weights(run.state.grid_index(u, v));
+        EXPECT_LE(mu.weight(red - 1), 0.5f + 1e-4f);
         EXPECT_NE(run.labels.labels[p], red) << p;
         ++checked;
     }
@@ -241,7 +245,7 @@ TEST(ClusterState, InactivePixelsKeepTheirWeights) {
     Runner run(ClusterParams::paper());
     run.step(table_with_boxes());
     const int g = run.state.grid_index(160, 200);
-    const std::vector<float> before(run.state.weights(g), run.state.weights(g) + 7);
+    const PixelWeights before = run.state.weights(g);
     // The same scene with the table pixel (160, 200) removed from the active set.
     const RgbdFrame f = render_scene(table_with_boxes());
     back_project(f, run.cloud);
@@ -249,8 +253,14 @@ TEST(ClusterState, InactivePixelsKeepTheirWeights) {
     select_depth_range(DepthRange{}, run.cloud, run.active);
     run.active[static_cast<std::size_t>(200) * 320 + 160] = 0;
     run.state.step(run.cloud, run.normals, run.active, run.labels);
-    const std::vector<float> after(run.state.weights(g), run.state.weights(g) + 7);
-    EXPECT_EQ(before, after);
+    const PixelWeights& after = run.state.weights(g);
+    int total = 0;
+    for (int s = 0; s < PixelWeights::kSlots; ++s) total += before.mu[s];
+    EXPECT_NEAR(total, PixelWeights::kOne, 8);
+    for (int s = 0; s < PixelWeights::kSlots; ++s) {
+        EXPECT_EQ(before.cluster[s], after.cluster[s]);
+        EXPECT_EQ(before.mu[s], after.mu[s]);
+    }
     EXPECT_EQ(run.labels.labels[static_cast<std::size_t>(200) * 320 + 160], 0);
 }
 
@@ -315,4 +325,113 @@ TEST(ClusterState, DepthOnlyFramesClusterOnGeometry) {
     std::set<int> used(run.labels.labels.begin(), run.labels.labels.end());
     used.erase(0);
     EXPECT_GE(used.size(), 3u);  // geometry alone still splits the scene
+}
+
+// ---- kept weights (PixelWeights) against dense float weights ---------------------------
+
+TEST(PixelWeights, UpdateMatchesDenseWhileTheWinnersFitInTheSlots) {
+    constexpr int S = PixelWeights::kSlots, k = S + 2;
+    PixelWeights w;
+    std::vector<float> dense(k, 0.0f);
+    // S distinct winners, some more than once: all kept, so kept = dense (to 16 bits).
+    std::vector<int> winners;
+    for (int j = 0; j < S; ++j) winners.push_back((j * 3) % S);
+    for (int j = 0; j < S; j += 2) winners.push_back(j);
+    for (int winner : winners) {
+        const int label = update_weights(w, winner, 0.6f);
+        EXPECT_EQ(label, update_weights(dense.data(), k, winner, 0.6f));
+        float sum = 0;
+        for (int s = 0; s < S; ++s) sum += static_cast<float>(w.mu[s]) / PixelWeights::kOne;
+        EXPECT_NEAR(sum, 1.0f, 1e-4f);
+    }
+    for (int j = 0; j < k; ++j) EXPECT_NEAR(w.weight(j), dense[j], 1e-4f) << j;
+    // One more cluster wins: the smallest kept weight is dropped, the rest renormalize.
+    int smallest = 0;
+    for (int j = 0; j < S; ++j)
+        if (dense[j] < dense[smallest]) smallest = j;
+    update_weights(w, S, 0.6f);
+    EXPECT_EQ(w.weight(smallest), 0.0f);
+    EXPECT_NEAR(w.weight(S), 0.6f / 1.6f, 1e-3f);
+}
+
+TEST(PixelWeights, NewPixelTakesTheWinnerAndPsiOneHalves) {
+    PixelWeights w;
+    EXPECT_EQ(update_weights(w, 5, 1.0f), 5);
+    EXPECT_FLOAT_EQ(w.weight(5), 1.0f);
+    EXPECT_EQ(update_weights(w, 2, 1.0f), 2);  // a tie at 0.5: the newest winner
+    EXPECT_NEAR(w.weight(5), 0.5f, 1e-4f);
+    EXPECT_NEAR(w.weight(2), 0.5f, 1e-4f);
+}
+
+namespace {
+// Replays a real sequence (frames repeated `rounds` times) through the clustering and,
+// from the same winners, through dense float weights; returns the share of active pixels
+// whose arg-max agrees, and the largest colour difference (eq. 9, 0-255) seen.
+void compare_with_dense(const std::string& input, int k, float psi, int rounds,
+                        double& label_agreement, double& colour_within_2) {
+    auto source = open_source((sample_dir() / input).string(), SourceOptions{});
+    ClusterParams p = ClusterParams::paper();
+    p.k = k;
+    p.psi = psi;
+    ClusterState state(p);
+    OrganizedCloud cloud;
+    NormalMap normals;
+    std::vector<std::uint8_t> active;
+    LabelImage labels;
+    SourceItem item;
+    std::vector<float> dense;
+    std::vector<int> winners;
+    std::size_t compared = 0, agree = 0, colour_compared = 0, colour_ok = 0;
+    std::vector<double> palette;
+    for (int j = 0; j < k; ++j)
+        for (int q = 0; q < 3; ++q) palette.push_back(cluster_color(j)[q]);
+    for (int round = 0; round < rounds; ++round)
+        for (std::size_t f = 0; f < source->size(); ++f) {
+            source->read(f, item);
+            back_project(item.frame, cloud);
+            estimate_normals(NormalParams{}, cloud, normals);
+            select_depth_range(DepthRange{}, cloud, active);
+            state.step(cloud, normals, active, labels);
+            state.last_winners(winners);
+            dense.resize(winners.size() * static_cast<std::size_t>(k), 0.0f);
+            for (std::size_t g = 0; g < winners.size(); ++g) {
+                if (winners[g] < 0) continue;
+                float* mu = dense.data() + g * k;
+                const int label = update_weights(mu, k, winners[g], psi);
+                ++compared;
+                agree += labels.labels[g] == label + 1;
+                if (g % 5 != 0) continue;  // colours on a fifth of the pixels: enough, and fast
+                const PixelWeights& kept = state.weights(static_cast<int>(g));
+                bool ok = true;
+                for (int q = 0; q < 3; ++q) {
+                    double a = 0, b = 0;
+                    for (int j = 0; j < k; ++j) a += mu[j] * palette[3 * j + q];
+                    for (int s = 0; s < PixelWeights::kSlots; ++s)
+                        b += kept.mu[s] / PixelWeights::kOne * palette[3 * kept.cluster[s] + q];
+                    ok = ok && std::abs(a - b) <= 2.0;
+                }
+                ++colour_compared;
+                colour_ok += ok;
+            }
+        }
+    label_agreement = static_cast<double>(agree) / static_cast<double>(compared);
+    colour_within_2 = static_cast<double>(colour_ok) / static_cast<double>(colour_compared);
+}
+}  // namespace
+
+TEST(PixelWeights, LabelsAndColoursMatchDenseFloatWeightsOnRealSequences) {
+    struct Case {
+        const char* input;
+        int k;
+        float psi;
+    };
+    for (const Case c : {Case{"uois_tabletop", 10, 1.0f}, Case{"uois_tabletop", 50, 1.0f},
+                         Case{"uois_tabletop", 10, 0.3f}, Case{"pcl_kinect/pairwise_seq", 30, 0.5f}}) {
+        double labels = 0, colours = 0;
+        compare_with_dense(c.input, c.k, c.psi, 2, labels, colours);
+        EXPECT_GE(labels, 0.995) << c.input << " k " << c.k << " psi " << c.psi;
+        EXPECT_GE(colours, 0.99) << c.input << " k " << c.k << " psi " << c.psi;
+        std::printf("%s k=%d psi=%.1f: same arg-max %.4f, colour within 2 levels %.4f\n",
+                    c.input, c.k, c.psi, labels, colours);
+    }
 }

@@ -81,3 +81,140 @@ TEST(SelectedObject, RejectsPixelsOutsideTheImageOrWithoutPoints) {
     EXPECT_EQ(mask[7 * 10 + 7], 255);
     EXPECT_EQ(near.pixels(), 1u);
 }
+
+// ---- objects and tracks ----------------------------------------------------------------
+
+#include "wul3d/plane.hpp"
+#include "wul3d/segmentation.hpp"
+
+namespace {
+struct ObjectRun {
+    std::vector<std::vector<std::uint16_t>> objects;  ///< per frame
+    std::vector<std::vector<int>> truth;
+    int tracks_started = 0;
+};
+
+/// A synthetic sequence: a red box slides 2.5 cm a frame past a static blue one, seen by a
+/// camera pitched down over the table; every stage from normals to objects runs per frame.
+ObjectRun run_moving_sequence(float psi, int frames) {
+    ObjectParams op;
+    op.psi = psi;
+    ObjectTracker tracker(op);
+    ObjectRun run;
+    OrganizedCloud cloud;
+    NormalMap normals;
+    std::vector<std::uint8_t> active, classes;
+    PlaneWorkspace pws;
+    SegmentWorkspace sws;
+    LabelImage segments, objects;
+    std::vector<DetectedObject> list;
+    for (int t = 0; t < frames; ++t) {
+        Scene s;
+        s.width = 320;
+        s.height = 240;
+        s.pitch_rad = 0.5f;
+        s.table_y = 0.6f;
+        s.table_near = 0.4f;
+        s.table_far = 1.6f;
+        s.noise_seed = static_cast<std::uint32_t>(t + 1);
+        SceneBox red;
+        red.x = -0.3f + 0.025f * static_cast<float>(t);
+        red.z = 0.9f;
+        SceneBox blue;
+        blue.x = 0.3f;
+        blue.z = 1.2f;
+        blue.r = 30; blue.g = 60; blue.b = 220;
+        s.boxes = {red, blue};
+        std::vector<int> truth;
+        const RgbdFrame f = render_scene(s, &truth);
+        back_project(f, cloud);
+        estimate_normals(NormalParams{}, cloud, normals);
+        select_depth_range(DepthRange{}, cloud, active);
+        remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
+        const SegmentStats st = segment_objects(SegmentParams{}, cloud, normals, classes,
+                                                LabelImage{}, sws, segments);
+        tracker.step(cloud, segments, st.segments, LabelImage{}, objects, list);
+        // Every listed object is in the label image with its pixel count.
+        for (const DetectedObject& d : list) {
+            const auto n = static_cast<std::size_t>(std::count(
+                objects.labels.begin(), objects.labels.end(), static_cast<std::uint16_t>(d.id)));
+            EXPECT_EQ(n, d.pixels);
+            EXPECT_EQ(d.id, d.track_id);
+            EXPECT_LE(d.u_min, d.u_max);
+            for (int a = 0; a < 3; ++a) EXPECT_LE(d.aabb_min[a], d.aabb_max[a]);
+        }
+        run.objects.push_back(objects.labels);
+        run.truth.push_back(truth);
+    }
+    run.tracks_started = tracker.tracks_started();
+    return run;
+}
+
+/// Share of pixels whose object changes between consecutive frames while the truth does not.
+double flicker(const ObjectRun& run) {
+    std::size_t changed = 0, stable = 0;
+    for (std::size_t t = 1; t < run.objects.size(); ++t)
+        for (std::size_t p = 0; p < run.truth[t].size(); ++p) {
+            if (run.truth[t][p] != run.truth[t - 1][p]) continue;
+            ++stable;
+            changed += run.objects[t][p] != run.objects[t - 1][p];
+        }
+    return static_cast<double>(changed) / static_cast<double>(stable);
+}
+}  // namespace
+
+TEST(ObjectParams, Validate_RejectsOutOfRangeFields) {
+    ObjectParams p;
+    EXPECT_NO_THROW(p.validate());
+    p.psi = 0;
+    EXPECT_THROW(p.validate(), ParamError);
+    p = ObjectParams{};
+    p.max_tracks = 1;
+    EXPECT_THROW(p.validate(), ParamError);
+    EXPECT_THROW(ObjectTracker{p}, ParamError);
+}
+
+// Synthetic (rendered) sequence: the moving box keeps one track id in every frame, the
+// static box another, no other track is started, and pixels whose truth does not change
+// keep their object.
+TEST(ObjectTracker, MovingBox_KeepsItsTrackIdAndLabelsDoNotFlicker) {
+    const ObjectRun run = run_moving_sequence(0.5f, 16);
+    int red0 = 0, blue0 = 0;
+    for (std::size_t t = 0; t < run.objects.size(); ++t) {
+        SCOPED_TRACE(t);
+        int red = 0, blue = 0;
+        EXPECT_GT(dominant_share(run.objects[t], run.truth[t], kTruthBox0, &red), 0.9);
+        EXPECT_GT(dominant_share(run.objects[t], run.truth[t], kTruthBox0 + 1, &blue), 0.9);
+        if (t == 0) {
+            red0 = red;
+            blue0 = blue;
+            EXPECT_NE(red0, 0);
+            EXPECT_NE(blue0, 0);
+            EXPECT_NE(red0, blue0);
+        }
+        EXPECT_EQ(red, red0) << "the moving box changed track";
+        EXPECT_EQ(blue, blue0) << "the static box changed track";
+    }
+    EXPECT_EQ(run.tracks_started, 2);
+    EXPECT_LT(flicker(run), 0.002);
+}
+
+// A folder of unrelated frames is a sequence of scene cuts: each frame starts new tracks.
+TEST(ObjectTracker, SceneCut_StartsNewTracks) {
+    ObjectTracker tracker(ObjectParams{});
+    OrganizedCloud cloud;
+    cloud.resize(40, 30);
+    LabelImage segments{40, 30, std::vector<std::uint16_t>(1200, 0)}, objects;
+    std::vector<DetectedObject> list;
+    for (int frame = 0; frame < 2; ++frame) {
+        for (std::size_t p = 0; p < 1200; ++p) {
+            cloud.valid[p] = 1;
+            cloud.z[p] = frame == 0 ? 1.0f : 2.0f;  // everything moved by 1 m: a cut
+            segments.labels[p] = p % 40 < 20 ? 1 : 0;
+        }
+        tracker.step(cloud, segments, 1, LabelImage{}, objects, list);
+        ASSERT_EQ(list.size(), 1u);
+        EXPECT_EQ(list[0].track_id, frame + 1);
+    }
+    EXPECT_EQ(tracker.scene_cuts(), 1);
+}

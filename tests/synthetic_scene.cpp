@@ -15,7 +15,7 @@ PinholeIntrinsics scene_intrinsics(int width, int height) {
 
 namespace {
 // Ray (dx, dy, 1) against an axis-aligned box; returns the entry t or +inf.
-float hit_box(float dx, float dy, float x0, float x1, float y0, float y1, float z0, float z1) {
+float hit_box(float dx, float dy, float dz, float x0, float x1, float y0, float y1, float z0, float z1) {
     float t0 = 0, t1 = std::numeric_limits<float>::infinity();
     auto slab = [&](float dir, float lo, float hi) {
         if (std::fabs(dir) < 1e-12f) return lo <= 0 && 0 <= hi;
@@ -25,7 +25,7 @@ float hit_box(float dx, float dy, float x0, float x1, float y0, float y1, float 
         t1 = std::min(t1, b);
         return t0 <= t1;
     };
-    if (!slab(dx, x0, x1) || !slab(dy, y0, y1) || !slab(1.0f, z0, z1))
+    if (!slab(dx, x0, x1) || !slab(dy, y0, y1) || !slab(dz, z0, z1))
         return std::numeric_limits<float>::infinity();
     return t0 > 0 ? t0 : std::numeric_limits<float>::infinity();
 }
@@ -49,28 +49,32 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
     for (int v = 0; v < s.height; ++v) {
         for (int u = 0; u < s.width; ++u) {
             const float dx = static_cast<float>((u - K.cx) / K.fx);
-            const float dy = static_cast<float>((v - K.cy) / K.fy);
+            const float dy_cam = static_cast<float>((v - K.cy) / K.fy);
+            // The ray (dx, dy_cam, 1) in the scene's axes: the camera's forward axis points
+            // down by pitch. Its parameter t stays the camera-frame depth.
+            const float cp = std::cos(s.pitch_rad), sp = std::sin(s.pitch_rad);
+            const float dy = dy_cam * cp + sp, dz = -dy_cam * sp + cp;
             float best = std::numeric_limits<float>::infinity();
             int id = 0;
             std::uint8_t rgb[3] = {0, 0, 0};
             // Table: the plane y = table_y, a rectangle on it.
             if (dy > 1e-6f) {
                 const float t = s.table_y / dy;
-                const float x = dx * t;
-                if (t >= s.table_near && t <= s.table_far && std::fabs(x) <= s.table_half_width) {
+                const float x = dx * t, zt = dz * t;
+                if (zt >= s.table_near && zt <= s.table_far && std::fabs(x) <= s.table_half_width) {
                     best = t;
                     id = kTruthTable;
                     rgb[0] = 150; rgb[1] = 140; rgb[2] = 120;
                 }
             }
-            if (s.wall && 2.4f < best) {
-                best = 2.4f;
+            if (s.wall && dz > 1e-6f && 2.4f / dz < best) {
+                best = 2.4f / dz;
                 id = kTruthWall;
                 rgb[0] = 90; rgb[1] = 110; rgb[2] = 140;
             }
             for (std::size_t i = 0; i < s.boxes.size(); ++i) {
                 const SceneBox& b = s.boxes[i];
-                const float t = hit_box(dx, dy, b.x - b.w / 2, b.x + b.w / 2, s.table_y - b.h,
+                const float t = hit_box(dx, dy, dz, b.x - b.w / 2, b.x + b.w / 2, s.table_y - b.h,
                                         s.table_y, b.z - b.d / 2, b.z + b.d / 2);
                 if (t < best) {
                     best = t;

@@ -23,6 +23,8 @@ struct Scene {
     float table_y = 0.35f;      ///< table top height below the camera, metres
     int width = 320, height = 240;
     std::uint32_t noise_seed = 0;  ///< colour noise of +-3 levels when non-zero
+    float pitch_rad = 0.0f;     ///< camera pitched down by this angle about its x axis (the
+                                ///< scene's axes stay put; 0 = looking straight ahead)
 };
 
 /// Ground-truth ids: 0 nothing, 1 table, 2 wall, 10 + i box i.

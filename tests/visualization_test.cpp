@@ -57,12 +57,13 @@ TEST(RenderWeightColors, IsEquation9) {
     const int after = labels.labels[centre];
     ASSERT_GT(after, 0);
     ASSERT_NE(after, before);
-    const float* mu = state.weights(state.grid_index(f.width() / 2, 200));
+    const PixelWeights& mu = state.weights(state.grid_index(f.width() / 2, 200));
     double expect[3] = {0, 0, 0};
     for (int j = 0; j < 3; ++j)
-        for (int q = 0; q < 3; ++q) expect[q] += mu[j] * cluster_color(j)[q];
+        for (int q = 0; q < 3; ++q) expect[q] += mu.weight(j) * cluster_color(j)[q];
     for (int q = 0; q < 3; ++q) EXPECT_NEAR(out.rgb[3 * centre + q], expect[q], 1.0);
-    EXPECT_NEAR(mu[before - 1], 0.5, 1e-6);
+    EXPECT_NEAR(mu.weight(before - 1), 0.5, 1e-4);
+    EXPECT_NEAR(mu.weight(after - 1), 0.5, 1e-4);
 
     // Pixels with no point show the scene's own colour as dim grey, not a cluster colour.
     f.color.rgb.assign(f.color.rgb.size(), 200);

@@ -8,6 +8,9 @@ namespace wul3d::cli {
 
 /// Registers `wul3d run` on `app`; the returned callback runs it after parsing.
 void add_run_command(CLI::App& app);
+void add_bench_command(CLI::App& app);  ///< `wul3d bench` (bench_command.cpp)
+void add_eval_command(CLI::App& app);
+void add_view_command(CLI::App& app);  ///< `wul3d view` (view_command.cpp or view_unavailable.cpp)
 
 /// Prints "wul3d: <message>" as one line on stderr and returns `code`.
 int report(const std::exception& e, int code);

@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "wul3d 0.1.0");
     wul3d::cli::add_run_command(app);
+    wul3d::cli::add_bench_command(app);
+    wul3d::cli::add_eval_command(app);
+    wul3d::cli::add_view_command(app);
     try {
         try {
             app.parse(argc, argv);

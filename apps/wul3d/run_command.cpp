@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "video_writer.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/objects.hpp"
@@ -39,6 +40,11 @@ struct RunOptions {
     std::string calibration;
     std::string registration = "depth-to-color";
     std::string select;
+    std::string video;  // --video FILE: side-by-side video (video_writer.hpp)
+    std::string segmenter;
+    bool no_plane = false;
+    std::optional<int> min_points;
+    std::optional<float> object_psi;
     std::size_t max_frames = 0;  // 0 = all
     int threads = 0;             // 0 = all cores
     bool ply = false;
@@ -91,6 +97,10 @@ PipelineParams make_params(const RunOptions& o) {
     if (o.zmin) p.range.zmin_m = *o.zmin;
     if (o.zmax) p.range.zmax_m = *o.zmax;
     if (o.normal_radius) p.normals.radius_px = *o.normal_radius;
+    if (!o.segmenter.empty()) p.segmentation.segmenter = parse_segmenter(o.segmenter);
+    if (o.no_plane) p.remove_plane = false;
+    if (o.min_points) p.segmentation.min_points = *o.min_points;
+    if (o.object_psi) p.objects.psi = *o.object_psi;
     p.validate();
     return p;
 }
@@ -150,10 +160,42 @@ private:
     bool enabled_;
 };
 
+/// objects.json of one frame: every object with its boxes, colour and sources.
+std::string objects_json(const FrameResult& r, int selected_id) {
+    nlohmann::json objs = nlohmann::json::array();
+    for (const DetectedObject& d : r.object_list) {
+        nlohmann::json o = {{"id", d.id},
+                            {"track_id", d.track_id},
+                            {"pixels", d.pixels},
+                            {"centroid_m", d.centroid},
+                            {"aabb_m", {{"min", d.aabb_min}, {"max", d.aabb_max}}},
+                            {"obb_m",
+                             {{"centre", d.obb_centre},
+                              {"axes", {{d.obb_axes[0], d.obb_axes[1], d.obb_axes[2]},
+                                        {d.obb_axes[3], d.obb_axes[4], d.obb_axes[5]},
+                                        {d.obb_axes[6], d.obb_axes[7], d.obb_axes[8]}}},
+                              {"half_extent", d.obb_half_extent}}},
+                            {"box_px", {{"u_min", d.u_min}, {"v_min", d.v_min},
+                                        {"u_max", d.u_max}, {"v_max", d.v_max}}},
+                            {"mean_rgb", d.mean_rgb},
+                            {"source_clusters", d.source_clusters},
+                            {"source_segments", d.source_segments}};
+        if (selected_id != 0) o["selected"] = d.id == selected_id;
+        objs.push_back(std::move(o));
+    }
+    nlohmann::json j = {{"objects", objs}, {"support_plane", nullptr}};
+    if (r.plane.found) {
+        const Plane& pl = r.plane.support;
+        j["support_plane"] = {{"normal", {pl.nx, pl.ny, pl.nz}}, {"d_m", pl.d}};
+    }
+    return j.dump(1) + "\n";
+}
+
 /// Writes one frame's outputs into OUT/.<name>.partial, then renames it to OUT/<name>, so a
 /// frame folder is either complete or absent.
 void write_frame(const fs::path& out_dir, const std::string& name, const Pipeline& pipeline,
-                 const FrameResult& r, const std::vector<std::uint8_t>* selected, bool ply) {
+                 const FrameResult& r, const std::vector<std::uint8_t>* selected,
+                 const std::vector<std::uint8_t>* selected_object, int selected_id, bool ply) {
     const fs::path final_dir = out_dir / name;
     const fs::path tmp_dir = out_dir / ("." + name + ".partial");
     std::error_code ec;
@@ -166,6 +208,11 @@ void write_frame(const fs::path& out_dir, const std::string& name, const Pipelin
         if (selected)
             write_mask_png((tmp_dir / "selected.png").string(), r.labels.width,
                            r.labels.height, *selected);
+        write_label_png((tmp_dir / "objects.png").string(), r.objects);
+        write_text_file((tmp_dir / "objects.json").string(), objects_json(r, selected_id));
+        if (selected_object)
+            write_mask_png((tmp_dir / "selected_object.png").string(), r.objects.width,
+                           r.objects.height, *selected_object);
         if (ply) write_ply((tmp_dir / "cloud.ply").string(), pipeline.cloud(), r.labels, r.colors);
         fs::remove_all(final_dir, ec);
         fs::rename(tmp_dir, final_dir);
@@ -178,10 +225,11 @@ void write_frame(const fs::path& out_dir, const std::string& name, const Pipelin
 void run(const RunOptions& o) {
     const PipelineParams params = make_params(o);
     const SourceOptions source_options = make_source_options(o);
-    std::optional<SelectedObject> selection;
+    std::optional<SelectedObject> selection, selected_object;
     if (!o.select.empty()) {
         const auto uv = parse_list("--select", o.select, 2);
         selection.emplace(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
+        selected_object.emplace(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
 
@@ -198,7 +246,7 @@ void run(const RunOptions& o) {
 
     Pipeline pipeline(params);
     SourceItem item;
-    std::vector<std::uint8_t> selected_mask;
+    std::vector<std::uint8_t> selected_mask, selected_object_mask;
     std::map<std::string, std::vector<double>> stage_ms;
     std::vector<double> compute_ms;
     nlohmann::json per_frame = nlohmann::json::array();
@@ -206,6 +254,8 @@ void run(const RunOptions& o) {
     Progress progress(n_frames, !o.quiet);
     using Clock = std::chrono::steady_clock;
     const auto run_start = Clock::now();
+    std::optional<RunVideo> video;
+    if (!o.video.empty()) video.emplace(o.video);
 
     for (std::size_t i = 0; i < n_frames; ++i) {
         source->read(i, item);
@@ -220,10 +270,26 @@ void run(const RunOptions& o) {
             said_depth_only = true;
         }
         if (selection) selection->update(r.labels, selected_mask);
+        // The user-defined object followed as an object (objects.png), once it has one.
+        bool object_selected = false;
+        if (selected_object) {
+            if (selected_object->label() != 0 ||
+                std::any_of(r.objects.labels.begin(), r.objects.labels.end(),
+                            [](std::uint16_t l) { return l != 0; })) {
+                try {
+                    selected_object->update(r.objects, selected_object_mask);
+                    object_selected = true;
+                } catch (const InputError&) {
+                    // No object near the picked pixel yet: try again next frame.
+                }
+            }
+            if (!object_selected) selected_object_mask.assign(r.objects.labels.size(), 0);
+        }
 
         const auto t_out = Clock::now();
         write_frame(out_dir, source->name(i), pipeline, r, selection ? &selected_mask : nullptr,
-                    o.ply);
+                    selected_object ? &selected_object_mask : nullptr,
+                    object_selected ? selected_object->label() : 0, o.ply);
         const double out_ms =
             std::chrono::duration<double, std::milli>(Clock::now() - t_out).count();
 
@@ -233,6 +299,9 @@ void run(const RunOptions& o) {
         stage_ms["background"].push_back(r.times.background);
         stage_ms["clustering"].push_back(r.times.clustering);
         stage_ms["colors"].push_back(r.times.colors);
+        stage_ms["plane"].push_back(r.times.plane);
+        stage_ms["segmentation"].push_back(r.times.segmentation);
+        stage_ms["objects"].push_back(r.times.objects);
         stage_ms["output"].push_back(out_ms);
         compute_ms.push_back(r.times.total());
         nlohmann::json f = {{"name", source->name(i)},
@@ -241,12 +310,19 @@ void run(const RunOptions& o) {
                             {"seeded", r.stats.seeded},
                             {"reseeded", r.stats.reseeded},
                             {"mean_f", r.stats.mean_f},
-                            {"ms", r.times.total()}};
+                            {"ms", r.times.total()},
+                            {"support_plane", r.plane.found},
+                            {"segments", r.segment_stats.segments},
+                            {"color_splits", r.segment_stats.color_splits},
+                            {"objects", r.object_list.size()}};
         if (selection) f["selected_pixels"] = selection->pixels();
         per_frame.push_back(std::move(f));
         progress.update(i + 1, 1000.0 / std::max(1e-9, median(compute_ms)));
+        if (video) video->write(frame, r, selection ? &selected_mask : nullptr, i, n_frames,
+                                1000.0 / std::max(1e-9, median(compute_ms)));
     }
     progress.finish();
+    if (video) video->close();
 
     const double ms = median(compute_ms);
     const double fps = ms > 0 ? 1000.0 / ms : 0.0;
@@ -268,6 +344,10 @@ void run(const RunOptions& o) {
                              {"zmin_m", params.range.zmin_m},
                              {"zmax_m", params.range.zmax_m},
                              {"normal_radius_px", params.normals.radius_px},
+                             {"segmenter", segmenter_name(params.segmentation.segmenter)},
+                             {"remove_plane", params.remove_plane},
+                             {"min_points", params.segmentation.min_points},
+                             {"object_psi", params.objects.psi},
                              {"preset", o.preset.empty() ? "default" : o.preset}};
     summary["frames"] = n_frames;
     summary["threads"] = omp_get_max_threads();
@@ -312,11 +392,20 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("--zmax", opts->zmax, "Farthest depth kept, metres (default 4.5)");
     cmd->add_option("--normal-radius", opts->normal_radius, "Normal neighbour distance, px (default 2)");
     cmd->add_option("--select", opts->select, "U,V: follow the object under this pixel of the first frame");
+    cmd->add_option("--segmenter", opts->segmenter,
+                    "Object segmentation: geometric|kmeans|hybrid (default hybrid)");
+    cmd->add_flag("--no-plane", opts->no_plane,
+                  "Keep the support plane (the paper's background step: depth range only)");
+    cmd->add_option("--min-points", opts->min_points, "Smallest object, pixels (default 300)");
+    cmd->add_option("--object-psi", opts->object_psi,
+                    "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
     cmd->add_option("--frames", opts->max_frames, "Stop after N frames (default: all)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
+    cmd->add_option("--video", opts->video,
+                    "Also write a video: colour | clusters | selected object (e.g. out.mp4)");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
     cmd->add_option("--tum-camera", opts->tum_camera,
                     "TUM intrinsics preset: kinect_v1|tum_fr1|tum_fr2|tum_fr3 (default: from folder name)");

@@ -72,6 +72,32 @@ double distance_f(const ClusterParams& p, float px, float py, float pz, float pr
 /// evidence.
 int update_weights(float* mu, int k, int winner, float psi);
 
+/// The weights of one pixel that matter: its kSlots largest weights mu (eq. 7, 8), with their
+/// 0-based cluster ids, in 16-bit fixed point (1 = kOne); an unused slot has weight 0, and
+/// all-zero means "never seen". Keeping these instead of all k bounds memory independently
+/// of k: 32 bytes a pixel, where dense float weights at 1920x1080 and k = 100 would take
+/// 830 MB. A weight is dropped only when a ninth cluster wins while eight are kept; it is
+/// then the smallest (with psi = 1 at most 1/256 after eight other winners). Labels and
+/// eq. (9) colours match dense float weights on real sequences (tests/clustering_test.cpp).
+struct PixelWeights {
+    static constexpr int kSlots = 8;
+    static constexpr float kOne = 65535.0f;
+    std::uint16_t cluster[kSlots] = {};
+    std::uint16_t mu[kSlots] = {};
+
+    /// mu of cluster j (0-based), in [0, 1]: its weight if kept, else 0.
+    float weight(int j) const {
+        for (int s = 0; s < kSlots; ++s)
+            if (mu[s] > 0 && cluster[s] == j) return static_cast<float>(mu[s]) / kOne;
+        return 0.0f;
+    }
+};
+
+/// update_weights on the kept weights: psi is added to the winner (which takes the slot of
+/// the smallest kept weight if it is not kept: that weight is dropped), then the kept
+/// weights are L1-normalized. Returns the 0-based arg-max cluster; ties go to the winner.
+int update_weights(PixelWeights& w, int winner, float psi);
+
 /// State across frames. Construct once per sequence; step() once per frame.
 class ClusterState {
 public:
@@ -105,8 +131,12 @@ public:
     int grid_index(int u, int v) const {
         return (v / params_.stride) * grid_w_ + (u / params_.stride);
     }
-    /// The k weights mu of grid point g (sum 1, or all 0 if never seen).
-    const float* weights(int g) const { return mu_.data() + static_cast<std::size_t>(g) * params_.k; }
+    /// The kept weights mu of grid point g (sum 1, or all 0 if never seen).
+    const PixelWeights& weights(int g) const { return mu_[static_cast<std::size_t>(g)]; }
+    /// The winner (0-based centre with the smallest f) of each grid point in the last frame,
+    /// -1 where the point was not active. For tests and tools: it lets a caller replay the
+    /// weight update with another representation.
+    void last_winners(std::vector<int>& per_grid_point) const;
 
 private:
     void allocate(int width, int height);
@@ -119,17 +149,16 @@ private:
     void update_weights_and_labels();
     // helpers of seeding and re-seeding
     void set_centre(int j, std::size_t i);
-    float f_to(int j, std::size_t i) const;        ///< f of point i to centre j
-    float f_between(std::size_t i, std::size_t c) const;  ///< f of point i to point c
+    void f_to_point(std::size_t c, std::vector<float>& out) const;  ///< f of every point to point c
     std::size_t sample_by_f_squared();
-    void lower_f_with(int j);
+    void add_centre(int j);  ///< centre j by the greedy D^2 rule; lowers every point's f
     bool centre_has_normal(int j) const {
         return centres_.nx[j] != 0.0f || centres_.ny[j] != 0.0f || centres_.nz[j] != 0.0f;
     }
 
     ClusterParams params_;
     Centres centres_;
-    std::vector<float> mu_;  ///< pixel-major on the grid: mu_[g * k + j]
+    std::vector<PixelWeights> mu_;  ///< one per grid point
     std::int64_t tau_ = 0;
     bool seeded_ = false;
     int width_ = 0, height_ = 0, grid_w_ = 0, grid_h_ = 0;
@@ -149,6 +178,7 @@ private:
     std::vector<double> block_sums_;          ///< move_centres' per-block sums
     std::vector<float> centre_normal_;        ///< 1 where centre j has a normal
     std::vector<double> cumulative_;          ///< seeding's running sum of f^2
+    std::vector<float> candidate_f_, best_candidate_f_;  ///< seeding: f to a candidate
     std::size_t n_ = 0;       ///< packed points this frame
     bool use_color_ = true;   ///< false for depth-only frames: the colour term drops out
 };

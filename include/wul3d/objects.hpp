@@ -1,13 +1,99 @@
 #pragma once
 /// @file objects.hpp
-/// The paper's user-defined object (its third contribution): the user picks a pixel of the
-/// first frame; the cluster under it is the object, followed from frame to frame.
+/// Objects and their tracks. ObjectTracker turns each frame's segments (segmentation.hpp)
+/// into objects with stable track ids and smooths their pixels over time with the paper's
+/// weights: every pixel keeps one membership weight per track slot and updates it exactly
+/// as ClusterState does for clusters (eq. 2, 7, 8 with psi, update_weights); its object is
+/// the arg-max weight. SelectedObject is the paper's user-defined object (its third
+/// contribution): the label under a picked pixel, followed from frame to frame; it follows
+/// clusters (labels.png) or objects (objects.png) alike.
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "wul3d/backprojection.hpp"
 #include "wul3d/clustering.hpp"
 
 namespace wul3d {
+
+struct ObjectParams {
+    float psi = 0.5f;          ///< weight increment of eq. (2) for object tracks; (0, 1]. Below 1
+                               ///< a pixel changes object only after two frames of evidence
+    int max_tracks = 32;       ///< weight slots per pixel (memory 4 * W * H * max_tracks bytes);
+                               ///< [2, 255]
+    float min_overlap = 0.2f;  ///< a segment continues a track when its weight mass on the track
+                               ///< is at least this share of the smaller of the two; (0, 1]
+    float max_jump_m = 0.15f;  ///< else a lost track within this distance (centroids) is taken
+                               ///< back; >= 0
+    int max_lost_frames = 15;  ///< a track unseen this many frames is retired; >= 0
+    int min_points = 100;      ///< an object left with fewer pixels after weighting is dropped; >= 1
+    float scene_cut_share = 0.5f;  ///< when more than this share of the pixels with depth in
+                                   ///< both frames moved by over 5 cm, the scene changed (a cut
+                                   ///< in the recording, or a folder of unrelated frames): the
+                                   ///< weights and tracks start afresh (new track ids); (0, 1]
+
+    void validate() const;  ///< throws ParamError naming the field
+};
+
+/// One object of a frame. Positions in metres, camera frame; colours 0-255.
+struct DetectedObject {
+    int id = 0;        ///< the value in objects.png; equal to track_id (stable across frames)
+    int track_id = 0;  ///< 1, 2, ... in order of first appearance
+    std::size_t pixels = 0;
+    std::array<float, 3> centroid{};
+    std::array<float, 3> aabb_min{}, aabb_max{};  ///< axis-aligned box (camera axes)
+    std::array<float, 3> obb_centre{};            ///< oriented box: centre,
+    std::array<float, 9> obb_axes{};              ///< unit axes (rows; principal directions),
+    std::array<float, 3> obb_half_extent{};       ///< half sizes along them
+    int u_min = 0, v_min = 0, u_max = 0, v_max = 0;  ///< 2D box, inclusive pixels
+    std::array<float, 3> mean_rgb{};
+    std::vector<int> source_clusters;  ///< clusters (labels.png) covering >= 5 % of its pixels
+    std::vector<int> source_segments;  ///< this frame's segments that fed it
+};
+
+/// State across frames for objects: tracks and per-pixel weights. Construct once per
+/// sequence; step() once per frame.
+class ObjectTracker {
+public:
+    explicit ObjectTracker(const ObjectParams& params);  ///< validates params
+
+    /// `segments`: 0 background, 1..n (segment_objects). `clusters` may be empty. Writes
+    /// `objects` (0 background, else track id) and one DetectedObject per track present.
+    /// A pixel with valid depth outside every segment forgets its weights (objects come and
+    /// go; unlike clusters, objects do not cover every point); a pixel without depth keeps
+    /// them, as in ClusterState.
+    void step(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments,
+              const LabelImage& clusters, LabelImage& objects, std::vector<DetectedObject>& out);
+    void reset();
+
+    const ObjectParams& params() const { return params_; }
+    std::int64_t tau() const { return tau_; }
+    int tracks_started() const { return next_id_ - 1; }
+    int scene_cuts() const { return scene_cuts_; }  ///< frames on which the tracks restarted
+
+private:
+    struct Track {
+        int id = 0;  ///< 0: slot free
+        int lost = 0;
+        std::size_t pixels = 0;
+        float x = 0, y = 0, z = 0;
+    };
+    void free_slot(int slot);
+
+    ObjectParams params_;
+    int width_ = 0, height_ = 0;
+    std::int64_t tau_ = 0;
+    int next_id_ = 1;
+    std::vector<Track> tracks_;           ///< max_tracks slots
+    std::vector<float> mu_;               ///< pixel-major: mu_[p * max_tracks + slot]
+    std::vector<std::uint8_t> has_mu_;    ///< 1 where a pixel's weights are not all zero
+    std::vector<std::uint8_t> slot_of_;   ///< arg-max slot + 1 per pixel this frame, 0 none
+    std::vector<float> prev_z_;           ///< last frame's depth (0 = none), for scene cuts
+    int scene_cuts_ = 0;
+    // per-frame scratch
+    std::vector<double> votes_, seg_sums_, obj_sums_;
+    std::vector<int> seg_slot_, cluster_count_;
+};
 
 /// Follows one user-picked object through the labels of successive frames.
 /// First frame: the cluster under (u, v), or under the nearest labelled pixel within
@@ -22,7 +108,8 @@ public:
     /// frame if (u, v) is outside the image or no labelled pixel is near it.
     void update(const LabelImage& labels, std::vector<std::uint8_t>& mask);
 
-    int cluster() const { return cluster_; }  ///< 1..k, 0 before the first update
+    int cluster() const { return cluster_; }  ///< the followed label, 0 before the first update
+    int label() const { return cluster_; }    ///< same as cluster(), for object labels
     std::size_t pixels() const { return pixels_; }
 
 private:

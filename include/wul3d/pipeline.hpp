@@ -1,16 +1,20 @@
 #pragma once
 /// @file pipeline.hpp
 /// The whole per-frame pipeline of the paper, stages in order:
-/// registration -> back-projection -> normals -> background -> clustering -> colours.
-/// Holds the stages' buffers (no allocation after the first frame) and the one object that
-/// lives across frames, ClusterState.
+/// registration -> back-projection -> normals -> background -> clustering -> colours, then
+/// the object stages: support plane -> segmentation -> objects (tracks and their weights).
+/// Holds the stages' buffers (no allocation after the first frame) and the two objects that
+/// live across frames, ClusterState and ObjectTracker.
 #include <vector>
 
 #include "wul3d/background.hpp"
 #include "wul3d/backprojection.hpp"
 #include "wul3d/clustering.hpp"
 #include "wul3d/normals.hpp"
+#include "wul3d/objects.hpp"
+#include "wul3d/plane.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/segmentation.hpp"
 #include "wul3d/visualization.hpp"
 
 namespace wul3d {
@@ -19,6 +23,10 @@ struct PipelineParams {
     NormalParams normals;
     DepthRange range;
     ClusterParams cluster;
+    bool remove_plane = true;  ///< false: --no-plane, the paper's background (depth range only)
+    PlaneParams plane;
+    SegmentParams segmentation;
+    ObjectParams objects;
 
     /// The paper's setting: ClusterParams::paper(), depth range 0.5-4.5 m (Kinect v2).
     static PipelineParams paper();
@@ -28,9 +36,10 @@ struct PipelineParams {
 /// Milliseconds spent in each stage on one frame (0 for a stage that did not run).
 struct StageTimes {
     double registration = 0, backprojection = 0, normals = 0, background = 0, clustering = 0,
-           colors = 0;
+           colors = 0, plane = 0, segmentation = 0, objects = 0;
     double total() const {
-        return registration + backprojection + normals + background + clustering + colors;
+        return registration + backprojection + normals + background + clustering + colors +
+               plane + segmentation + objects;
     }
 };
 
@@ -41,6 +50,12 @@ struct FrameResult {
     std::vector<std::uint8_t> active;   ///< points in the depth range
     std::size_t active_points = 0;
     FrameStats stats;
+    PlaneResult plane;                         ///< the support found (plane.found)
+    std::vector<std::uint8_t> plane_classes;   ///< PlaneClass per pixel
+    LabelImage segments;                       ///< this frame's segments, 0 = background
+    SegmentStats segment_stats;
+    LabelImage objects;                        ///< 0 = background, else track id (objects.png)
+    std::vector<DetectedObject> object_list;   ///< one per object in `objects`
     StageTimes times;
 };
 
@@ -58,6 +73,7 @@ public:
     const OrganizedCloud& cloud() const { return cloud_; }
     const NormalMap& normals() const { return normals_; }
     const ClusterState& state() const { return state_; }
+    const ObjectTracker& tracker() const { return tracker_; }
     const RgbdFrame& registered() const { return registered_; }  ///< last raw frame, registered
 
 private:
@@ -67,6 +83,9 @@ private:
     OrganizedCloud cloud_;
     NormalMap normals_;
     ClusterState state_;
+    ObjectTracker tracker_;
+    PlaneWorkspace plane_ws_;
+    SegmentWorkspace segment_ws_;
     RegistrationWorkspace registration_ws_;
     RgbdFrame registered_;
     FrameResult result_;

@@ -1,0 +1,214 @@
+// `wul3d bench`: frames per second and peak memory of the pipeline against k, one fresh
+// process per k (so that one k's peak memory cannot hide another's), as in the paper's
+// Figure 7. Parsing, timing and reporting only; the pipeline is the library's.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+#include "wul3d/pipeline.hpp"
+
+namespace wul3d::cli {
+namespace {
+
+struct BenchOptions {
+    std::string input;
+    std::string ks = "2,5,7,10,15,20,30,50,75,100";
+    std::string resolution = "native";
+    std::string csv;
+    std::size_t frames = 5;  // distinct frames loaded
+    int passes = 4;          // times the frames are run through the pipeline
+    int single_k = 0;        // internal: measure this k in this process and print one row
+};
+
+/// "native" or "WxH".
+void parse_resolution(const std::string& text, int& w, int& h) {
+    w = h = 0;
+    if (text == "native") return;
+    char x = 0;
+    std::istringstream in(text);
+    if (!(in >> w >> x >> h) || x != 'x' || w <= 0 || h <= 0 || !in.eof())
+        throw ParamError("--resolution '" + text + "': expected native or WxH, e.g. 1920x1080");
+}
+
+/// Nearest-neighbour resampling of a registered frame to w x h, intrinsics scaled per axis:
+/// the way to get the paper's 1920x1080 point count from a 640x480 recording.
+RgbdFrame resample(const RgbdFrame& f, int w, int h) {
+    RgbdFrame out;
+    out.name = f.name;
+    const double sx = static_cast<double>(w) / f.width(), sy = static_cast<double>(h) / f.height();
+    out.intrinsics = PinholeIntrinsics{w, h, f.intrinsics.fx * sx, f.intrinsics.fy * sy,
+                                       (f.intrinsics.cx + 0.5) * sx - 0.5,
+                                       (f.intrinsics.cy + 0.5) * sy - 0.5};
+    out.depth.width = w;
+    out.depth.height = h;
+    out.depth.scale_m_per_unit = f.depth.scale_m_per_unit;
+    out.depth.data.resize(static_cast<std::size_t>(w) * h);
+    if (f.has_color()) {
+        out.color.width = w;
+        out.color.height = h;
+        out.color.rgb.resize(3 * out.depth.data.size());
+    }
+    for (int v = 0; v < h; ++v) {
+        const int sv = std::min(f.height() - 1, static_cast<int>((v + 0.5) / sy));
+        for (int u = 0; u < w; ++u) {
+            const int su = std::min(f.width() - 1, static_cast<int>((u + 0.5) / sx));
+            const std::size_t p = static_cast<std::size_t>(v) * w + u;
+            const std::size_t q = static_cast<std::size_t>(sv) * f.width() + su;
+            out.depth.data[p] = f.depth.data[q];
+            if (f.has_color())
+                for (int c = 0; c < 3; ++c) out.color.rgb[3 * p + c] = f.color.rgb[3 * q + c];
+        }
+    }
+    return out;
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t m = v.size() / 2;
+    return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+/// Measures one k in this process; prints "k,width,height,points,fps_median,ms_median,peak_rss_mb".
+void measure_one(const BenchOptions& o) {
+    int w = 0, h = 0;
+    parse_resolution(o.resolution, w, h);
+    auto source = open_source(o.input, SourceOptions{});
+    std::vector<RgbdFrame> frames;
+    SourceItem item;
+    for (std::size_t i = 0; i < std::min(o.frames, source->size()); ++i) {
+        source->read(i, item);
+        if (item.is_raw)
+            throw InputError(o.input + ": bench takes registered frames (frames or tum input)");
+        frames.push_back(w ? resample(item.frame, w, h) : item.frame);
+    }
+    PipelineParams params;
+    params.cluster.k = o.single_k;
+    Pipeline pipeline(params);
+    pipeline.process(frames.front());  // seeding is a one-off: not timed
+    std::vector<double> ms;
+    std::size_t points = 0;
+    for (int pass = 0; pass < o.passes; ++pass)
+        for (const RgbdFrame& f : frames) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const FrameResult& r = pipeline.process(f);
+            ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+            points = std::max(points, r.stats.points);
+        }
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double m = median(ms);
+    std::cout << o.single_k << ',' << frames.front().width() << ',' << frames.front().height() << ','
+              << points << ',' << std::fixed << std::setprecision(2) << 1000.0 / m << ',' << m
+              << ',' << std::setprecision(1) << static_cast<double>(usage.ru_maxrss) / 1024.0 << '\n';
+}
+
+/// Runs this program again as `bench ... --single-k k` and returns the row it printed.
+std::string run_child(const BenchOptions& o, int k) {
+    int fd[2];
+    if (::pipe(fd) != 0) throw Error("bench: cannot create a pipe");
+    const pid_t pid = ::fork();
+    if (pid < 0) throw Error("bench: cannot fork");
+    if (pid == 0) {
+        ::dup2(fd[1], STDOUT_FILENO);
+        ::close(fd[0]);
+        ::close(fd[1]);
+        std::vector<std::string> args = {"wul3d", "bench", o.input, "--single-k", std::to_string(k),
+                                         "--resolution", o.resolution, "--frames",
+                                         std::to_string(o.frames), "--passes",
+                                         std::to_string(o.passes)};
+        std::vector<char*> argv;
+        for (auto& a : args) argv.push_back(a.data());
+        argv.push_back(nullptr);
+        ::execv("/proc/self/exe", argv.data());
+        ::_exit(127);
+    }
+    ::close(fd[1]);
+    std::string text;
+    char buf[512];
+    ssize_t got;
+    while ((got = ::read(fd[0], buf, sizeof buf)) > 0) text.append(buf, static_cast<std::size_t>(got));
+    ::close(fd[0]);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || text.empty())
+        throw Error("bench: the measurement of k = " + std::to_string(k) + " failed");
+    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+    return text;
+}
+
+void run(const BenchOptions& o) {
+    if (o.single_k > 0) {
+        measure_one(o);
+        return;
+    }
+    int w = 0, h = 0;
+    parse_resolution(o.resolution, w, h);  // fail before forking
+    std::vector<int> ks;
+    {
+        std::stringstream ss(o.ks);
+        std::string item;
+        while (std::getline(ss, item, ',')) {
+            try {
+                std::size_t used = 0;
+                const int k = std::stoi(item, &used);
+                if (used != item.size() || k < 1) throw std::invalid_argument(item);
+                ks.push_back(k);
+            } catch (const std::exception&) {
+                throw ParamError("--k '" + o.ks + "': '" + item + "' is not a positive integer");
+            }
+        }
+    }
+    open_source(o.input, SourceOptions{});  // a bad input fails here, once, with its message
+    const std::string header = "k,width,height,points,fps_median,ms_median,peak_rss_mb";
+    std::vector<std::string> rows;
+    std::cout << header << std::endl;
+    for (int k : ks) {
+        rows.push_back(run_child(o, k));
+        std::cout << rows.back() << std::endl;
+    }
+    if (!o.csv.empty()) {
+        std::ostringstream text;
+        text << header << '\n';
+        for (const auto& r : rows) text << r << '\n';
+        write_text_file(o.csv, text.str());
+    }
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+    auto opts = std::make_shared<BenchOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "bench", "Frames per second and peak memory against k, one process per k (paper Figure 7)");
+    cmd->add_option("input", opts->input, "Frame folder(s) or TUM sequence")->required();
+    cmd->add_option("--k", opts->ks, "Comma-separated k values")->capture_default_str();
+    cmd->add_option("--resolution", opts->resolution,
+                    "native, or WxH to resample each frame (1920x1080: the paper's point count)")
+        ->capture_default_str();
+    cmd->add_option("--csv", opts->csv, "Also write the rows as CSV");
+    cmd->add_option("--frames", opts->frames, "Distinct frames loaded")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
+    cmd->add_option("--passes", opts->passes, "Passes over the frames")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
+    cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
+        ->group("");
+    cmd->callback([opts]() { run(*opts); });
+}
+
+}  // namespace wul3d::cli

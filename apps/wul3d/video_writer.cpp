@@ -1,0 +1,234 @@
+// The side-by-side video of `wul3d run --video` and the panel pictures shared with the viewer.
+#include "video_writer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <string>
+#include <system_error>
+#include <utility>
+
+#include "wul3d/error.hpp"
+
+namespace wul3d::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+void resize_like(int width, int height, ColorImage& out) {
+    out.width = width;
+    out.height = height;
+    out.rgb.resize(static_cast<std::size_t>(width) * height * 3);
+}
+
+/// A ramp from warm (t = 0, near) through green to blue (t = 1, far): readable without a
+/// legend, and distinct from the cluster colours' grey surroundings.
+void ramp(float t, std::uint8_t* o) {
+    static constexpr float kStops[5][3] = {
+        {250, 230, 90}, {245, 130, 50}, {200, 60, 90}, {90, 70, 170}, {30, 50, 110}};
+    t = std::clamp(t, 0.0f, 1.0f) * 4.0f;
+    const int i = std::min(3, static_cast<int>(t));
+    const float f = t - static_cast<float>(i);
+    for (int q = 0; q < 3; ++q)
+        o[q] = static_cast<std::uint8_t>(kStops[i][q] + f * (kStops[i + 1][q] - kStops[i][q]));
+}
+
+}  // namespace
+
+std::pair<float, float> render_depth_panel(const DepthImage& depth, float zmin_m, float zmax_m,
+                                           ColorImage& out) {
+    resize_like(depth.width, depth.height, out);
+    // The ramp spans the 1st to 99th percentile of the depths in range (a sample of them),
+    // so a tabletop at 0.6-1.2 m does not sit in one colour of a 0.2-4.5 m ramp.
+    std::vector<float> sample;
+    for (std::size_t p = 0; p < depth.data.size(); p += 5) {
+        const float z = static_cast<float>(depth.data[p]) * depth.scale_m_per_unit;
+        if (depth.data[p] != 0 && z >= zmin_m && z <= zmax_m) sample.push_back(z);
+    }
+    float lo = zmin_m, hi = zmax_m;
+    if (sample.size() >= 100) {
+        const auto at = [&](std::size_t i) {
+            std::nth_element(sample.begin(), sample.begin() + static_cast<std::ptrdiff_t>(i),
+                             sample.end());
+            return sample[i];
+        };
+        lo = at(sample.size() / 100);
+        hi = at(sample.size() - 1 - sample.size() / 100);
+    }
+    const float span = std::max(1e-3f, hi - lo);
+    for (std::size_t p = 0; p < depth.data.size(); ++p) {
+        std::uint8_t* o = out.rgb.data() + 3 * p;
+        const float z = static_cast<float>(depth.data[p]) * depth.scale_m_per_unit;
+        if (depth.data[p] == 0) {
+            o[0] = o[1] = o[2] = 0;
+        } else if (z < zmin_m || z > zmax_m) {
+            o[0] = o[1] = o[2] = 60;
+        } else {
+            ramp((z - lo) / span, o);
+        }
+    }
+    return {lo, hi};
+}
+
+void render_color_panel(const RgbdFrame& frame, ColorImage& out) {
+    if (frame.has_color()) {
+        out = frame.color;
+        return;
+    }
+    // Depth-only: grey by depth over the depth's own range, near bright.
+    resize_like(frame.depth.width, frame.depth.height, out);
+    std::uint16_t lo = 0xffff, hi = 0;
+    for (const std::uint16_t d : frame.depth.data)
+        if (d) lo = std::min(lo, d), hi = std::max(hi, d);
+    const float span = std::max(1.0f, static_cast<float>(hi) - static_cast<float>(lo));
+    for (std::size_t p = 0; p < frame.depth.data.size(); ++p) {
+        const std::uint16_t d = frame.depth.data[p];
+        const auto g = d ? static_cast<std::uint8_t>(
+                               235.0f - 180.0f * (static_cast<float>(d) - lo) / span)
+                         : std::uint8_t{0};
+        out.rgb[3 * p] = out.rgb[3 * p + 1] = out.rgb[3 * p + 2] = g;
+    }
+}
+
+void highlight_mask(const ColorImage& base, const std::vector<std::uint8_t>& mask,
+                    const std::uint8_t outline[3], ColorImage& out) {
+    out = base;
+    const int W = base.width, H = base.height;
+    if (mask.size() != static_cast<std::size_t>(W) * H) return;
+    auto in = [&](int u, int v) {
+        return u >= 0 && v >= 0 && u < W && v < H && mask[static_cast<std::size_t>(v) * W + u];
+    };
+    for (int v = 0; v < H; ++v) {
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            std::uint8_t* o = out.rgb.data() + 3 * p;
+            if (!mask[p]) {
+                for (int q = 0; q < 3; ++q) o[q] = static_cast<std::uint8_t>(o[q] / 4);
+            } else if (!in(u - 1, v) || !in(u + 1, v) || !in(u, v - 1) || !in(u, v + 1)) {
+                for (int q = 0; q < 3; ++q) o[q] = outline[q];
+            }
+        }
+    }
+}
+
+// ---- RunVideo ---------------------------------------------------------------------------
+
+struct RunVideo::Impl {
+    cv::VideoWriter writer;
+    cv::Size panel;   // every panel's size: the first frame's
+    cv::Mat canvas;   // BGR, 3 panels side by side
+};
+
+RunVideo::RunVideo(fs::path path) : path_(std::move(path)), impl_(std::make_unique<Impl>()) {
+    const fs::path dir = path_.has_parent_path() ? path_.parent_path() : fs::path(".");
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec || !fs::is_directory(dir))
+        throw IoError(path_.string() + ": cannot create the video's folder" +
+                      (ec ? ": " + ec.message() : ""));
+    // FFmpeg picks the container from the extension, so the temporary name keeps it.
+    std::string name = path_.stem().string();
+    name.insert(0, 1, '.');
+    name.append(".partial").append(path_.extension().string());
+    tmp_path_ = dir / name;
+}
+
+RunVideo::~RunVideo() {
+    if (impl_->writer.isOpened()) impl_->writer.release();
+    std::error_code ec;
+    fs::remove(tmp_path_, ec);
+}
+
+namespace {
+
+/// Pastes an RGB image into the BGR canvas at column x0, scaled to `size` if needed.
+void paste(const ColorImage& image, cv::Mat& canvas, int x0, cv::Size size) {
+    const cv::Mat rgb(image.height, image.width, CV_8UC3,
+                      const_cast<std::uint8_t*>(image.rgb.data()));
+    cv::Mat roi = canvas(cv::Rect(x0, 0, size.width, size.height));
+    if (rgb.size() == size) {
+        cv::cvtColor(rgb, roi, cv::COLOR_RGB2BGR);
+    } else {
+        cv::Mat scaled;
+        cv::resize(rgb, scaled, size, 0, 0, cv::INTER_NEAREST);
+        cv::cvtColor(scaled, roi, cv::COLOR_RGB2BGR);
+    }
+}
+
+/// White text on a dark band, top-left of a panel, one line per entry.
+void caption(cv::Mat& canvas, int x0, const std::vector<std::string>& lines) {
+    const double scale = std::max(0.45, canvas.rows / 960.0);
+    const int thick = scale > 0.8 ? 2 : 1;
+    int baseline = 0;
+    const int line_h =
+        cv::getTextSize("Ag", cv::FONT_HERSHEY_SIMPLEX, scale, thick, &baseline).height + 10;
+    int width = 0;
+    for (const auto& s : lines)
+        width = std::max(width,
+                         cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, thick, &baseline).width);
+    cv::Mat band = canvas(cv::Rect(x0, 0, std::min(width + 16, canvas.cols - x0),
+                                   std::min(line_h * static_cast<int>(lines.size()) + 8, canvas.rows)));
+    band *= 0.35;  // darken, keep the picture faintly visible
+    for (std::size_t i = 0; i < lines.size(); ++i)
+        cv::putText(canvas, lines[i], cv::Point(x0 + 8, line_h * static_cast<int>(i + 1)),
+                    cv::FONT_HERSHEY_SIMPLEX, scale, cv::Scalar(255, 255, 255), thick,
+                    cv::LINE_AA);
+}
+
+}  // namespace
+
+void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
+                     const std::vector<std::uint8_t>* selected, std::size_t index,
+                     std::size_t total, double fps) {
+    if (!impl_->writer.isOpened()) {
+        // Even sizes: H.264 in yuv420p needs them.
+        impl_->panel = cv::Size(result.colors.width & ~1, result.colors.height & ~1);
+        const cv::Size size(3 * impl_->panel.width, impl_->panel.height);
+        for (const char* codec : {"avc1", "mp4v"}) {
+            const int fourcc = cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]);
+            if (impl_->writer.open(tmp_path_.string(), cv::CAP_FFMPEG, fourcc, kVideoFps, size))
+                break;
+        }
+        if (!impl_->writer.isOpened())
+            throw IoError(path_.string() +
+                          ": cannot open a video writer (OpenCV's FFmpeg backend has neither "
+                          "H.264 nor MPEG-4 for this container; try a .mp4 name)");
+        impl_->canvas.create(size, CV_8UC3);
+    }
+    const cv::Size panel = impl_->panel;
+    render_color_panel(frame, colour_);
+    paste(colour_, impl_->canvas, 0, panel);
+    paste(result.colors, impl_->canvas, panel.width, panel);
+    if (selected) {
+        highlight_mask(result.colors, *selected, kSelectionOutline, selected_);
+    } else {
+        highlight_mask(result.colors, std::vector<std::uint8_t>(result.colors.rgb.size() / 3, 0),
+                       kSelectionOutline, selected_);
+    }
+    paste(selected_, impl_->canvas, 2 * panel.width, panel);
+
+    char fps_text[64];
+    std::snprintf(fps_text, sizeof fps_text, "%.1f FPS", fps);
+    caption(impl_->canvas, 0,
+            {"frame " + std::to_string(index + 1) + "/" + std::to_string(total) + "  " +
+                 frame.name,
+             fps_text});
+    caption(impl_->canvas, panel.width, {"clusters (eq. 9)"});
+    caption(impl_->canvas, 2 * panel.width,
+            {selected ? "selected object" : "no object selected (--select U,V)"});
+    impl_->writer.write(impl_->canvas);
+}
+
+void RunVideo::close() {
+    if (!impl_->writer.isOpened())
+        throw IoError(path_.string() + ": no frame was written to the video");
+    impl_->writer.release();
+    std::error_code ec;
+    fs::rename(tmp_path_, path_, ec);
+    if (ec) throw IoError(path_.string() + ": cannot write the video: " + ec.message());
+}
+
+}  // namespace wul3d::cli

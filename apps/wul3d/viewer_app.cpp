@@ -1,0 +1,722 @@
+// The `wul3d view` window. One loop: poll input, maybe run the pipeline on the next frame,
+// lay out the UI (controls | 3D cloud over colour, depth, clusters), draw, maybe screenshot.
+#include "viewer_app.hpp"
+
+#define GL_GLEXT_PROTOTYPES 1
+#define GLFW_INCLUDE_NONE
+#include <GL/glcorearb.h>
+#include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "video_writer.hpp"
+#include "viewer_gl.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/objects.hpp"
+#include "wul3d/visualization.hpp"
+
+namespace wul3d::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// ---- the window and the UI library, released in reverse order ------------------------------
+
+std::string g_glfw_error;  // the last GLFW error, for the one-line message
+std::vector<int> g_keys;   // keys pressed since the last loop turn
+
+struct GlfwWindow {
+    GLFWwindow* window = nullptr;
+    GlfwWindow(int width, int height, const std::string& title) {
+        const char* x11 = std::getenv("DISPLAY");
+        const char* wayland = std::getenv("WAYLAND_DISPLAY");
+        if ((!x11 || !*x11) && (!wayland || !*wayland))
+            throw InputError("no display: DISPLAY is not set (run in a desktop session, or "
+                             "under xvfb-run)");
+        glfwSetErrorCallback([](int, const char* text) { g_glfw_error = text; });
+        if (!glfwInit()) throw InputError("no display: " + g_glfw_error);
+        glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+        glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+        glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+        glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+        window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+        if (!window) {
+            glfwTerminate();
+            throw InputError("no display: cannot open an OpenGL 3.3 window: " + g_glfw_error);
+        }
+        glfwMakeContextCurrent(window);
+        glfwSwapInterval(1);
+        // Ours first; the UI library chains to it.
+        glfwSetKeyCallback(window, [](GLFWwindow*, int key, int, int action, int) {
+            if (action == GLFW_PRESS || action == GLFW_REPEAT) g_keys.push_back(key);
+        });
+    }
+    ~GlfwWindow() {
+        glfwDestroyWindow(window);
+        glfwTerminate();
+    }
+    GlfwWindow(const GlfwWindow&) = delete;
+    GlfwWindow& operator=(const GlfwWindow&) = delete;
+};
+
+struct ImGuiSession {
+    explicit ImGuiSession(GLFWwindow* window) {
+        IMGUI_CHECKVERSION();
+        ImGui::CreateContext();
+        ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in the user's folder
+        ImGui::StyleColorsDark();
+        ImGuiStyle& style = ImGui::GetStyle();
+        style.WindowRounding = 0;
+        style.FrameRounding = 3;
+        style.GrabRounding = 3;
+        style.WindowBorderSize = 0;
+        style.Colors[ImGuiCol_WindowBg] = ImVec4(0.11f, 0.12f, 0.14f, 1.0f);
+        style.Colors[ImGuiCol_TitleBg] = ImVec4(0.16f, 0.18f, 0.22f, 1.0f);
+        style.Colors[ImGuiCol_TitleBgActive] = style.Colors[ImGuiCol_TitleBg];
+        ImGui_ImplGlfw_InitForOpenGL(window, true);
+        ImGui_ImplOpenGL3_Init("#version 330 core");
+    }
+    ~ImGuiSession() {
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+    }
+    ImGuiSession(const ImGuiSession&) = delete;
+    ImGuiSession& operator=(const ImGuiSession&) = delete;
+};
+
+struct Rect {
+    float x = 0, y = 0, w = 0, h = 0;
+    bool contains(ImVec2 p) const { return p.x >= x && p.y >= y && p.x < x + w && p.y < y + h; }
+};
+
+constexpr ImGuiWindowFlags kPanelFlags =
+    ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoScrollbar |
+    ImGuiWindowFlags_NoScrollWithMouse | ImGuiWindowFlags_NoBringToFrontOnFocus;
+constexpr float kControlsWidth = 340;
+constexpr double kRecordingFps = 30;  // playback pace when "real time" is on
+const ImVec4 kErrorColour(1.0f, 0.45f, 0.4f, 1.0f);
+const ImVec4 kDimColour(0.6f, 0.62f, 0.66f, 1.0f);
+
+class Viewer {
+public:
+    Viewer(const ViewerConfig& config, GLFWwindow* window)
+        : cfg_(config), window_(window), params_(config.params), pending_(config.params) {
+        source_ = open_source(cfg_.input, cfg_.source);
+        delta_is_one_minus_alpha_ =
+            std::abs(params_.cluster.alpha + params_.cluster.delta - 1.0f) < 1e-6f;
+        pipeline_ = std::make_unique<Pipeline>(params_);
+        if (cfg_.select) selection_.emplace(cfg_.select->first, cfg_.select->second);
+        scripted_ = cfg_.exit_after > 0;
+        playing_ = true;
+        process(0);
+        const RgbdFrame& f = *frame_;
+        const float fov_y = 2.0f * std::atan(static_cast<float>(f.height()) /
+                                             (2.0f * static_cast<float>(f.intrinsics.fy)));
+        view_fov_y_ = fov_y;
+        camera_.reset(scene_depth_, fov_y);
+        constexpr float kRadPerDeg = 3.14159265f / 180.0f;
+        camera_.yaw = cfg_.orbit_yaw_deg * kRadPerDeg;
+        camera_.pitch = std::clamp(cfg_.orbit_pitch_deg * kRadPerDeg, -1.48f, 1.48f);
+    }
+
+    void run();
+
+private:
+    void process(std::size_t index);
+    void apply_pending();
+    void refresh_views();
+    void rebuild_cloud();
+    void select_at(int u, int v);
+    void handle_keys();
+    void draw_controls(const Rect& area);
+    void draw_cloud(const Rect& area);
+    void draw_image(const char* title, ImageTexture& texture, const Rect& area, bool clickable,
+                    Rect* image_rect);
+    void take_screenshot(const std::string& path, bool scripted);
+
+    ViewerConfig cfg_;
+    GLFWwindow* window_;
+    std::unique_ptr<FrameSource> source_;
+    SourceItem item_;
+    std::unique_ptr<Pipeline> pipeline_;
+    PipelineParams params_;   // what the pipeline runs with
+    PipelineParams pending_;  // what the controls show; applied at the next frame
+    bool params_dirty_ = false;
+    bool delta_is_one_minus_alpha_ = true;
+    std::string param_error_;
+
+    const FrameResult* result_ = nullptr;
+    const RgbdFrame* frame_ = nullptr;
+    std::size_t current_ = 0;   // index of the frame on screen
+    std::size_t played_ = 0;    // frames run through the pipeline
+    double pipeline_ms_avg_ = 0;  // median of recent_ms_
+    std::vector<double> recent_ms_;
+    float scene_depth_ = 1.0f;  // median depth of the first frame's points, metres
+
+    bool playing_ = true, loop_ = true, real_time_ = true, step_ = false, scripted_ = false;
+    Clock::time_point last_frame_time_{};
+
+    std::optional<SelectedObject> selection_;
+    std::vector<std::uint8_t> mask_;
+    std::string status_;
+
+    ImageTexture tex_color_, tex_depth_, tex_clusters_;
+    ColorImage img_color_, img_depth_, img_clusters_;
+    std::pair<float, float> depth_ramp_{0, 0};  // metres at the ramp's warm and cool ends
+    CloudRenderer cloud_;
+    OrbitCamera camera_;
+    float view_fov_y_ = 0.8f;
+    std::vector<float> xyz_;
+    std::vector<std::uint8_t> rgb_;
+    std::vector<std::int32_t> pixel_of_point_;
+    int cloud_colour_mode_ = 0;  // 0 clusters (eq. 9), 1 the frame's colour
+    bool show_inactive_ = true;
+    float point_size_ = 2.0f;
+    Mat4 mvp_{};
+    Rect cloud_rect_, clusters_rect_;
+    int screenshots_ = 0;
+};
+
+// ---- frames --------------------------------------------------------------------------------
+
+void Viewer::process(std::size_t index) {
+    source_->read(index, item_);
+    const auto run_once = [&]() -> const FrameResult& {
+        return item_.is_raw ? pipeline_->process(item_.raw, *source_->calibration(),
+                                                 cfg_.source.registration)
+                            : pipeline_->process(item_.frame);
+    };
+    const PipelineParams before = params_;
+    const bool changed = params_dirty_;
+    if (params_dirty_) apply_pending();
+    try {
+        result_ = &run_once();
+    } catch (const wul3d::Error& e) {
+        if (!changed) throw;
+        // The new parameters do not fit this input (e.g. k above its points): keep the old.
+        param_error_ = e.what();
+        params_ = pending_ = before;
+        pipeline_ = std::make_unique<Pipeline>(params_);
+        result_ = &run_once();
+    }
+    frame_ = item_.is_raw ? &pipeline_->registered() : &item_.frame;
+    current_ = index;
+    ++played_;
+    // FPS from the median of the last 30 frames: the seeding frame does not skew it for long.
+    recent_ms_.push_back(result_->times.total());
+    if (recent_ms_.size() > 30) recent_ms_.erase(recent_ms_.begin());
+    std::vector<double> sorted = recent_ms_;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                     sorted.end());
+    pipeline_ms_avg_ = sorted[sorted.size() / 2];
+    if (played_ == 1) {
+        // Where the scene is, for the orbit camera's first target.
+        std::vector<float> z;
+        const OrganizedCloud& c = pipeline_->cloud();
+        for (std::size_t p = 0; p < c.z.size(); p += 7)
+            if (result_->active[p]) z.push_back(c.z[p]);
+        if (!z.empty()) {
+            std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2), z.end());
+            scene_depth_ = std::max(0.1f, z[z.size() / 2]);
+        }
+    }
+    if (selection_) {
+        try {
+            selection_->update(result_->labels, mask_);
+            status_ = "following cluster " + std::to_string(selection_->cluster()) + ", " +
+                      std::to_string(selection_->pixels()) + " px";
+        } catch (const InputError& e) {
+            selection_.reset();
+            mask_.clear();
+            status_ = e.what();
+        }
+    }
+    refresh_views();
+}
+
+void Viewer::apply_pending() {
+    params_dirty_ = false;
+    param_error_.clear();
+    if (delta_is_one_minus_alpha_) pending_.cluster.delta = 1.0f - pending_.cluster.alpha;
+    try {
+        pending_.validate();
+    } catch (const ParamError& e) {
+        param_error_ = e.what();
+        pending_ = params_;
+        return;
+    }
+    // The pipeline has no setters: a new one is the honest way, and it re-seeds.
+    params_ = pending_;
+    pipeline_ = std::make_unique<Pipeline>(params_);
+}
+
+void Viewer::refresh_views() {
+    const FrameResult& r = *result_;
+    render_color_panel(*frame_, img_color_);
+    depth_ramp_ = render_depth_panel(frame_->depth, params_.range.zmin_m, params_.range.zmax_m,
+                                     img_depth_);
+    if (selection_) {
+        highlight_mask(r.colors, mask_, kSelectionOutline, img_clusters_);
+    } else {
+        img_clusters_ = r.colors;
+    }
+    tex_color_.upload(img_color_);
+    tex_depth_.upload(img_depth_);
+    tex_clusters_.upload(img_clusters_);
+    rebuild_cloud();
+}
+
+void Viewer::rebuild_cloud() {
+    const OrganizedCloud& c = pipeline_->cloud();
+    const FrameResult& r = *result_;
+    const bool selected = selection_ && mask_.size() == c.x.size();
+    xyz_.clear();
+    rgb_.clear();
+    pixel_of_point_.clear();
+    std::vector<float> sx, sy, sz;  // the selected object's points, for its box
+    for (std::size_t p = 0; p < c.x.size(); ++p) {
+        if (!c.valid[p]) continue;
+        const bool labelled = r.labels.labels[p] != 0;
+        if (!labelled && !show_inactive_) continue;
+        const float x = c.x[p], y = -c.y[p], z = -c.z[p];
+        xyz_.insert(xyz_.end(), {x, y, z});
+        pixel_of_point_.push_back(static_cast<std::int32_t>(p));
+        const std::uint8_t* src = (cloud_colour_mode_ == 0 && labelled)
+                                      ? &r.colors.rgb[3 * p]
+                                      : (frame_->has_color() ? &frame_->color.rgb[3 * p] : nullptr);
+        std::uint8_t col[3] = {160, 160, 160};
+        if (src) std::copy_n(src, 3, col);
+        float gain = labelled ? 1.0f : 0.3f;
+        if (selected && !mask_[p]) gain *= 0.35f;
+        if (selected && mask_[p]) {
+            sx.push_back(x);
+            sy.push_back(y);
+            sz.push_back(z);
+        }
+        for (int q = 0; q < 3; ++q)
+            rgb_.push_back(static_cast<std::uint8_t>(static_cast<float>(col[q]) * gain));
+    }
+    cloud_.set_points(xyz_, rgb_);
+
+    // The selected object's box: 2nd to 98th percentile on each axis, so a few stray pixels
+    // at its border do not blow it up.
+    std::vector<float> lines;
+    std::vector<std::uint8_t> line_rgb;
+    if (sx.size() >= 10) {
+        float lo[3], hi[3];
+        std::vector<float>* axes[3] = {&sx, &sy, &sz};
+        for (int a = 0; a < 3; ++a) {
+            auto& v = *axes[a];
+            const auto n = static_cast<std::ptrdiff_t>(v.size());
+            std::nth_element(v.begin(), v.begin() + n / 50, v.end());
+            lo[a] = v[static_cast<std::size_t>(n / 50)];
+            std::nth_element(v.begin(), v.begin() + n - 1 - n / 50, v.end());
+            hi[a] = v[static_cast<std::size_t>(n - 1 - n / 50)];
+        }
+        for (int e = 0; e < 12; ++e) {
+            // Edge e runs along axis e / 4; the other two axes take the corners of e % 4.
+            const int axis = e / 4, o1 = (axis + 1) % 3, o2 = (axis + 2) % 3;
+            for (int end = 0; end < 2; ++end) {
+                float pt[3];
+                pt[axis] = end ? hi[axis] : lo[axis];
+                pt[o1] = (e % 4) & 1 ? hi[o1] : lo[o1];
+                pt[o2] = (e % 4) & 2 ? hi[o2] : lo[o2];
+                lines.insert(lines.end(), pt, pt + 3);
+                line_rgb.insert(line_rgb.end(), kSelectionOutline, kSelectionOutline + 3);
+            }
+        }
+    }
+    cloud_.set_lines(lines, line_rgb);
+}
+
+void Viewer::select_at(int u, int v) {
+    selection_.emplace(u, v);
+    mask_.clear();
+    try {
+        selection_->update(result_->labels, mask_);
+        status_ = "selected cluster " + std::to_string(selection_->cluster()) + " at (" +
+                  std::to_string(u) + ", " + std::to_string(v) + "), " +
+                  std::to_string(selection_->pixels()) + " px";
+    } catch (const InputError& e) {
+        selection_.reset();
+        mask_.clear();
+        status_ = e.what();
+    }
+    refresh_views();
+}
+
+// ---- input -------------------------------------------------------------------------------
+
+void Viewer::handle_keys() {
+    std::vector<int> keys;
+    keys.swap(g_keys);
+    if (ImGui::GetIO().WantCaptureKeyboard) return;
+    for (const int key : keys) {
+        switch (key) {
+            case GLFW_KEY_SPACE: playing_ = !playing_; break;
+            case GLFW_KEY_RIGHT:
+            case GLFW_KEY_N:
+                playing_ = false;
+                step_ = true;
+                break;
+            case GLFW_KEY_L: loop_ = !loop_; break;
+            case GLFW_KEY_R: camera_.reset(scene_depth_, view_fov_y_); break;
+            case GLFW_KEY_C:
+                selection_.reset();
+                mask_.clear();
+                status_.clear();
+                refresh_views();
+                break;
+            case GLFW_KEY_S: {
+                char name[64];
+                std::snprintf(name, sizeof name, "wul3d_view_%03d.png", ++screenshots_);
+                take_screenshot(name, false);
+                break;
+            }
+            case GLFW_KEY_ESCAPE:
+            case GLFW_KEY_Q: glfwSetWindowShouldClose(window_, GLFW_TRUE); break;
+            default: break;
+        }
+    }
+}
+
+// ---- drawing -------------------------------------------------------------------------------
+
+void Viewer::draw_controls(const Rect& area) {
+    ImGui::SetNextWindowPos(ImVec2(area.x, area.y));
+    ImGui::SetNextWindowSize(ImVec2(area.w, area.h));
+    ImGui::Begin("wul3d view", nullptr, kPanelFlags & ~ImGuiWindowFlags_NoScrollbar &
+                                            ~ImGuiWindowFlags_NoScrollWithMouse);
+    const std::size_t n = source_->size();
+    ImGui::TextWrapped("%s", cfg_.input.c_str());
+    ImGui::Text("frame %zu / %zu   %s", current_ + 1, n, frame_->name.c_str());
+
+    if (ImGui::CollapsingHeader("Playback", ImGuiTreeNodeFlags_DefaultOpen)) {
+        if (ImGui::Button(playing_ ? "Pause" : "Play", ImVec2(70, 0))) playing_ = !playing_;
+        ImGui::SameLine();
+        if (ImGui::Button("Step", ImVec2(70, 0))) {
+            playing_ = false;
+            step_ = true;
+        }
+        ImGui::SameLine();
+        ImGui::Checkbox("Loop", &loop_);
+        ImGui::Checkbox("Real time (30 FPS at most)", &real_time_);
+    }
+
+    if (ImGui::CollapsingHeader("Parameters", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::PushItemWidth(170);
+        ClusterParams& c = pending_.cluster;
+        bool changed = false;
+        changed |= ImGui::SliderInt("k", &c.k, 1, 32);
+        changed |= ImGui::SliderFloat("alpha (eq. 4)", &c.alpha, 0.0005f, 0.2f, "%.4f",
+                                      ImGuiSliderFlags_Logarithmic);
+        changed |= ImGui::Checkbox("delta = 1 - alpha", &delta_is_one_minus_alpha_);
+        ImGui::BeginDisabled(delta_is_one_minus_alpha_);
+        if (delta_is_one_minus_alpha_) c.delta = 1.0f - c.alpha;
+        changed |= ImGui::SliderFloat("delta (eq. 4)", &c.delta, 0.5f, 1.0f, "%.4f");
+        ImGui::EndDisabled();
+        changed |= ImGui::SliderFloat("gamma (eq. 6)", &c.gamma, 0.00001f, 0.1f, "%.5f",
+                                      ImGuiSliderFlags_Logarithmic);
+        changed |= ImGui::SliderFloat("psi (eq. 2)", &c.psi, 0.01f, 1.0f, "%.2f");
+        changed |= ImGui::DragFloatRange2("depth, m", &pending_.range.zmin_m,
+                                          &pending_.range.zmax_m, 0.01f, 0.0f, 10.0f, "%.2f");
+        changed |= ImGui::SliderInt("stride, px", &c.stride, 1, 8);
+        changed |= ImGui::SliderInt("iterations", &c.iters, 1, 10);
+        ImGui::PopItemWidth();
+        if (changed) params_dirty_ = true;
+        if (ImGui::Button("Re-seed")) params_dirty_ = true;
+        ImGui::SameLine();
+        if (ImGui::Button("Paper preset")) {
+            pending_ = PipelineParams::paper();
+            delta_is_one_minus_alpha_ = true;
+            params_dirty_ = true;
+        }
+        ImGui::TextColored(kDimColour, params_dirty_ ? "applies at the next frame (re-seeds)"
+                                                     : "changes re-seed at the next frame");
+        if (!param_error_.empty()) {
+            ImGui::PushStyleColor(ImGuiCol_Text, kErrorColour);
+            ImGui::TextWrapped("%s", param_error_.c_str());
+            ImGui::PopStyleColor();
+        }
+    }
+
+    if (ImGui::CollapsingHeader("Timings", ImGuiTreeNodeFlags_DefaultOpen)) {
+        const StageTimes& t = result_->times;
+        ImGui::Text("pipeline %.1f FPS (%.1f ms)   window %.0f FPS",
+                    pipeline_ms_avg_ > 0 ? 1000.0 / pipeline_ms_avg_ : 0.0, pipeline_ms_avg_,
+                    static_cast<double>(ImGui::GetIO().Framerate));
+        const std::pair<const char*, double> stages[] = {
+            {"registration", t.registration}, {"back-projection", t.backprojection},
+            {"normals", t.normals},           {"background", t.background},
+            {"clustering", t.clustering},     {"colours (eq. 9)", t.colors},
+            // Stages added after these (objects, ...): total() counts them.
+            {"later stages", t.total() - t.registration - t.backprojection - t.normals -
+                                 t.background - t.clustering - t.colors}};
+        const double total = std::max(1e-9, t.total());
+        for (const auto& [name, ms] : stages) {
+            char label[32];
+            std::snprintf(label, sizeof label, "%.2f ms", ms);
+            ImGui::ProgressBar(static_cast<float>(ms / total), ImVec2(150, 0), label);
+            ImGui::SameLine();
+            ImGui::TextUnformatted(name);
+        }
+        const FrameStats& s = result_->stats;
+        ImGui::PushStyleColor(ImGuiCol_Text, kDimColour);
+        ImGui::TextWrapped("%zu points clustered, %zu in range, tau %lld, re-seeded %d",
+                           s.points, result_->active_points, static_cast<long long>(s.tau),
+                           s.reseeded);
+        ImGui::PopStyleColor();
+    }
+
+    if (ImGui::CollapsingHeader("Selected object", ImGuiTreeNodeFlags_DefaultOpen)) {
+        if (selection_) {
+            const auto col = cluster_color(selection_->cluster() - 1);
+            ImGui::ColorButton("##c", ImVec4(col[0] / 255.0f, col[1] / 255.0f, col[2] / 255.0f, 1),
+                               ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+            ImGui::SameLine();
+            ImGui::Text("cluster %d, %zu px", selection_->cluster(), selection_->pixels());
+            if (ImGui::Button("Clear (C)")) {
+                selection_.reset();
+                mask_.clear();
+                status_.clear();
+                refresh_views();
+            }
+        } else {
+            ImGui::TextColored(kDimColour, "click an object in a picture or in 3D");
+        }
+        if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
+    }
+
+    if (ImGui::CollapsingHeader("3D view", ImGuiTreeNodeFlags_DefaultOpen)) {
+        bool changed = ImGui::RadioButton("clusters", &cloud_colour_mode_, 0);
+        ImGui::SameLine();
+        changed |= ImGui::RadioButton("colour", &cloud_colour_mode_, 1);
+        changed |= ImGui::Checkbox("points out of range (dim)", &show_inactive_);
+        ImGui::PushItemWidth(170);
+        ImGui::SliderFloat("point size", &point_size_, 1.0f, 6.0f, "%.1f");
+        ImGui::PopItemWidth();
+        if (ImGui::Button("Reset view (R)")) camera_.reset(scene_depth_, view_fov_y_);
+        if (changed) rebuild_cloud();
+    }
+
+    if (ImGui::CollapsingHeader("Keys")) {
+        ImGui::TextColored(kDimColour,
+                           "space play/pause   N or right step\n"
+                           "L loop   R reset view   C clear selection\n"
+                           "S screenshot (wul3d_view_NNN.png)   Q quit\n"
+                           "3D: left drag orbit, right drag pan,\n"
+                           "    wheel zoom, click select");
+    }
+    ImGui::End();
+}
+
+void Viewer::draw_cloud(const Rect& area) {
+    ImGui::SetNextWindowPos(ImVec2(area.x, area.y));
+    ImGui::SetNextWindowSize(ImVec2(area.w, area.h));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    ImGui::Begin("3D: coloured point cloud (eq. 9)", nullptr, kPanelFlags);
+    const ImVec2 pos = ImGui::GetCursorScreenPos();
+    const ImVec2 size = ImGui::GetContentRegionAvail();
+    cloud_rect_ = {pos.x, pos.y, size.x, size.y};
+    const ImGuiIO& io = ImGui::GetIO();
+    const int w = std::max(1, static_cast<int>(size.x * io.DisplayFramebufferScale.x));
+    const int h = std::max(1, static_cast<int>(size.y * io.DisplayFramebufferScale.y));
+
+    ImGui::InvisibleButton("##cloud", ImVec2(std::max(1.0f, size.x), std::max(1.0f, size.y)),
+                           ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight |
+                               ImGuiButtonFlags_MouseButtonMiddle);
+    // Not on the press itself: the mouse may have jumped there since the last frame.
+    if (ImGui::IsItemActive() && !ImGui::IsItemActivated()) {
+        if (ImGui::IsMouseDown(ImGuiMouseButton_Left))
+            camera_.orbit(io.MouseDelta.x, io.MouseDelta.y);
+        else
+            camera_.pan(io.MouseDelta.x, io.MouseDelta.y, size.y);
+    }
+    if (ImGui::IsItemHovered() && io.MouseWheel != 0) camera_.zoom(io.MouseWheel);
+    if (ImGui::IsItemHovered() && ImGui::IsMouseReleased(ImGuiMouseButton_Left) &&
+        io.MouseDragMaxDistanceSqr[0] < 16.0f) {
+        // A click, not a drag: the front-most point within 6 px of the mouse.
+        const float mx = io.MousePos.x - pos.x, my = io.MousePos.y - pos.y;
+        int best = -1;
+        float best_w = 1e30f;
+        for (std::size_t i = 0; i < pixel_of_point_.size(); ++i) {
+            const float* p = &xyz_[3 * i];
+            const float cx = mvp_[0] * p[0] + mvp_[4] * p[1] + mvp_[8] * p[2] + mvp_[12];
+            const float cy = mvp_[1] * p[0] + mvp_[5] * p[1] + mvp_[9] * p[2] + mvp_[13];
+            const float cw = mvp_[3] * p[0] + mvp_[7] * p[1] + mvp_[11] * p[2] + mvp_[15];
+            if (cw <= 0) continue;
+            const float sx = (cx / cw * 0.5f + 0.5f) * size.x;
+            const float sy = (0.5f - cy / cw * 0.5f) * size.y;
+            if ((sx - mx) * (sx - mx) + (sy - my) * (sy - my) < 36.0f && cw < best_w) {
+                best_w = cw;
+                best = pixel_of_point_[i];
+            }
+        }
+        if (best >= 0) {
+            const int W = pipeline_->cloud().width;
+            select_at(best % W, best / W);
+        } else {
+            status_ = "no point under the mouse";
+        }
+    }
+
+    mvp_ = multiply(camera_.projection(size.x / std::max(1.0f, size.y)), camera_.view());
+    const float background[3] = {0.05f, 0.055f, 0.07f};
+    const unsigned tex = cloud_.render(w, h, mvp_, point_size_, background);
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(tex)), pos,
+                 ImVec2(pos.x + size.x, pos.y + size.y), ImVec2(0, 1), ImVec2(1, 0));
+    char line[160];
+    std::snprintf(line, sizeof line, "frame %zu/%zu  %s   k = %d", current_ + 1,
+                  source_->size(), frame_->name.c_str(), params_.cluster.k);
+    dl->AddText(ImVec2(pos.x + 10, pos.y + 8), IM_COL32(235, 235, 235, 255), line);
+    dl->AddText(ImVec2(pos.x + 10, pos.y + size.y - 22), IM_COL32(150, 155, 165, 255),
+                "left drag: orbit   right drag: pan   wheel: zoom   R: reset   click: select");
+    ImGui::End();
+    ImGui::PopStyleVar();
+}
+
+void Viewer::draw_image(const char* title, ImageTexture& texture, const Rect& area,
+                        bool clickable, Rect* image_rect) {
+    ImGui::SetNextWindowPos(ImVec2(area.x, area.y));
+    ImGui::SetNextWindowSize(ImVec2(area.w, area.h));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(4, 4));
+    ImGui::Begin(title, nullptr, kPanelFlags);
+    const ImVec2 avail = ImGui::GetContentRegionAvail();
+    const float aspect =
+        static_cast<float>(texture.height()) / static_cast<float>(std::max(1, texture.width()));
+    float w = avail.x, h = avail.x * aspect;
+    if (h > avail.y) {
+        h = avail.y;
+        w = h / aspect;
+    }
+    ImVec2 pos = ImGui::GetCursorScreenPos();
+    pos.x += (avail.x - w) / 2;  // centred
+    ImGui::SetCursorScreenPos(pos);
+    ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(texture.id())),
+                 ImVec2(w, h));
+    if (image_rect) *image_rect = {pos.x, pos.y, w, h};
+    if (ImGui::IsItemHovered()) {
+        const ImVec2 m = ImGui::GetIO().MousePos;
+        const int u = std::clamp(static_cast<int>((m.x - pos.x) / w * static_cast<float>(texture.width())), 0,
+                                 texture.width() - 1);
+        const int v = std::clamp(static_cast<int>((m.y - pos.y) / h * static_cast<float>(texture.height())), 0,
+                                 texture.height() - 1);
+        const std::size_t p = static_cast<std::size_t>(v) * texture.width() + u;
+        const float z = p < frame_->depth.data.size()
+                            ? static_cast<float>(frame_->depth.data[p]) * frame_->depth.scale_m_per_unit
+                            : 0.0f;
+        const int label = p < result_->labels.labels.size() ? result_->labels.labels[p] : 0;
+        ImGui::BeginTooltip();
+        ImGui::Text("(%d, %d)  z %.3f m  cluster %d", u, v, static_cast<double>(z), label);
+        ImGui::EndTooltip();
+        if (clickable && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) select_at(u, v);
+    }
+    ImGui::End();
+    ImGui::PopStyleVar();
+}
+
+void Viewer::take_screenshot(const std::string& path, bool scripted) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_, &w, &h);
+    write_color_png(path, read_framebuffer(w, h));
+    const float s = ImGui::GetIO().DisplayFramebufferScale.x;
+    const auto px = [s](float x) { return static_cast<int>(std::lround(x * s)); };
+    status_ = "screenshot: " + path;
+    if (scripted)
+        std::cout << "wul3d: screenshot " << path << " (" << w << "x" << h
+                  << "), clusters panel at " << px(clusters_rect_.x) << "," << px(clusters_rect_.y)
+                  << " " << px(clusters_rect_.w) << "x" << px(clusters_rect_.h) << std::endl;
+}
+
+// ---- the loop ------------------------------------------------------------------------------
+
+void Viewer::run() {
+    last_frame_time_ = Clock::now();
+    int settle = 0;  // UI frames drawn after the last scripted frame (layout settles in two)
+    while (!glfwWindowShouldClose(window_)) {
+        glfwPollEvents();
+        handle_keys();
+
+        const std::size_t n = source_->size();
+        const bool at_end = current_ + 1 >= n;
+        const bool scripted_done = scripted_ && played_ >= static_cast<std::size_t>(cfg_.exit_after);
+        const double since =
+            std::chrono::duration<double>(Clock::now() - last_frame_time_).count();
+        const bool due = playing_ && !scripted_done && (!at_end || loop_) &&
+                         (scripted_ || !real_time_ || since >= 1.0 / kRecordingFps);
+        if (due || step_) {
+            last_frame_time_ = Clock::now();
+            process(at_end ? 0 : current_ + 1);
+        } else if (params_dirty_ && !playing_) {
+            process(current_);  // paused: show the new parameters on this frame
+        }
+        step_ = false;
+
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        const ImVec2 display = ImGui::GetIO().DisplaySize;
+        const float right_w = std::max(300.0f, display.x - kControlsWidth);
+        const float panel_w = right_w / 3;
+        const float aspect =
+            static_cast<float>(frame_->height()) / static_cast<float>(std::max(1, frame_->width()));
+        const float title_h = ImGui::GetFrameHeight();
+        const float panel_h = std::min((panel_w - 8) * aspect + title_h + 8, display.y * 0.5f);
+        const float cloud_h = std::max(100.0f, display.y - panel_h);
+        draw_controls({0, 0, kControlsWidth, display.y});
+        draw_cloud({kControlsWidth, 0, right_w, cloud_h});
+        draw_image("colour", tex_color_, {kControlsWidth, cloud_h, panel_w, panel_h}, true,
+                   nullptr);
+        char depth_title[128];
+        std::snprintf(depth_title, sizeof depth_title,
+                      "depth: %.2f m (yellow) to %.2f m (blue), grey out of range###depth",
+                      static_cast<double>(depth_ramp_.first),
+                      static_cast<double>(depth_ramp_.second));
+        draw_image(depth_title, tex_depth_, {kControlsWidth + panel_w, cloud_h, panel_w, panel_h},
+                   true, nullptr);
+        draw_image("clusters (eq. 9): click to select###clusters", tex_clusters_,
+                   {kControlsWidth + 2 * panel_w, cloud_h, display.x - kControlsWidth - 2 * panel_w,
+                    panel_h},
+                   true, &clusters_rect_);
+        ImGui::Render();
+
+        int fb_w = 0, fb_h = 0;
+        glfwGetFramebufferSize(window_, &fb_w, &fb_h);
+        glViewport(0, 0, fb_w, fb_h);
+        glClearColor(0.08f, 0.08f, 0.1f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+        if (scripted_done && ++settle >= 3) {
+            if (!cfg_.screenshot.empty()) take_screenshot(cfg_.screenshot, true);
+            break;
+        }
+        glfwSwapBuffers(window_);
+    }
+}
+
+}  // namespace
+
+void run_viewer(const ViewerConfig& config) {
+    const std::string title = "wul3d view: " + config.input;
+    GlfwWindow window(config.width, config.height, title);
+    ImGuiSession ui(window.window);
+    Viewer viewer(config, window.window);
+    viewer.run();
+}
+
+}  // namespace wul3d::cli

@@ -1,0 +1,29 @@
+#pragma once
+// The `wul3d view` window: plays a recording through the pipeline and shows the coloured
+// cloud in 3D, the colour, depth and cluster pictures in 2D, live parameter controls, timings
+// and the user-selected object. GLFW + OpenGL 3.3 + Dear ImGui.
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "wul3d/io.hpp"
+#include "wul3d/pipeline.hpp"
+
+namespace wul3d::cli {
+
+struct ViewerConfig {
+    std::string input;
+    SourceOptions source;
+    PipelineParams params;
+    std::optional<std::pair<int, int>> select;  ///< follow the object under (u, v)
+    std::string screenshot;  ///< write the window here after exit_after frames, then exit
+    int exit_after = 0;      ///< frames to play before the screenshot and exit; 0 = until closed
+    int width = 1600, height = 900;  ///< window size, screen pixels
+    float orbit_yaw_deg = 0, orbit_pitch_deg = 0;  ///< first 3D view, turned from the sensor's
+};
+
+/// Opens the window and runs until it is closed (or, with exit_after, until that many frames
+/// were played). Throws InputError "no display ..." when no window can be opened.
+void run_viewer(const ViewerConfig& config);
+
+}  // namespace wul3d::cli

@@ -1,0 +1,82 @@
+#pragma once
+/// @file segmentation.hpp
+/// Object instances on the pixel grid, from the points left after support-plane removal
+/// (plane.hpp). The geometric segmenter cuts the surface where it folds inward (a concave
+/// crease: a per-pixel version of LCCP's convexity test between neighbouring normals) and
+/// where depth jumps, takes connected components, then re-attaches the cut pixels and the
+/// objects' feet to the component they touch. The hybrid segmenter adds the colour cue of
+/// the paper's weighted clustering where geometry is silent (two flush boxes of different
+/// colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "wul3d/backprojection.hpp"
+#include "wul3d/clustering.hpp"
+#include "wul3d/normals.hpp"
+
+namespace wul3d {
+
+enum class Segmenter {
+    Geometric,  ///< crease and depth cuts, connected components, re-attachment
+    Kmeans,     ///< the paper's clusters (ClusterState labels), connected parts of each
+    Hybrid,     ///< Geometric, then the colour cue splits segments geometry cannot
+};
+Segmenter parse_segmenter(const std::string& name);  ///< geometric|kmeans|hybrid, else ParamError
+const char* segmenter_name(Segmenter s);
+
+struct SegmentParams {
+    Segmenter segmenter = Segmenter::Hybrid;
+    int min_points = 300;           ///< objects with fewer pixels are dropped; >= 1 (--min-points)
+    float depth_jump_m = 0.004f;    ///< neighbours whose depths differ by more than
+    float depth_jump_rel = 0.012f;  ///< depth_jump_m + depth_jump_rel * z^2 are not connected;
+                                    ///< > 0 and >= 0 (Kinect depth noise grows with z^2)
+    int crease_step_px = 3;         ///< normals compared this many pixels apart; [1, 16]
+    float concavity = 0.4f;         ///< (n_p - n_q) . (X_q - X_p) / |X_q - X_p| above this is a
+                                    ///< concave crease (LCCP's test, per pixel); > 0
+    int reattach_px = 8;            ///< cut pixels and feet join a segment up to this far; >= 0
+    int min_seed_points = 40;       ///< components smaller than this before re-attachment are
+                                    ///< cut pixels too; >= 1
+    // Colour cue (hybrid): a segment is split in two by the paper's distance (eq. 4, 6) with a
+    // colour-heavy alpha when the two parts differ in colour, are each large, meet along a
+    // short boundary, and that boundary crosses a smooth surface (no crease: shading on two
+    // faces of one box is not a second object).
+    float color_alpha = 0.02f;      ///< alpha of eq. (4) for the split; [0.002, 0.1]
+    float color_min_distance = 45;  ///< RGB distance (0-255) between the parts' means; > 0
+    float color_min_share = 0.15f;  ///< each part holds at least this share; (0, 0.5]
+    float color_max_boundary = 2.5f;  ///< boundary pairs / sqrt(smaller part) at most; > 0
+    float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
+                                      ///< step away on either side) within this angle; > 0
+
+    void validate() const;  ///< throws ParamError naming the field
+};
+
+/// Scratch, sized once per resolution.
+struct SegmentWorkspace {
+    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component
+    std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
+    std::vector<int> label;    ///< 0 none, 1..n
+    std::vector<int> queue;
+    std::vector<int> dist;
+    std::vector<int> sizes;
+    std::vector<int> remap;
+    std::vector<int> offsets;  ///< counting sort of pixels by label
+    std::vector<int> order;
+    std::vector<std::uint8_t> part;
+};
+
+/// What segmentation did, as data.
+struct SegmentStats {
+    int segments = 0;      ///< objects written to `out`
+    int color_splits = 0;  ///< segments the colour cue split
+    std::size_t reattached = 0;  ///< cut pixels and feet re-attached
+};
+
+/// `classes` comes from remove_support_plane (PlaneClass: 0 removed, 1 object, 2 foot).
+/// `clusters` are the ClusterState labels of the same frame (used by kmeans; may be empty
+/// for geometric and hybrid). `out` gets 0 = background, 1..n = segment.
+SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
+                             const NormalMap& normals, const std::vector<std::uint8_t>& classes,
+                             const LabelImage& clusters, SegmentWorkspace& ws, LabelImage& out);
+
+}  // namespace wul3d

@@ -1,0 +1,321 @@
+#include "wul3d/plane.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "wul3d/error.hpp"
+
+namespace wul3d {
+
+namespace {
+template <class T>
+void require(bool ok, const char* name, T value, const char* range) {
+    if (ok) return;
+    std::ostringstream msg;
+    msg << "PlaneParams." << name << " = " << value << ": must be " << range;
+    throw ParamError(msg.str());
+}
+constexpr float kDegToRad = 3.14159265358979f / 180.0f;
+// Per-region sums: count, x, y, z, xx, xy, xz, yy, yz, zz, nx, ny, nz.
+constexpr int kSums = 13;
+}  // namespace
+
+void PlaneParams::validate() const {
+    require(grid_stride_px >= 1 && grid_stride_px <= 32, "grid_stride_px", grid_stride_px, "in [1, 32]");
+    require(grow_angle_deg > 0 && grow_angle_deg < 90, "grow_angle_deg", grow_angle_deg, "in (0, 90)");
+    require(grow_dist_m > 0, "grow_dist_m", grow_dist_m, "> 0");
+    require(min_region_points >= 3, "min_region_points", min_region_points, ">= 3");
+    require(merge_angle_deg > 0 && merge_angle_deg < 90, "merge_angle_deg", merge_angle_deg, "in (0, 90)");
+    require(merge_dist_m > 0, "merge_dist_m", merge_dist_m, "> 0");
+    require(on_plane_m > 0, "on_plane_m", on_plane_m, "> 0");
+    require(on_plane_rel >= 0, "on_plane_rel", on_plane_rel, ">= 0");
+    require(inlier_angle_deg > 0 && inlier_angle_deg < 90, "inlier_angle_deg", inlier_angle_deg, "in (0, 90)");
+    require(min_extent > 0 && min_extent <= 1, "min_extent", min_extent, "in (0, 1]");
+    require(min_up >= -1 && min_up <= 1, "min_up", min_up, "in [-1, 1]");
+    require(max_object_height_m > 0, "max_object_height_m", max_object_height_m, "> 0");
+    require(hull_margin_px >= 0, "hull_margin_px", hull_margin_px, ">= 0");
+}
+
+namespace {
+
+/// Least-squares plane of a region's sums: the normal is the eigenvector of the smallest
+/// eigenvalue of the scatter matrix, oriented towards the camera (d > 0).
+Plane fit(const double* s) {
+    const double n = s[0];
+    const Eigen::Vector3d c(s[1] / n, s[2] / n, s[3] / n);
+    Eigen::Matrix3d m;
+    m(0, 0) = s[4] / n - c.x() * c.x();
+    m(0, 1) = m(1, 0) = s[5] / n - c.x() * c.y();
+    m(0, 2) = m(2, 0) = s[6] / n - c.x() * c.z();
+    m(1, 1) = s[7] / n - c.y() * c.y();
+    m(1, 2) = m(2, 1) = s[8] / n - c.y() * c.z();
+    m(2, 2) = s[9] / n - c.z() * c.z();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    double d = -normal.dot(c);
+    if (d < 0) {
+        normal = -normal;
+        d = -d;
+    }
+    Plane p;
+    p.nx = static_cast<float>(normal.x());
+    p.ny = static_cast<float>(normal.y());
+    p.nz = static_cast<float>(normal.z());
+    p.d = static_cast<float>(d);
+    p.up = -p.ny;
+    return p;
+}
+
+struct Grid {
+    int w = 0, h = 0, s = 1, W = 0;
+    std::size_t pixel(int g) const {
+        return static_cast<std::size_t>(g / w) * s * W + static_cast<std::size_t>(g % w) * s;
+    }
+};
+
+}  // namespace
+
+PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
+                                 const OrganizedCloud& cloud, const NormalMap& normals,
+                                 const std::vector<std::uint8_t>& active, PlaneWorkspace& ws,
+                                 std::vector<std::uint8_t>& classes) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t N = cloud.size();
+    classes.resize(N);
+    PlaneResult result;
+
+    Grid grid;
+    grid.s = params.grid_stride_px;
+    grid.w = (W + grid.s - 1) / grid.s;
+    grid.h = (H + grid.s - 1) / grid.s;
+    grid.W = W;
+    const int G = grid.w * grid.h;
+    ws.region.assign(static_cast<std::size_t>(G), -1);
+    ws.stack.resize(static_cast<std::size_t>(G));
+    ws.sums.clear();
+
+    const float cos_grow = std::cos(params.grow_angle_deg * kDegToRad);
+    const float cos_inlier = std::cos(params.inlier_angle_deg * kDegToRad);
+    auto usable = [&](int g) {
+        const std::size_t p = grid.pixel(g);
+        return active[p] && normals.valid[p];
+    };
+    auto on_band = [&](float z) { return params.on_plane_m + params.on_plane_rel * z * z; };
+
+    // 1. Region growing on the grid: a neighbour joins when its normal agrees with the
+    //    region's mean normal and it lies on the region's mean plane.
+    std::size_t with_normal = 0;
+    int regions = 0;
+    for (int seed = 0; seed < G; ++seed) {
+        if (ws.region[seed] != -1 || !usable(seed)) continue;
+        const int id = regions++;
+        ws.sums.resize(static_cast<std::size_t>(regions) * kSums, 0.0);
+        double* s = ws.sums.data() + static_cast<std::size_t>(id) * kSums;
+        int top = 0;
+        ws.stack[top++] = seed;
+        ws.region[seed] = id;
+        while (top > 0) {
+            const int g = ws.stack[--top];
+            const std::size_t p = grid.pixel(g);
+            const double x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
+            s[0] += 1;
+            s[1] += x; s[2] += y; s[3] += z;
+            s[4] += x * x; s[5] += x * y; s[6] += x * z;
+            s[7] += y * y; s[8] += y * z; s[9] += z * z;
+            s[10] += normals.nx[p]; s[11] += normals.ny[p]; s[12] += normals.nz[p];
+            const double nlen = std::sqrt(s[10] * s[10] + s[11] * s[11] + s[12] * s[12]);
+            const float mnx = static_cast<float>(s[10] / nlen), mny = static_cast<float>(s[11] / nlen),
+                        mnz = static_cast<float>(s[12] / nlen);
+            const float cx = static_cast<float>(s[1] / s[0]), cy = static_cast<float>(s[2] / s[0]),
+                        cz = static_cast<float>(s[3] / s[0]);
+            const int gu = g % grid.w, gv = g / grid.w;
+            const int nb[4] = {gu > 0 ? g - 1 : -1, gu + 1 < grid.w ? g + 1 : -1,
+                               gv > 0 ? g - grid.w : -1, gv + 1 < grid.h ? g + grid.w : -1};
+            for (int q : nb) {
+                if (q < 0 || ws.region[q] != -1 || !usable(q)) continue;
+                const std::size_t pq = grid.pixel(q);
+                const float cosq = normals.nx[pq] * mnx + normals.ny[pq] * mny + normals.nz[pq] * mnz;
+                if (cosq < cos_grow) continue;
+                const float dist = std::fabs(mnx * (cloud.x[pq] - cx) + mny * (cloud.y[pq] - cy) +
+                                             mnz * (cloud.z[pq] - cz));
+                if (dist > params.grow_dist_m + params.on_plane_rel * cloud.z[pq] * cloud.z[pq])
+                    continue;
+                ws.region[q] = id;
+                ws.stack[top++] = q;
+            }
+        }
+        with_normal += static_cast<std::size_t>(s[0]);
+    }
+
+    // 2. Fit the regions worth fitting, merge coplanar ones (a table cut in pieces by the
+    //    objects on it is one plane).
+    std::vector<int> big;
+    std::vector<Plane> fits(static_cast<std::size_t>(regions));
+    for (int r = 0; r < regions; ++r) {
+        const double* s = ws.sums.data() + static_cast<std::size_t>(r) * kSums;
+        if (s[0] < params.min_region_points) continue;
+        fits[r] = fit(s);
+        big.push_back(r);
+    }
+    std::vector<int> parent(static_cast<std::size_t>(regions));
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int a) {
+        while (parent[a] != a) a = parent[a] = parent[parent[a]];
+        return a;
+    };
+    const float cos_merge = std::cos(params.merge_angle_deg * kDegToRad);
+    std::vector<int> roots = big;
+    // Two passes: pieces too noisy to match pairwise often match once merged (a slightly
+    // warped table top seen in pieces between objects).
+    for (int pass = 0; pass < 2; ++pass) {
+        for (std::size_t i = 0; i < roots.size(); ++i)
+            for (std::size_t j = i + 1; j < roots.size(); ++j) {
+                const Plane &a = fits[roots[i]], &b = fits[roots[j]];
+                if (a.nx * b.nx + a.ny * b.ny + a.nz * b.nz < cos_merge) continue;
+                if (std::fabs(a.d - b.d) > params.merge_dist_m) continue;
+                const int ra = find(roots[i]), rb = find(roots[j]);
+                if (ra != rb) parent[rb] = ra;
+            }
+        std::vector<int> next;
+        for (int r : roots) {
+            const int root = find(r);
+            if (root != r) {
+                double* dst = ws.sums.data() + static_cast<std::size_t>(root) * kSums;
+                const double* src = ws.sums.data() + static_cast<std::size_t>(r) * kSums;
+                for (int q = 0; q < kSums; ++q) dst[q] += src[q];
+            } else {
+                next.push_back(r);
+            }
+        }
+        roots = next;
+        for (int r : roots) fits[r] = fit(ws.sums.data() + static_cast<std::size_t>(r) * kSums);
+    }
+
+    // 3. Candidates: merged planes covering min_extent of the grid points with a normal.
+    //    Inliers are counted over the whole grid (distance and normal agree).
+    for (int r : roots) {
+        Plane pl = fit(ws.sums.data() + static_cast<std::size_t>(r) * kSums);
+        std::size_t inliers = 0;
+        for (int g = 0; g < G; ++g) {
+            if (!usable(g)) continue;
+            const std::size_t p = grid.pixel(g);
+            const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+            if (std::fabs(h) > on_band(cloud.z[p])) continue;
+            if (normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz < cos_inlier)
+                continue;
+            ++inliers;
+        }
+        pl.inliers = inliers;
+        if (static_cast<double>(inliers) >= params.min_extent * static_cast<double>(with_normal))
+            result.candidates.push_back(pl);
+    }
+
+    // The support's extent: the image-space convex hull of its inliers on the grid, widened
+    // by the margin; a point belongs over the support when its foot (the point moved down
+    // the normal onto the plane) projects into it.
+    auto build_hull = [&](const Plane& pl) {
+        ws.hull.assign(static_cast<std::size_t>(G), 0);
+        ws.hull_points.clear();
+        for (int g = 0; g < G; ++g) {
+            if (!usable(g)) continue;
+            const std::size_t p = grid.pixel(g);
+            const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+            if (std::fabs(h) > on_band(cloud.z[p])) continue;
+            if (normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz < cos_inlier)
+                continue;
+            ws.hull_points.push_back(g % grid.w);
+            ws.hull_points.push_back(g / grid.w);
+        }
+        if (ws.hull_points.size() < 6) return;
+        cv::Mat pts(static_cast<int>(ws.hull_points.size() / 2), 1, CV_32SC2, ws.hull_points.data());
+        std::vector<cv::Point> hull;
+        cv::convexHull(pts, hull);
+        cv::Mat mask(grid.h, grid.w, CV_8U, ws.hull.data());
+        cv::fillConvexPoly(mask, hull, cv::Scalar(1));
+        const int m = (params.hull_margin_px + grid.s - 1) / grid.s;
+        if (m > 0) {
+            const cv::Mat kernel =
+                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1));
+            cv::dilate(mask, mask, kernel);
+        }
+    };
+    auto foot_in_hull = [&](const Plane& pl, float x, float y, float z, float h) {
+        const float fx = x - h * pl.nx, fy = y - h * pl.ny, fz = z - h * pl.nz;
+        if (fz <= 1e-3f) return false;
+        const double u = K.fx * fx / fz + K.cx, v = K.fy * fy / fz + K.cy;
+        const int gu = static_cast<int>(std::lround(u / grid.s)), gv = static_cast<int>(std::lround(v / grid.s));
+        if (gu < 0 || gv < 0 || gu >= grid.w || gv >= grid.h) return false;
+        return ws.hull[static_cast<std::size_t>(gv) * grid.w + gu] != 0;
+    };
+
+    // 4. The support: among planes that face up, the one that carries most: score = points
+    //    standing on it (at most its extent) + 0.1 x its extent.
+    double best_score = -1;
+    int best = -1;
+    for (std::size_t c = 0; c < result.candidates.size(); ++c) {
+        Plane& pl = result.candidates[c];
+        if (pl.up < params.min_up) continue;
+        build_hull(pl);
+        std::size_t above = 0;
+        for (int g = 0; g < G; ++g) {
+            const std::size_t p = grid.pixel(g);
+            if (!active[p]) continue;
+            const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+            if (h <= on_band(cloud.z[p]) || h > params.max_object_height_m) continue;
+            if (foot_in_hull(pl, cloud.x[p], cloud.y[p], cloud.z[p], h)) ++above;
+        }
+        pl.above = above;
+        // Points standing on a plane count up to its own extent (a small tilted plane, a box
+        // top, has half the room "above" it); extent alone breaks ties (the floor of an
+        // uncropped scene is often larger than the table, but little stands on it).
+        const double score = static_cast<double>(std::min(above, pl.inliers)) +
+                             0.1 * static_cast<double>(pl.inliers);
+        if (score > best_score) {
+            best_score = score;
+            best = static_cast<int>(c);
+        }
+    }
+
+    if (best < 0) {
+        for (std::size_t p = 0; p < N; ++p) classes[p] = active[p] ? kPlaneObject : kPlaneRemoved;
+        result.kept = static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
+        return result;
+    }
+    result.found = true;
+    result.support = result.candidates[static_cast<std::size_t>(best)];
+    const Plane pl = result.support;
+    build_hull(pl);
+
+    // 5. Classify every pixel: below or on the plane (and facing like it) is removed; on the
+    //    band but facing otherwise is a candidate foot; above and over the support is object.
+    std::size_t kept = 0;
+#pragma omp parallel for schedule(static) reduction(+ : kept)
+    for (int v = 0; v < H; ++v) {
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            std::uint8_t c = kPlaneRemoved;
+            if (active[p]) {
+                const float x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
+                const float h = pl.height(x, y, z), band = on_band(z);
+                if (h > band) {
+                    if (foot_in_hull(pl, x, y, z, h)) c = kPlaneObject;
+                } else if (h > -band && normals.valid[p] &&
+                           normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz <
+                               cos_inlier &&
+                           foot_in_hull(pl, x, y, z, h)) {
+                    c = kPlaneFoot;
+                }
+            }
+            classes[p] = c;
+            kept += c != kPlaneRemoved;
+        }
+    }
+    result.kept = kept;
+    return result;
+}
+
+}  // namespace wul3d

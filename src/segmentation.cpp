@@ -1,0 +1,360 @@
+#include "wul3d/segmentation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "wul3d/error.hpp"
+#include "wul3d/plane.hpp"
+
+namespace wul3d {
+
+Segmenter parse_segmenter(const std::string& name) {
+    if (name == "geometric") return Segmenter::Geometric;
+    if (name == "kmeans") return Segmenter::Kmeans;
+    if (name == "hybrid") return Segmenter::Hybrid;
+    throw ParamError("--segmenter '" + name + "': unknown (known: geometric, kmeans, hybrid)");
+}
+
+const char* segmenter_name(Segmenter s) {
+    switch (s) {
+        case Segmenter::Geometric: return "geometric";
+        case Segmenter::Kmeans: return "kmeans";
+        case Segmenter::Hybrid: return "hybrid";
+    }
+    return "?";
+}
+
+namespace {
+template <class T>
+void require(bool ok, const char* name, T value, const char* range) {
+    if (ok) return;
+    std::ostringstream msg;
+    msg << "SegmentParams." << name << " = " << value << ": must be " << range;
+    throw ParamError(msg.str());
+}
+constexpr float kDegToRad = 3.14159265358979f / 180.0f;
+}  // namespace
+
+void SegmentParams::validate() const {
+    if (min_points < 1) {
+        std::ostringstream msg;
+        msg << "--min-points " << min_points << ": must be >= 1";
+        throw ParamError(msg.str());
+    }
+    require(depth_jump_m > 0, "depth_jump_m", depth_jump_m, "> 0");
+    require(depth_jump_rel >= 0, "depth_jump_rel", depth_jump_rel, ">= 0");
+    require(crease_step_px >= 1 && crease_step_px <= 16, "crease_step_px", crease_step_px, "in [1, 16]");
+    require(concavity > 0, "concavity", concavity, "> 0");
+    require(reattach_px >= 0, "reattach_px", reattach_px, ">= 0");
+    require(min_seed_points >= 1, "min_seed_points", min_seed_points, ">= 1");
+    require(color_alpha >= 0.002f && color_alpha <= 0.1f, "color_alpha", color_alpha,
+            "in [0.002, 0.1] (the paper's range of alpha)");
+    require(color_min_distance > 0, "color_min_distance", color_min_distance, "> 0");
+    require(color_min_share > 0 && color_min_share <= 0.5f, "color_min_share", color_min_share, "in (0, 0.5]");
+    require(color_max_boundary > 0, "color_max_boundary", color_max_boundary, "> 0");
+    require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
+}
+
+namespace {
+
+struct Ctx {
+    const SegmentParams& prm;
+    const OrganizedCloud& c;
+    const NormalMap& n;
+    const std::vector<std::uint8_t>& cls;
+    int W, H;
+
+    bool connected(std::size_t p, std::size_t q, float steps = 1.0f) const {
+        const float z = c.z[p];
+        return std::fabs(z - c.z[q]) <= steps * (prm.depth_jump_m + prm.depth_jump_rel * z * z);
+    }
+    /// Paper-free LCCP test between two surface points: concave when the normals face
+    /// each other across the step, (n_p - n_q) . (X_q - X_p) > 0.
+    float concavity(std::size_t p, std::size_t q) const {
+        const float dx = c.x[q] - c.x[p], dy = c.y[q] - c.y[p], dz = c.z[q] - c.z[p];
+        const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+        if (!(len > 1e-6f)) return 0.0f;
+        return ((n.nx[p] - n.nx[q]) * dx + (n.ny[p] - n.ny[q]) * dy + (n.nz[p] - n.nz[q]) * dz) / len;
+    }
+};
+
+/// Connected components of the pixels with `seedable[p]`, 4-connected where depth is
+/// continuous; `ws.label` gets 1..n, returns n. Sizes in ws.sizes[1..n].
+int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentWorkspace& ws) {
+    const int W = x.W, H = x.H;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    std::fill(ws.label.begin(), ws.label.end(), 0);
+    ws.sizes.assign(1, 0);
+    int n = 0;
+    for (std::size_t seed = 0; seed < N; ++seed) {
+        if (!seedable[seed] || ws.label[seed]) continue;
+        const int id = ++n;
+        int head = 0, tail = 0;
+        ws.queue[tail++] = static_cast<int>(seed);
+        ws.label[seed] = id;
+        while (head < tail) {
+            const int p = ws.queue[head++];
+            const int u = p % W, v = p / W;
+            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
+                               v + 1 < H ? p + W : -1};
+            for (int q : nb) {
+                if (q < 0 || !seedable[q] || ws.label[q]) continue;
+                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
+                ws.label[q] = id;
+                ws.queue[tail++] = q;
+            }
+        }
+        ws.sizes.push_back(tail);
+    }
+    return n;
+}
+
+/// Grows the labelled pixels into unlabelled foreground (cut pixels, feet, pixels without a
+/// normal, dropped fragments) breadth-first, up to `max_steps`, where depth is continuous.
+std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps) {
+    const int W = x.W, H = x.H;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    int head = 0, tail = 0;
+    for (std::size_t p = 0; p < N; ++p) {
+        ws.dist[p] = ws.label[p] ? 0 : -1;
+        if (ws.label[p]) ws.queue[tail++] = static_cast<int>(p);
+    }
+    std::size_t added = 0;
+    while (head < tail) {
+        const int p = ws.queue[head++];
+        if (ws.dist[p] >= max_steps) continue;
+        const int u = p % W, v = p / W;
+        const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
+                           v + 1 < H ? p + W : -1};
+        for (int q : nb) {
+            if (q < 0 || ws.label[q] || x.cls[q] == kPlaneRemoved) continue;
+            if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
+            ws.label[q] = ws.label[p];
+            ws.dist[q] = ws.dist[p] + 1;
+            ws.queue[tail++] = q;
+            ++added;
+        }
+    }
+    return added;
+}
+
+/// Drops labels with fewer than min_points pixels and renumbers the rest 1..n in order of
+/// first appearance (raster order). Returns n.
+int compact(SegmentWorkspace& ws, int n, int min_points) {
+    ws.sizes.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (int l : ws.label) ++ws.sizes[static_cast<std::size_t>(l)];
+    ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
+    ws.remap[0] = 0;
+    int next = 0;
+    for (int& l : ws.label) {
+        if (l == 0) continue;
+        int& m = ws.remap[static_cast<std::size_t>(l)];
+        if (m < 0) m = ws.sizes[static_cast<std::size_t>(l)] >= min_points ? ++next : 0;
+        l = m;
+    }
+    return next;
+}
+
+/// The colour cue: tries to split each segment in two by 2-means under the paper's
+/// distance (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ
+/// in colour, are large, meet along a short boundary across a smooth surface.
+int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    const int W = x.W;
+    const std::size_t N = static_cast<std::size_t>(W) * x.H;
+    // Counting sort of the pixels by segment.
+    ws.offsets.assign(static_cast<std::size_t>(n) + 2, 0);
+    for (std::size_t p = 0; p < N; ++p) ++ws.offsets[static_cast<std::size_t>(ws.label[p]) + 1];
+    for (int l = 0; l <= n; ++l) ws.offsets[l + 1] += ws.offsets[l];
+    ws.order.resize(N);
+    ws.remap.assign(ws.offsets.begin(), ws.offsets.end());
+    for (std::size_t p = 0; p < N; ++p)
+        ws.order[static_cast<std::size_t>(ws.remap[static_cast<std::size_t>(ws.label[p])]++)] = static_cast<int>(p);
+    ws.part.assign(N, 0);
+
+    ClusterParams cp;
+    cp.alpha = prm.color_alpha;
+    cp.delta = 1.0f - prm.color_alpha;
+    const float a2 = cp.alpha * cp.alpha, d2 = cp.delta * cp.delta;
+    const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
+    const int s = prm.crease_step_px;
+    int splits = 0, next = n;
+    for (int l = 1; l <= n; ++l) {
+        const int* px = ws.order.data() + ws.offsets[l];
+        const int m = ws.offsets[l + 1] - ws.offsets[l];
+        if (m < 2 * prm.min_points) continue;
+        // Seeds: the pixel farthest in colour from the mean, then the one farthest from it.
+        double mr = 0, mg = 0, mb = 0;
+        for (int i = 0; i < m; ++i) {
+            mr += x.c.r[px[i]]; mg += x.c.g[px[i]]; mb += x.c.b[px[i]];
+        }
+        mr /= m; mg /= m; mb /= m;
+        auto farthest = [&](double r, double g, double b) {
+            int best = px[0];
+            double bd = -1;
+            for (int i = 0; i < m; ++i) {
+                const double dr = x.c.r[px[i]] - r, dg = x.c.g[px[i]] - g, db = x.c.b[px[i]] - b;
+                const double d = dr * dr + dg * dg + db * db;
+                if (d > bd) { bd = d; best = px[i]; }
+            }
+            return best;
+        };
+        const int a0 = farthest(mr, mg, mb);
+        const int b0 = farthest(x.c.r[a0], x.c.g[a0], x.c.b[a0]);
+        float cen[2][6] = {{x.c.x[a0], x.c.y[a0], x.c.z[a0], x.c.r[a0], x.c.g[a0], x.c.b[a0]},
+                           {x.c.x[b0], x.c.y[b0], x.c.z[b0], x.c.r[b0], x.c.g[b0], x.c.b[b0]}};
+        int count[2] = {0, 0};
+        for (int it = 0; it < 6; ++it) {
+            double sum[2][6] = {};
+            count[0] = count[1] = 0;
+            for (int i = 0; i < m; ++i) {
+                const int p = px[i];
+                float f[2];
+                for (int j = 0; j < 2; ++j) {
+                    const float dx = x.c.x[p] - cen[j][0], dy = x.c.y[p] - cen[j][1], dz = x.c.z[p] - cen[j][2];
+                    const float dr = x.c.r[p] - cen[j][3], dg = x.c.g[p] - cen[j][4], db = x.c.b[p] - cen[j][5];
+                    // Paper eq. (4); the normal term of eq. (6) is left out: both parts may
+                    // share a face.
+                    f[j] = std::sqrt(d2 * (dx * dx + dy * dy + dz * dz) + a2 * (dr * dr + dg * dg + db * db));
+                }
+                const int j = f[1] < f[0] ? 1 : 0;
+                ws.part[p] = static_cast<std::uint8_t>(j);
+                ++count[j];
+                sum[j][0] += x.c.x[p]; sum[j][1] += x.c.y[p]; sum[j][2] += x.c.z[p];
+                sum[j][3] += x.c.r[p]; sum[j][4] += x.c.g[p]; sum[j][5] += x.c.b[p];
+            }
+            if (count[0] == 0 || count[1] == 0) break;
+            for (int j = 0; j < 2; ++j)
+                for (int q = 0; q < 6; ++q) cen[j][q] = static_cast<float>(sum[j][q] / count[j]);
+        }
+        const int small = std::min(count[0], count[1]);
+        if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m)) continue;
+        const float dr = cen[0][3] - cen[1][3], dg = cen[0][4] - cen[1][4], db = cen[0][5] - cen[1][5];
+        if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
+        // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
+        // crease step away on either side tell a smooth surface from a fold.
+        int boundary = 0, with_normals = 0, smooth = 0;
+        for (int i = 0; i < m; ++i) {
+            const int p = px[i];
+            const int u = p % W, v = p / W;
+            const int dirs[2][2] = {{1, 0}, {0, 1}};
+            for (const auto& d : dirs) {
+                if (u + d[0] >= W || v + d[1] >= x.H) continue;
+                const int q = p + d[0] + d[1] * W;
+                if (ws.label[q] != l || ws.part[q] == ws.part[p]) continue;
+                ++boundary;
+                const int pu = u - s * d[0], pv = v - s * d[1];
+                const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
+                if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) continue;
+                const int a = pv * W + pu, b = qv * W + qu;
+                if (!x.n.valid[a] || !x.n.valid[b]) continue;
+                smooth += x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b] >= cos_crease;
+                ++with_normals;
+            }
+        }
+        if (static_cast<float>(boundary) > prm.color_max_boundary * std::sqrt(static_cast<float>(small))) continue;
+        // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
+        // straddle its edge).
+        if (with_normals == 0 || 10 * smooth < 7 * with_normals) continue;
+        const int id = ++next;
+        for (int i = 0; i < m; ++i)
+            if (ws.part[px[i]] == 1) ws.label[px[i]] = id;
+        ++splits;
+    }
+    return splits;
+}
+
+}  // namespace
+
+SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
+                             const NormalMap& normals, const std::vector<std::uint8_t>& classes,
+                             const LabelImage& clusters, SegmentWorkspace& ws, LabelImage& out) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t N = cloud.size();
+    const Ctx x{params, cloud, normals, classes, W, H};
+    ws.cut.resize(N);
+    ws.label.resize(N);
+    ws.queue.resize(N);
+    ws.dist.resize(N);
+    SegmentStats stats;
+
+    if (params.segmenter == Segmenter::Kmeans) {
+        // The paper's clusters on the object points: pixels are seedable, and a component
+        // never crosses a cluster boundary (the cut marks pixels whose right or lower
+        // neighbour lies in another cluster).
+        if (clusters.labels.size() != N)
+            throw InputError("segmentation: the kmeans segmenter needs the cluster labels of the frame");
+        for (std::size_t p = 0; p < N; ++p) ws.cut[p] = classes[p] == kPlaneObject;
+        // Components per cluster: run the BFS with a cluster check folded into `seedable`
+        // by labelling cluster by cluster is costly; instead split by marking boundaries.
+        for (int v = 0; v < H; ++v)
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                if (!ws.cut[p]) continue;
+                const auto l = clusters.labels[p];
+                if ((u + 1 < W && clusters.labels[p + 1] != l) ||
+                    (v + 1 < H && clusters.labels[p + static_cast<std::size_t>(W)] != l))
+                    ws.cut[p] = 0;
+            }
+    } else {
+        // Seedable pixels: object points with a normal that sit on no concave crease. First
+        // each pixel tests the pair (p, p + s) along u and v; then a pixel is on a crease
+        // when any pair spanning it is concave (two passes: no two threads write one byte).
+        const int s = params.crease_step_px;
+        ws.crease.resize(N);
+#pragma omp parallel for schedule(static)
+        for (int v = 0; v < H; ++v) {
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                std::uint8_t bits = 0;
+                if (classes[p] == kPlaneObject && normals.valid[p]) {
+                    const std::size_t qs[2] = {u + s < W ? p + s : p,
+                                               v + s < H ? p + static_cast<std::size_t>(s) * W : p};
+                    for (int k = 0; k < 2; ++k) {
+                        const std::size_t q = qs[k];
+                        if (q == p || classes[q] != kPlaneObject || !normals.valid[q]) continue;
+                        if (!x.connected(p, q, static_cast<float>(s))) continue;
+                        if (x.concavity(p, q) > params.concavity) bits |= static_cast<std::uint8_t>(1 << k);
+                    }
+                }
+                ws.crease[p] = bits;
+            }
+        }
+#pragma omp parallel for schedule(static)
+        for (int v = 0; v < H; ++v) {
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                bool seed = classes[p] == kPlaneObject && normals.valid[p];
+                for (int k = 0; k <= s && seed; ++k) {
+                    if (u - k >= 0 && (ws.crease[p - k] & 1)) seed = false;
+                    if (v - k >= 0 && (ws.crease[p - static_cast<std::size_t>(k) * W] & 2)) seed = false;
+                }
+                ws.cut[p] = seed;
+            }
+        }
+    }
+    // ws.cut now holds "seedable"; components of it.
+    std::vector<std::uint8_t>& seedable = ws.cut;
+    int n = components(x, seedable, ws);
+    // Fragments too small to seed an object go back to the unassigned pool.
+    for (std::size_t p = 0; p < N; ++p)
+        if (ws.label[p] && ws.sizes[static_cast<std::size_t>(ws.label[p])] < params.min_seed_points)
+            ws.label[p] = 0;
+    stats.reattached = reattach(x, ws, params.reattach_px);
+    n = compact(ws, n, 1);
+    if (params.segmenter == Segmenter::Hybrid) {
+        stats.color_splits = color_splits(x, ws, n);
+        n += stats.color_splits;
+    }
+    n = compact(ws, n, params.min_points);
+    stats.segments = n;
+
+    out.width = W;
+    out.height = H;
+    out.labels.resize(N);
+    for (std::size_t p = 0; p < N; ++p) out.labels[p] = static_cast<std::uint16_t>(std::min(ws.label[p], 65535));
+    return stats;
+}
+
+}  // namespace wul3d

@@ -1,0 +1,170 @@
+#include "wul3d/plane.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "synthetic_scene.hpp"
+#include "test_support.hpp"
+#include "wul3d/background.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+
+using namespace wul3d;
+using namespace wul3d::test;
+
+namespace {
+struct Prepared {
+    RgbdFrame frame;
+    OrganizedCloud cloud;
+    NormalMap normals;
+    std::vector<std::uint8_t> active;
+};
+
+void prepare(Prepared& f) {
+    back_project(f.frame, f.cloud);
+    estimate_normals(NormalParams{}, f.cloud, f.normals);
+    select_depth_range(DepthRange{}, f.cloud, f.active);
+}
+}  // namespace
+
+TEST(PlaneParams, Validate_RejectsOutOfRangeFields) {
+    PlaneParams p;
+    EXPECT_NO_THROW(p.validate());
+    p.on_plane_m = 0;
+    EXPECT_THROW(p.validate(), ParamError);
+    p = PlaneParams{};
+    p.grid_stride_px = 0;
+    EXPECT_THROW(p.validate(), ParamError);
+    p = PlaneParams{};
+    p.min_up = 2;
+    EXPECT_THROW(p.validate(), ParamError);
+}
+
+// A camera pitched down 35 degrees over a table with two boxes and a back wall: the
+// support is the table (not the wall, which faces the camera), its normal is the table's,
+// the table goes and the boxes stay, their feet included.
+TEST(RemoveSupportPlane, TiltedTable_RemovesTableKeepsBoxesAndTheirFeet) {
+    Scene s;
+    s.width = 320;
+    s.height = 240;
+    s.pitch_rad = 35.0f * 3.14159265f / 180.0f;
+    s.table_y = 0.6f;
+    s.table_near = 0.4f;
+    s.table_far = 1.6f;
+    s.wall = true;
+    SceneBox a;
+    a.x = -0.15f;
+    a.z = 0.9f;
+    SceneBox b = a;
+    b.x = 0.2f;
+    b.z = 1.1f;
+    b.r = 30; b.g = 60; b.b = 220;
+    s.boxes = {a, b};
+    std::vector<int> truth;
+    Prepared f;
+    f.frame = render_scene(s, &truth);
+    prepare(f);
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
+                                               f.normals, f.active, ws, classes);
+    ASSERT_TRUE(r.found);
+    // The table's normal in the camera frame: up in the scene is -y; the camera pitched down
+    // by theta sees it as (0, -cos theta, -sin theta).
+    EXPECT_NEAR(r.support.nx, 0.0f, 0.02f);
+    EXPECT_NEAR(r.support.ny, -std::cos(s.pitch_rad), 0.02f);
+    EXPECT_NEAR(r.support.nz, -std::sin(s.pitch_rad), 0.02f);
+    std::size_t table = 0, table_kept = 0, wall = 0, wall_kept = 0;
+    std::size_t box[2] = {0, 0}, box_kept[2] = {0, 0};
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        const bool kept = classes[p] != kPlaneRemoved;
+        if (truth[p] == kTruthTable) { ++table; table_kept += kept; }
+        if (truth[p] == kTruthWall) { ++wall; wall_kept += kept; }
+        for (int i = 0; i < 2; ++i)
+            if (truth[p] == kTruthBox0 + i) { ++box[i]; box_kept[i] += kept; }
+    }
+    ASSERT_GT(table, 10000u);
+    EXPECT_LT(static_cast<double>(table_kept) / static_cast<double>(table), 0.005);
+    // The wall stands off the table's extent: not an object on it.
+    if (wall > 0) {
+        EXPECT_LT(static_cast<double>(wall_kept) / static_cast<double>(wall), 0.02);
+    }
+    for (int i = 0; i < 2; ++i) {
+        ASSERT_GT(box[i], 500u);
+        EXPECT_GT(static_cast<double>(box_kept[i]) / static_cast<double>(box[i]), 0.97) << "box " << i;
+    }
+}
+
+TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
+    // Only a wall in view: nothing faces up, so there is no support.
+    Scene s;
+    s.wall = true;
+    s.table_half_width = 0.0f;
+    Prepared f;
+    f.frame = render_scene(s);
+    prepare(f);
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
+                                               f.normals, f.active, ws, classes);
+    EXPECT_FALSE(r.found);
+    std::size_t active = 0;
+    for (auto a : f.active) active += a;
+    EXPECT_EQ(r.kept, active);
+}
+
+// Real uncropped tabletop frames (data/samples/uois_tabletop, MIT): floor, walls, chairs
+// and other furniture are in view. The support must be the table under the objects: a
+// patch of that table, picked by eye in each frame, is removed and the support's normal is
+// the patch's; objects remain, and the room (floor, walls) does not.
+TEST(RemoveSupportPlane, RealUncroppedTabletops_ChoosesTheTableUnderTheObjects) {
+    struct TablePatch {
+        const char* frame;
+        int u, v;
+    };
+    const TablePatch patches[] = {{"image_0000", 320, 455}, {"image_0002", 320, 440},
+                                  {"image_0005", 300, 250}, {"image_0007", 330, 380}};
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    ASSERT_EQ(source->size(), 4u);
+    SourceItem item;
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    for (std::size_t i = 0; i < source->size(); ++i) {
+        source->read(i, item);
+        SCOPED_TRACE(item.frame.name);
+        ASSERT_EQ(item.frame.name, patches[i].frame);
+        Prepared f;
+        f.frame = item.frame;
+        prepare(f);
+        const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
+                                                   f.normals, f.active, ws, classes);
+        ASSERT_TRUE(r.found);
+        EXPECT_GT(r.support.up, 0.5f);
+        const int W = f.cloud.width;
+        std::size_t patch = 0, removed = 0;
+        double mx = 0, my = 0, mz = 0;
+        for (int v = patches[i].v - 10; v <= patches[i].v + 10; ++v)
+            for (int u = patches[i].u - 10; u <= patches[i].u + 10; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                if (!f.active[p] || !f.normals.valid[p]) continue;
+                ++patch;
+                removed += classes[p] == kPlaneRemoved;
+                mx += f.normals.nx[p];
+                my += f.normals.ny[p];
+                mz += f.normals.nz[p];
+            }
+        ASSERT_GT(patch, 300u);
+        EXPECT_GT(static_cast<double>(removed) / static_cast<double>(patch), 0.95);
+        const double len = std::sqrt(mx * mx + my * my + mz * mz);
+        const double cos_angle = (mx * r.support.nx + my * r.support.ny + mz * r.support.nz) / len;
+        EXPECT_GT(cos_angle, std::cos(8.0 * 3.14159265 / 180.0));
+        std::size_t kept = 0, active = 0;
+        for (std::size_t p = 0; p < classes.size(); ++p) {
+            active += f.active[p];
+            kept += classes[p] != kPlaneRemoved;
+        }
+        EXPECT_GT(kept, 5000u);
+        EXPECT_LT(static_cast<double>(kept) / static_cast<double>(active), 0.45);
+    }
+}

@@ -1,0 +1,135 @@
+#include "wul3d/segmentation.hpp"
+
+#include <gtest/gtest.h>
+
+#include "synthetic_scene.hpp"
+#include "wul3d/background.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/plane.hpp"
+
+using namespace wul3d;
+using namespace wul3d::test;
+
+namespace {
+/// Renders `s` and runs normals, depth range, support-plane removal and segmentation.
+LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
+                   SegmentStats* stats = nullptr) {
+    const RgbdFrame f = render_scene(s, &truth);
+    OrganizedCloud cloud;
+    NormalMap normals;
+    std::vector<std::uint8_t> active, classes;
+    back_project(f, cloud);
+    estimate_normals(NormalParams{}, cloud, normals);
+    select_depth_range(DepthRange{}, cloud, active);
+    PlaneWorkspace pws;
+    const PlaneResult plane =
+        remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
+    EXPECT_TRUE(plane.found);
+    SegmentParams params;
+    params.segmenter = segmenter;
+    SegmentWorkspace ws;
+    LabelImage out;
+    const SegmentStats st = segment_objects(params, cloud, normals, classes, LabelImage{}, ws, out);
+    if (stats) *stats = st;
+    return out;
+}
+
+Scene pitched_scene() {
+    Scene s;
+    s.width = 320;
+    s.height = 240;
+    s.pitch_rad = 0.5f;
+    s.table_y = 0.6f;
+    s.table_near = 0.4f;
+    s.table_far = 1.6f;
+    return s;
+}
+}  // namespace
+
+TEST(SegmentParams, Validate_NamesTheFlag) {
+    SegmentParams p;
+    EXPECT_NO_THROW(p.validate());
+    p.min_points = 0;
+    try {
+        p.validate();
+        FAIL() << "no throw";
+    } catch (const ParamError& e) {
+        EXPECT_NE(std::string(e.what()).find("--min-points"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parse_segmenter("watershed"), ParamError);
+    EXPECT_EQ(parse_segmenter("kmeans"), Segmenter::Kmeans);
+    EXPECT_STREQ(segmenter_name(Segmenter::Hybrid), "hybrid");
+}
+
+// Two boxes of one colour, the small one standing in front of the tall one and touching
+// it: their surfaces meet at a concave junction, which is cut.
+TEST(SegmentObjects, TouchingSameColourBoxes_SeparatedAtTheConcaveJunction) {
+    Scene s = pitched_scene();
+    SceneBox tall;
+    tall.x = 0.05f;
+    tall.z = 1.0f;
+    tall.w = 0.2f;
+    tall.h = 0.25f;
+    tall.d = 0.1f;
+    SceneBox small = tall;  // same colour
+    small.x = 0.0f;
+    small.z = 0.9f;  // its back face touches the tall box's front face (z = 0.95)
+    small.w = 0.12f;
+    small.h = 0.1f;
+    small.d = 0.1f;
+    s.boxes = {tall, small};
+    std::vector<int> truth;
+    const LabelImage out = segment(s, Segmenter::Geometric, truth);
+    int a = 0, b = 0;
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(b, 0);
+    EXPECT_NE(a, b) << "the two boxes were merged";
+}
+
+// Two boxes side by side, flush: front and top faces coplanar and touching. Geometry cannot
+// tell them apart; the colour cue (hybrid) can, because they differ in colour and meet along
+// a straight boundary across a flat surface.
+TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
+    Scene s = pitched_scene();
+    s.noise_seed = 7;
+    SceneBox red;
+    red.x = -0.075f;
+    red.z = 1.0f;
+    SceneBox blue = red;
+    blue.x = 0.075f;
+    blue.r = 30;
+    blue.g = 60;
+    blue.b = 220;
+    s.boxes = {red, blue};
+    std::vector<int> truth;
+    int a = 0, b = 0;
+    const LabelImage geo = segment(s, Segmenter::Geometric, truth);
+    dominant_share(geo.labels, truth, kTruthBox0, &a);
+    dominant_share(geo.labels, truth, kTruthBox0 + 1, &b);
+    EXPECT_EQ(a, b) << "geometry alone should not separate flush boxes (test premise)";
+
+    SegmentStats stats;
+    const LabelImage hyb = segment(s, Segmenter::Hybrid, truth, &stats);
+    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(a, b) << "the colour cue did not split the flush boxes";
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
+// The colour cue leaves a box alone whose faces differ in shade: the colour boundary runs
+// along a convex edge, not across a flat surface.
+TEST(SegmentObjects, ColourCue_DoesNotSplitOneBox) {
+    Scene s = pitched_scene();
+    SceneBox box;
+    box.z = 1.0f;
+    s.boxes = {box};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0), 0.95);
+    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.segments, 1);
+}
