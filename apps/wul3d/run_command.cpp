@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "pipeline_options.hpp"
 #include "video_writer.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
@@ -31,99 +32,13 @@ namespace fs = std::filesystem;
 namespace {
 
 struct RunOptions {
-    std::string input;
+    PipelineOptions pipeline;    // input and parameters, shared with `wul3d view`
     std::string out_dir;
-    std::string format = "auto";
-    std::string preset;
-    std::string tum_camera;
-    std::string intrinsics;
-    std::string calibration;
-    std::string registration = "depth-to-color";
-    std::string select;
-    std::string video;  // --video FILE: side-by-side video (video_writer.hpp)
-    std::string segmenter;
-    bool no_plane = false;
-    std::optional<int> min_points;
-    std::optional<float> object_psi;
+    std::string video;           // --video FILE: side-by-side video (video_writer.hpp)
     std::size_t max_frames = 0;  // 0 = all
-    int threads = 0;             // 0 = all cores
     bool ply = false;
     bool quiet = false;
-    // Parameters given on the command line override the preset; kept apart so we know.
-    std::optional<int> k, iters, stride, normal_radius;
-    std::optional<float> alpha, delta, gamma, psi, zmin, zmax;
-    std::optional<std::uint64_t> seed;
 };
-
-/// Splits "a,b,c" into numbers; throws ParamError naming the flag.
-std::vector<double> parse_list(const std::string& flag, const std::string& text,
-                               std::size_t expected) {
-    std::vector<double> values;
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        try {
-            std::size_t used = 0;
-            values.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw ParamError(flag + " '" + text + "': '" + item + "' is not a number");
-        }
-    }
-    if (values.size() != expected)
-        throw ParamError(flag + " '" + text + "': expected " + std::to_string(expected) +
-                         " comma-separated numbers");
-    return values;
-}
-
-PipelineParams make_params(const RunOptions& o) {
-    PipelineParams p;
-    if (o.preset == "paper") {
-        p = PipelineParams::paper();
-    } else if (!o.preset.empty()) {
-        throw ParamError("--preset '" + o.preset + "': unknown (known: paper)");
-    }
-    if (o.k) p.cluster.k = *o.k;
-    if (o.alpha) {
-        p.cluster.alpha = *o.alpha;
-        if (!o.delta) p.cluster.delta = 1.0f - *o.alpha;  // eq. (5) at equality, as the paper
-    }
-    if (o.delta) p.cluster.delta = *o.delta;
-    if (o.gamma) p.cluster.gamma = *o.gamma;
-    if (o.psi) p.cluster.psi = *o.psi;
-    if (o.iters) p.cluster.iters = *o.iters;
-    if (o.stride) p.cluster.stride = *o.stride;
-    if (o.seed) p.cluster.seed = *o.seed;
-    if (o.zmin) p.range.zmin_m = *o.zmin;
-    if (o.zmax) p.range.zmax_m = *o.zmax;
-    if (o.normal_radius) p.normals.radius_px = *o.normal_radius;
-    if (!o.segmenter.empty()) p.segmentation.segmenter = parse_segmenter(o.segmenter);
-    if (o.no_plane) p.remove_plane = false;
-    if (o.min_points) p.segmentation.min_points = *o.min_points;
-    if (o.object_psi) p.objects.psi = *o.object_psi;
-    p.validate();
-    return p;
-}
-
-SourceOptions make_source_options(const RunOptions& o) {
-    SourceOptions s;
-    s.format = parse_input_format(o.format);
-    s.tum_camera = o.tum_camera;
-    s.calibration = o.calibration;
-    s.registration = parse_registration_mode(o.registration);
-    if (!o.intrinsics.empty()) {
-        const auto v = parse_list("--intrinsics", o.intrinsics, 4);
-        PinholeIntrinsics K;  // width and height come from each frame
-        K.fx = v[0];
-        K.fy = v[1];
-        K.cx = v[2];
-        K.cy = v[3];
-        if (!(K.fx > 0 && K.fy > 0))
-            throw ParamError("--intrinsics '" + o.intrinsics + "': fx and fy must be > 0");
-        s.intrinsics = K;
-    }
-    return s;
-}
 
 double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
@@ -223,17 +138,16 @@ void write_frame(const fs::path& out_dir, const std::string& name, const Pipelin
 }
 
 void run(const RunOptions& o) {
-    const PipelineParams params = make_params(o);
-    const SourceOptions source_options = make_source_options(o);
+    const PipelineParams params = make_pipeline_params(o.pipeline);
+    const SourceOptions source_options = make_source_options(o.pipeline);
     std::optional<SelectedObject> selection, selected_object;
-    if (!o.select.empty()) {
-        const auto uv = parse_list("--select", o.select, 2);
-        selection.emplace(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
-        selected_object.emplace(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
+    if (const auto uv = selected_pixel(o.pipeline)) {
+        selection.emplace(uv->first, uv->second);
+        selected_object.emplace(uv->first, uv->second);
     }
-    if (o.threads > 0) omp_set_num_threads(o.threads);
+    apply_threads(o.pipeline);
 
-    auto source = open_source(o.input, source_options);
+    auto source = open_source(o.pipeline.input, source_options);
     const std::size_t n_frames =
         o.max_frames ? std::min(o.max_frames, source->size()) : source->size();
 
@@ -331,7 +245,7 @@ void run(const RunOptions& o) {
         std::chrono::duration<double>(Clock::now() - run_start).count();
     const auto& c = params.cluster;
     nlohmann::json summary;
-    summary["input"] = o.input;
+    summary["input"] = o.pipeline.input;
     summary["format"] = input_format_name(source->format());
     summary["parameters"] = {{"k", c.k},
                              {"alpha", c.alpha},
@@ -348,7 +262,7 @@ void run(const RunOptions& o) {
                              {"remove_plane", params.remove_plane},
                              {"min_points", params.segmentation.min_points},
                              {"object_psi", params.objects.psi},
-                             {"preset", o.preset.empty() ? "default" : o.preset}};
+                             {"preset", o.pipeline.preset.empty() ? "default" : o.pipeline.preset}};
     summary["frames"] = n_frames;
     summary["threads"] = omp_get_max_threads();
     nlohmann::json medians;
@@ -373,47 +287,14 @@ void run(const RunOptions& o) {
 void add_run_command(CLI::App& app) {
     auto opts = std::make_shared<RunOptions>();
     CLI::App* cmd = app.add_subcommand("run", "Detect objects in an RGB-D recording");
-    cmd->add_option("input", opts->input,
-                    "Frame folder(s), TUM RGB-D sequence, or unregistered frames")
-        ->required();
+    add_pipeline_options(cmd, opts->pipeline);
     cmd->add_option("-o,--out", opts->out_dir, "Output folder")->required();
-    cmd->add_option("--format", opts->format, "auto|frames|tum|unregistered")
-        ->capture_default_str();
-    cmd->add_option("--preset", opts->preset, "paper: the paper's parameters");
-    cmd->add_option("--k", opts->k, "Number of clusters (default 7)");
-    cmd->add_option("--alpha", opts->alpha, "Colour scale, eq. 4, [0.002, 0.1] (default 0.0033)");
-    cmd->add_option("--delta", opts->delta, "Position scale, eq. 4, alpha + delta <= 1 (default 1 - alpha)");
-    cmd->add_option("--gamma", opts->gamma, "Normal scale, eq. 6, [0.0001, 0.01] (default 0.0001)");
-    cmd->add_option("--psi", opts->psi, "Weight increment, eq. 2, (0, 1] (default 1)");
-    cmd->add_option("--iters", opts->iters, "k-means iterations per frame (default 1)");
-    cmd->add_option("--stride", opts->stride, "Sampling stride in pixels (default 1)");
-    cmd->add_option("--seed", opts->seed, "k-means++ seed (default 1)");
-    cmd->add_option("--zmin", opts->zmin, "Nearest depth kept, metres (default 0.2)");
-    cmd->add_option("--zmax", opts->zmax, "Farthest depth kept, metres (default 4.5)");
-    cmd->add_option("--normal-radius", opts->normal_radius, "Normal neighbour distance, px (default 2)");
-    cmd->add_option("--select", opts->select, "U,V: follow the object under this pixel of the first frame");
-    cmd->add_option("--segmenter", opts->segmenter,
-                    "Object segmentation: geometric|kmeans|hybrid (default hybrid)");
-    cmd->add_flag("--no-plane", opts->no_plane,
-                  "Keep the support plane (the paper's background step: depth range only)");
-    cmd->add_option("--min-points", opts->min_points, "Smallest object, pixels (default 300)");
-    cmd->add_option("--object-psi", opts->object_psi,
-                    "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
     cmd->add_option("--frames", opts->max_frames, "Stop after N frames (default: all)")
-        ->check(CLI::Range(1, 1 << 30));
-    cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_option("--video", opts->video,
                     "Also write a video: colour | clusters | selected object (e.g. out.mp4)");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
-    cmd->add_option("--tum-camera", opts->tum_camera,
-                    "TUM intrinsics preset: kinect_v1|tum_fr1|tum_fr2|tum_fr3 (default: from folder name)");
-    cmd->add_option("--intrinsics", opts->intrinsics, "fx,fy,cx,cy: override every frame's intrinsics");
-    cmd->add_option("--calibration", opts->calibration,
-                    "Unregistered input: calibration JSON, or kinect_v2 for the built-in preset");
-    cmd->add_option("--registration", opts->registration, "depth-to-color|color-to-depth")
-        ->capture_default_str();
     cmd->callback([opts]() { run(*opts); });
 }
 

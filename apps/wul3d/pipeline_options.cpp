@@ -1,0 +1,126 @@
+#include "pipeline_options.hpp"
+
+#include <omp.h>
+
+#include <sstream>
+
+#include "wul3d/error.hpp"
+#include "wul3d/segmentation.hpp"
+
+namespace wul3d::cli {
+
+std::vector<double> parse_numbers(const std::string& flag, const std::string& text,
+                                  std::size_t expected) {
+    std::vector<double> values;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            std::size_t used = 0;
+            values.push_back(std::stod(item, &used));
+            if (used != item.size()) throw std::invalid_argument(item);
+        } catch (const std::exception&) {
+            throw ParamError(flag + " '" + text + "': '" + item + "' is not a number");
+        }
+    }
+    if (values.size() != expected)
+        throw ParamError(flag + " '" + text + "': expected " + std::to_string(expected) +
+                         " comma-separated numbers");
+    return values;
+}
+
+void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
+    cmd->add_option("input", o.input, "Frame folder(s), TUM RGB-D sequence, or unregistered frames")
+        ->required();
+    cmd->add_option("--format", o.format, "auto|frames|tum|unregistered")->capture_default_str();
+    cmd->add_option("--preset", o.preset, "paper: the paper's parameters");
+    cmd->add_option("--k", o.k, "Number of clusters (default 7)");
+    cmd->add_option("--alpha", o.alpha, "Colour scale, eq. 4, [0.002, 0.1] (default 0.0033)");
+    cmd->add_option("--delta", o.delta, "Position scale, eq. 4, alpha + delta <= 1 (default 1 - alpha)");
+    cmd->add_option("--gamma", o.gamma, "Normal scale, eq. 6, [0.0001, 0.01] (default 0.0001)");
+    cmd->add_option("--psi", o.psi, "Weight increment, eq. 2, (0, 1] (default 1)");
+    cmd->add_option("--iters", o.iters, "k-means iterations per frame (default 1)");
+    cmd->add_option("--stride", o.stride, "Sampling stride in pixels (default 1)");
+    cmd->add_option("--seed", o.seed, "k-means++ seed (default 1)");
+    cmd->add_option("--zmin", o.zmin, "Nearest depth kept, metres (default 0.2)");
+    cmd->add_option("--zmax", o.zmax, "Farthest depth kept, metres (default 4.5)");
+    cmd->add_option("--normal-radius", o.normal_radius, "Normal neighbour distance, px (default 2)");
+    cmd->add_option("--select", o.select, "U,V: follow the object under this pixel of the first frame");
+    cmd->add_option("--segmenter", o.segmenter,
+                    "Object segmentation: geometric|kmeans|hybrid (default hybrid)");
+    cmd->add_flag("--no-plane", o.no_plane,
+                  "Keep the support plane (the paper's background step: depth range only)");
+    cmd->add_option("--min-points", o.min_points, "Smallest object, pixels (default 300)");
+    cmd->add_option("--object-psi", o.object_psi,
+                    "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
+    cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)")
+        ->check(CLI::Range(1, 1 << 30));
+    cmd->add_option("--tum-camera", o.tum_camera,
+                    "TUM intrinsics preset: kinect_v1|tum_fr1|tum_fr2|tum_fr3 (default: from folder name)");
+    cmd->add_option("--intrinsics", o.intrinsics, "fx,fy,cx,cy: override every frame's intrinsics");
+    cmd->add_option("--calibration", o.calibration,
+                    "Unregistered input: calibration JSON, or kinect_v2 for the built-in preset");
+    cmd->add_option("--registration", o.registration, "depth-to-color|color-to-depth")
+        ->capture_default_str();
+}
+
+PipelineParams make_pipeline_params(const PipelineOptions& o) {
+    PipelineParams p;
+    if (o.preset == "paper") {
+        p = PipelineParams::paper();
+    } else if (!o.preset.empty()) {
+        throw ParamError("--preset '" + o.preset + "': unknown (known: paper)");
+    }
+    if (o.k) p.cluster.k = *o.k;
+    if (o.alpha) {
+        p.cluster.alpha = *o.alpha;
+        if (!o.delta) p.cluster.delta = 1.0f - *o.alpha;  // eq. (5) at equality, as the paper
+    }
+    if (o.delta) p.cluster.delta = *o.delta;
+    if (o.gamma) p.cluster.gamma = *o.gamma;
+    if (o.psi) p.cluster.psi = *o.psi;
+    if (o.iters) p.cluster.iters = *o.iters;
+    if (o.stride) p.cluster.stride = *o.stride;
+    if (o.seed) p.cluster.seed = *o.seed;
+    if (o.zmin) p.range.zmin_m = *o.zmin;
+    if (o.zmax) p.range.zmax_m = *o.zmax;
+    if (o.normal_radius) p.normals.radius_px = *o.normal_radius;
+    if (!o.segmenter.empty()) p.segmentation.segmenter = parse_segmenter(o.segmenter);
+    if (o.no_plane) p.remove_plane = false;
+    if (o.min_points) p.segmentation.min_points = *o.min_points;
+    if (o.object_psi) p.objects.psi = *o.object_psi;
+    p.validate();
+    return p;
+}
+
+SourceOptions make_source_options(const PipelineOptions& o) {
+    SourceOptions s;
+    s.format = parse_input_format(o.format);
+    s.tum_camera = o.tum_camera;
+    s.calibration = o.calibration;
+    s.registration = parse_registration_mode(o.registration);
+    if (!o.intrinsics.empty()) {
+        const auto v = parse_numbers("--intrinsics", o.intrinsics, 4);
+        if (!(v[0] > 0 && v[1] > 0))
+            throw ParamError("--intrinsics '" + o.intrinsics + "': fx and fy must be > 0");
+        PinholeIntrinsics K;  // width and height 0: each frame's own size
+        K.fx = v[0];
+        K.fy = v[1];
+        K.cx = v[2];
+        K.cy = v[3];
+        s.intrinsics = K;
+    }
+    return s;
+}
+
+std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o) {
+    if (o.select.empty()) return std::nullopt;
+    const auto uv = parse_numbers("--select", o.select, 2);
+    return std::make_pair(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
+}
+
+void apply_threads(const PipelineOptions& o) {
+    if (o.threads > 0) omp_set_num_threads(o.threads);
+}
+
+}  // namespace wul3d::cli

@@ -1,0 +1,50 @@
+#pragma once
+// The options that `wul3d run` and `wul3d view` share: the input and the pipeline's
+// parameters. One place registers them on a subcommand and turns them into library structs,
+// so the two commands cannot drift apart.
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "wul3d/io.hpp"
+#include "wul3d/pipeline.hpp"
+
+namespace wul3d::cli {
+
+struct PipelineOptions {
+    std::string input;
+    std::string format = "auto";
+    std::string preset;
+    std::string tum_camera;
+    std::string intrinsics;
+    std::string calibration;
+    std::string registration = "depth-to-color";
+    std::string select;
+    std::string segmenter;
+    bool no_plane = false;
+    int threads = 0;  // 0 = all cores
+    // Parameters given on the command line override the preset; kept apart so we know.
+    std::optional<int> k, iters, stride, normal_radius, min_points;
+    std::optional<float> alpha, delta, gamma, psi, zmin, zmax, object_psi;
+    std::optional<std::uint64_t> seed;
+};
+
+/// Registers the input positional and every shared option on `cmd`.
+void add_pipeline_options(CLI::App* cmd, PipelineOptions& o);
+
+/// The preset, then every parameter given; validated (ParamError names the flag's field).
+PipelineParams make_pipeline_params(const PipelineOptions& o);
+SourceOptions make_source_options(const PipelineOptions& o);
+/// --select U,V, if given.
+std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o);
+/// Applies --threads.
+void apply_threads(const PipelineOptions& o);
+
+/// Splits "a,b,c" into exactly `expected` numbers; throws ParamError naming the flag.
+std::vector<double> parse_numbers(const std::string& flag, const std::string& text,
+                                  std::size_t expected);
+
+}  // namespace wul3d::cli
