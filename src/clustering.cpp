@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "param_check.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -25,10 +26,7 @@ ClusterParams ClusterParams::paper() {
 namespace {
 template <class T>
 void require(bool ok, const char* name, T value, const char* range) {
-    if (ok) return;
-    std::ostringstream msg;
-    msg << name << " = " << value << ": must be " << range;
-    throw ParamError(msg.str());
+    detail::require_param(ok, "", name, value, range);
 }
 }  // namespace
 

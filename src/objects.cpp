@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "param_check.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -75,10 +76,7 @@ namespace wul3d {
 namespace {
 template <class T>
 void require(bool ok, const char* name, T value, const char* range) {
-    if (ok) return;
-    std::ostringstream msg;
-    msg << "ObjectParams." << name << " = " << value << ": must be " << range;
-    throw ParamError(msg.str());
+    detail::require_param(ok, "ObjectParams", name, value, range);
 }
 // Per-segment sums: count, x, y, z.
 constexpr int kSegSums = 4;

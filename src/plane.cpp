@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "param_check.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -14,10 +15,7 @@ namespace wul3d {
 namespace {
 template <class T>
 void require(bool ok, const char* name, T value, const char* range) {
-    if (ok) return;
-    std::ostringstream msg;
-    msg << "PlaneParams." << name << " = " << value << ": must be " << range;
-    throw ParamError(msg.str());
+    detail::require_param(ok, "PlaneParams", name, value, range);
 }
 constexpr float kDegToRad = 3.14159265358979f / 180.0f;
 // Per-region sums: count, x, y, z, xx, xy, xz, yy, yz, zz, nx, ny, nz.

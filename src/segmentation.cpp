@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "param_check.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/plane.hpp"
 
@@ -28,10 +29,7 @@ const char* segmenter_name(Segmenter s) {
 namespace {
 template <class T>
 void require(bool ok, const char* name, T value, const char* range) {
-    if (ok) return;
-    std::ostringstream msg;
-    msg << "SegmentParams." << name << " = " << value << ": must be " << range;
-    throw ParamError(msg.str());
+    detail::require_param(ok, "SegmentParams", name, value, range);
 }
 constexpr float kDegToRad = 3.14159265358979f / 180.0f;
 }  // namespace
