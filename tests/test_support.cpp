@@ -43,26 +43,31 @@ std::string slurp(const fs::path& p) {
 }
 }  // namespace
 
-CommandResult run_cli(const std::vector<std::string>& args) {
+CommandResult run_command(const std::vector<std::string>& args,
+                          const std::vector<EnvChange>& env) {
     TempDir io;
     const fs::path out_path = io / "stdout", err_path = io / "stderr";
     CommandResult result;
     const pid_t pid = ::fork();
     if (pid < 0) throw std::runtime_error("fork failed");
     if (pid == 0) {
+        for (const auto& [name, value] : env) {
+            if (value)
+                ::setenv(name.c_str(), value->c_str(), 1);
+            else
+                ::unsetenv(name.c_str());
+        }
         const int in = ::open("/dev/null", O_RDONLY);
         const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         ::dup2(in, 0);
         ::dup2(out, 1);
         ::dup2(err, 2);
-        std::vector<std::string> argv_s;
-        argv_s.push_back(cli_path().string());
-        argv_s.insert(argv_s.end(), args.begin(), args.end());
+        std::vector<std::string> copy = args;
         std::vector<char*> argv;
-        for (auto& s : argv_s) argv.push_back(s.data());
+        for (auto& s : copy) argv.push_back(s.data());
         argv.push_back(nullptr);
-        ::execv(argv[0], argv.data());
+        ::execvp(argv[0], argv.data());
         ::_exit(127);
     }
     int status = 0;
@@ -71,6 +76,12 @@ CommandResult run_cli(const std::vector<std::string>& args) {
     result.out = slurp(out_path);
     result.err = slurp(err_path);
     return result;
+}
+
+CommandResult run_cli(const std::vector<std::string>& args) {
+    std::vector<std::string> argv = {cli_path().string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv);
 }
 
 std::vector<std::string> list_files(const fs::path& dir) {

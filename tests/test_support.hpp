@@ -2,7 +2,9 @@
 // Shared helpers of the test suite: where the shipped samples are, temporary folders, and
 // running the wul3d command.
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace wul3d::test {
@@ -31,6 +33,13 @@ struct CommandResult {
     std::string out;  ///< stdout
     std::string err;  ///< stderr
 };
+
+/// An environment change for run_command: set to a value, or unset (nullopt).
+using EnvChange = std::pair<std::string, std::optional<std::string>>;
+
+/// Runs argv[0] (looked up in PATH) with `args`, stdin from /dev/null, `env` applied.
+CommandResult run_command(const std::vector<std::string>& argv,
+                          const std::vector<EnvChange>& env = {});
 
 /// Runs the wul3d command with `args` (no shell quoting needed), stdin from /dev/null.
 CommandResult run_cli(const std::vector<std::string>& args);

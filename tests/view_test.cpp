@@ -38,48 +38,10 @@ using wul3d::test::cli_path;
 using wul3d::test::sample_dir;
 using wul3d::test::TempDir;
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// Runs argv[0] (looked up in PATH) with `env` set (a value) or unset (nullopt).
-CommandResult run_with_env(
-    const std::vector<std::string>& args,
-    const std::vector<std::pair<std::string, std::optional<std::string>>>& env) {
-    TempDir io;
-    const fs::path out_path = io / "stdout", err_path = io / "stderr";
-    const pid_t pid = ::fork();
-    if (pid < 0) throw std::runtime_error("fork failed");
-    if (pid == 0) {
-        for (const auto& [name, value] : env) {
-            if (value)
-                ::setenv(name.c_str(), value->c_str(), 1);
-            else
-                ::unsetenv(name.c_str());
-        }
-        const int in = ::open("/dev/null", O_RDONLY);
-        const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        ::dup2(in, 0);
-        ::dup2(out, 1);
-        ::dup2(err, 2);
-        std::vector<std::string> copy = args;
-        std::vector<char*> argv;
-        for (auto& s : copy) argv.push_back(s.data());
-        argv.push_back(nullptr);
-        ::execvp(argv[0], argv.data());
-        ::_exit(127);
-    }
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    CommandResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(out_path);
-    r.err = slurp(err_path);
-    return r;
+CommandResult run_with_env(const std::vector<std::string>& args,
+                           const std::vector<wul3d::test::EnvChange>& env) {
+    return wul3d::test::run_command(args, env);
 }
 
 bool in_path(const std::string& program) {
