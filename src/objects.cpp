@@ -104,7 +104,7 @@ ObjectTracker::ObjectTracker(const ObjectParams& params) : params_(params) {
 }
 
 void ObjectTracker::reset() {
-    std::fill(mu_.begin(), mu_.end(), 0.0f);
+    std::fill(mu_.begin(), mu_.end(), PixelWeights{});
     std::fill(has_mu_.begin(), has_mu_.end(), 0);
     tracks_.assign(static_cast<std::size_t>(params_.max_tracks), Track{});
     tau_ = 0;
@@ -113,9 +113,9 @@ void ObjectTracker::reset() {
 }
 
 void ObjectTracker::free_slot(int slot) {
-    const std::size_t K = static_cast<std::size_t>(params_.max_tracks);
-    const std::size_t N = has_mu_.size();
-    for (std::size_t p = 0; p < N; ++p) mu_[p * K + static_cast<std::size_t>(slot)] = 0.0f;
+    for (PixelWeights& w : mu_)
+        for (int s = 0; s < PixelWeights::kSlots; ++s)
+            if (w.cluster[s] == slot) w.mu[s] = 0;
     tracks_[static_cast<std::size_t>(slot)] = Track{};
 }
 
@@ -129,7 +129,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
     if (W != width_ || H != height_) {
         width_ = W;
         height_ = H;
-        mu_.assign(N * Kz, 0.0f);
+        mu_.assign(N, PixelWeights{});
         has_mu_.assign(N, 0);
         slot_of_.assign(N, 0);
         prev_z_.assign(N, 0.0f);
@@ -148,7 +148,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         }
         if (tau_ > 0 && (both == 0 || static_cast<double>(moved) >
                                           params_.scene_cut_share * static_cast<double>(both))) {
-            std::fill(mu_.begin(), mu_.end(), 0.0f);
+            std::fill(mu_.begin(), mu_.end(), PixelWeights{});
             std::fill(has_mu_.begin(), has_mu_.end(), 0);
             tracks_.assign(Kz, Track{});
             ++scene_cuts_;
@@ -171,8 +171,9 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         ss[3] += cloud.z[p];
         if (!has_mu_[p]) continue;
         double* vs = votes_.data() + static_cast<std::size_t>(s) * Kz;
-        const float* m = mu_.data() + p * Kz;
-        for (int j = 0; j < K; ++j) vs[j] += m[j];
+        const PixelWeights& w = mu_[p];
+        for (int q = 0; q < PixelWeights::kSlots; ++q)
+            if (w.mu[q] > 0) vs[w.cluster[q]] += w.mu[q] / static_cast<double>(PixelWeights::kOne);
     }
 
     // 2. Greedy one-to-one matching by vote, largest first.
@@ -250,13 +251,12 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int s = segments.labels[p];
             const int slot = s ? seg_slot_[static_cast<std::size_t>(s)] : -1;
-            float* m = mu_.data() + p * Kz;
             if (slot >= 0) {
-                slot_of_[p] = static_cast<std::uint8_t>(update_weights(m, K, slot, params_.psi) + 1);
+                slot_of_[p] = static_cast<std::uint8_t>(update_weights(mu_[p], slot, params_.psi) + 1);
                 has_mu_[p] = 1;
             } else {
                 if (cloud.valid[p] && has_mu_[p]) {
-                    std::fill(m, m + K, 0.0f);
+                    mu_[p] = PixelWeights{};
                     has_mu_[p] = 0;
                 }
                 slot_of_[p] = 0;

@@ -19,8 +19,8 @@ namespace wul3d {
 struct ObjectParams {
     float psi = 0.5f;          ///< weight increment of eq. (2) for object tracks; (0, 1]. Below 1
                                ///< a pixel changes object only after two frames of evidence
-    int max_tracks = 32;       ///< weight slots per pixel (memory 4 * W * H * max_tracks bytes);
-                               ///< [2, 255]
+    int max_tracks = 32;       ///< tracks held at once; [2, 255]. Each pixel keeps its 8 largest
+                               ///< track weights (PixelWeights, 32 bytes), whatever this is
     float min_overlap = 0.2f;  ///< a segment continues a track when its weight mass on the track
                                ///< is at least this share of the smaller of the two; (0, 1]
     float max_jump_m = 0.15f;  ///< else a lost track within this distance (centroids) is taken
@@ -85,7 +85,7 @@ private:
     std::int64_t tau_ = 0;
     int next_id_ = 1;
     std::vector<Track> tracks_;           ///< max_tracks slots
-    std::vector<float> mu_;               ///< pixel-major: mu_[p * max_tracks + slot]
+    std::vector<PixelWeights> mu_;        ///< per pixel, the kept weights over track slots
     std::vector<std::uint8_t> has_mu_;    ///< 1 where a pixel's weights are not all zero
     std::vector<std::uint8_t> slot_of_;   ///< arg-max slot + 1 per pixel this frame, 0 none
     std::vector<float> prev_z_;           ///< last frame's depth (0 = none), for scene cuts
