@@ -193,18 +193,23 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         for (int r : roots) fits[r] = fit(ws.sums.data() + static_cast<std::size_t>(r) * kSums);
     }
 
+    // A grid point is an inlier of a plane when it lies on the plane's band and its normal
+    // agrees with the plane's.
+    auto is_inlier = [&](const Plane& pl, int g) {
+        if (!usable(g)) return false;
+        const std::size_t p = grid.pixel(g);
+        const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+        if (std::fabs(h) > on_band(cloud.z[p])) return false;
+        return normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz >= cos_inlier;
+    };
+
     // 3. Candidates: merged planes covering min_extent of the grid points with a normal.
     //    Inliers are counted over the whole grid (distance and normal agree).
     for (int r : roots) {
         Plane pl = fit(ws.sums.data() + static_cast<std::size_t>(r) * kSums);
         std::size_t inliers = 0;
         for (int g = 0; g < G; ++g) {
-            if (!usable(g)) continue;
-            const std::size_t p = grid.pixel(g);
-            const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-            if (std::fabs(h) > on_band(cloud.z[p])) continue;
-            if (normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz < cos_inlier)
-                continue;
+            if (!is_inlier(pl, g)) continue;
             ++inliers;
         }
         pl.inliers = inliers;
@@ -219,12 +224,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         ws.hull.assign(static_cast<std::size_t>(G), 0);
         ws.hull_points.clear();
         for (int g = 0; g < G; ++g) {
-            if (!usable(g)) continue;
-            const std::size_t p = grid.pixel(g);
-            const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-            if (std::fabs(h) > on_band(cloud.z[p])) continue;
-            if (normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz < cos_inlier)
-                continue;
+            if (!is_inlier(pl, g)) continue;
             ws.hull_points.push_back(g % grid.w);
             ws.hull_points.push_back(g / grid.w);
         }

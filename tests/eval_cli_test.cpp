@@ -3,6 +3,8 @@
 // rejected with exit code 2 and one stderr line.
 #include <gtest/gtest.h>
 
+#include "synthetic_scene.hpp"
+
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +16,9 @@
 #include "test_support.hpp"
 #include "wul3d/io.hpp"
 
+using wul3d::test::blank_labels;
+using wul3d::test::fill_rect;
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -21,19 +26,6 @@ using wul3d::LabelImage;
 using wul3d::test::CommandResult;
 using wul3d::test::run_cli;
 using wul3d::test::TempDir;
-
-LabelImage blank(int w, int h) {
-    LabelImage l;
-    l.width = w;
-    l.height = h;
-    l.labels.assign(static_cast<std::size_t>(w) * h, 0);
-    return l;
-}
-
-void rect(LabelImage& l, int u0, int v0, int u1, int v1, std::uint16_t id) {
-    for (int v = v0; v <= v1; ++v)
-        for (int u = u0; u <= u1; ++u) l.labels[static_cast<std::size_t>(v) * l.width + u] = id;
-}
 
 void write(const fs::path& path, const LabelImage& l) {
     fs::create_directories(path.parent_path());
@@ -58,17 +50,17 @@ struct Fixture {
     TempDir dir;
     fs::path gt = dir / "gt", pred = dir / "pred";
     Fixture() {
-        LabelImage a = blank(20, 12);
-        rect(a, 1, 1, 4, 5, 1);
-        rect(a, 12, 1, 15, 5, 2);
+        LabelImage a = blank_labels(20, 12);
+        fill_rect(a, 1, 1, 4, 5, 1);
+        fill_rect(a, 12, 1, 15, 5, 2);
         write(gt / "f0" / "label.png", a);
         write(gt / "f1" / "label.png", a);
-        LabelImage p0 = blank(20, 12);
-        rect(p0, 1, 1, 4, 5, 3);
-        rect(p0, 12, 1, 15, 5, 9);
+        LabelImage p0 = blank_labels(20, 12);
+        fill_rect(p0, 1, 1, 4, 5, 3);
+        fill_rect(p0, 12, 1, 15, 5, 9);
         write(pred / "f0" / "objects.png", p0);
-        LabelImage p1 = blank(20, 12);
-        rect(p1, 1, 1, 4, 5, 7);
+        LabelImage p1 = blank_labels(20, 12);
+        fill_rect(p1, 1, 1, 4, 5, 7);
         write(pred / "f1" / "objects.png", p1);
     }
 };
@@ -109,9 +101,9 @@ TEST(EvalCli, JsonHoldsPerImageScores) {
 TEST(EvalCli, OnlyPrefixAndPredFile) {
     Fixture f;
     // labels.png beside objects.png: --pred-file picks it (here, a perfect f1).
-    LabelImage a = blank(20, 12);
-    rect(a, 1, 1, 4, 5, 1);
-    rect(a, 12, 1, 15, 5, 2);
+    LabelImage a = blank_labels(20, 12);
+    fill_rect(a, 1, 1, 4, 5, 1);
+    fill_rect(a, 12, 1, 15, 5, 2);
     write(f.pred / "f1" / "labels.png", a);
     CommandResult r = run_cli({"eval", f.pred.string(), f.gt.string(), "--only", "f1"});
     ASSERT_EQ(r.exit_code, 0) << describe(r);
@@ -179,7 +171,7 @@ TEST(EvalCli, BadInput_ExitTwoOneLine) {
         EXPECT_EQ(lines(r.err), 1) << r.err;
     }
     // A prediction of another size.
-    write(f.pred / "f0" / "objects.png", blank(12, 20));
+    write(f.pred / "f0" / "objects.png", blank_labels(12, 20));
     const CommandResult r = run_cli({"eval", f.pred.string(), f.gt.string()});
     EXPECT_EQ(r.exit_code, 2) << describe(r);
     EXPECT_EQ(lines(r.err), 1) << r.err;

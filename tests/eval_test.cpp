@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "synthetic_scene.hpp"
+
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
@@ -15,21 +17,10 @@
 
 using namespace wul3d;
 
+using wul3d::test::blank_labels;
+using wul3d::test::fill_rect;
+
 namespace {
-
-LabelImage blank(int w, int h) {
-    LabelImage l;
-    l.width = w;
-    l.height = h;
-    l.labels.assign(static_cast<std::size_t>(w) * h, 0);
-    return l;
-}
-
-/// Sets the pixels u0 <= u <= u1, v0 <= v <= v1 (inclusive) to `id`.
-void rect(LabelImage& l, int u0, int v0, int u1, int v1, std::uint16_t id) {
-    for (int v = v0; v <= v1; ++v)
-        for (int u = u0; u <= u1; ++u) l.labels[static_cast<std::size_t>(v) * l.width + u] = id;
-}
 
 void expect_all(const ImageScore& s, double p, double r, double f) {
     EXPECT_DOUBLE_EQ(s.overlap_p, p);
@@ -152,13 +143,13 @@ TEST(Hungarian, EmptyAndBadSizes) {
 // so a w x h rectangle in the open has 2w + 2h - 4 of them.
 
 TEST(ScoreImage, Perfect_AllOneWhateverTheIds) {
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 1, 1, 6, 8, 1);
-    rect(gt, 7, 1, 12, 8, 2);  // touching object 1
-    rect(gt, 15, 3, 18, 10, 5);
-    rect(pred, 1, 1, 6, 8, 9);
-    rect(pred, 7, 1, 12, 8, 3);
-    rect(pred, 15, 3, 18, 10, 1);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 1, 1, 6, 8, 1);
+    fill_rect(gt, 7, 1, 12, 8, 2);  // touching object 1
+    fill_rect(gt, 15, 3, 18, 10, 5);
+    fill_rect(pred, 1, 1, 6, 8, 9);
+    fill_rect(pred, 7, 1, 12, 8, 3);
+    fill_rect(pred, 15, 3, 18, 10, 1);
     const ImageScore s = score_image(pred, gt);
     expect_all(s, 1, 1, 1);
     EXPECT_DOUBLE_EQ(s.detected_share, 1.0);
@@ -182,10 +173,10 @@ TEST(ScoreImage, SplitObject) {
     // The GT's boundary misses pred 1's at u = 12..14 on the top and bottom rows (3 + 3)
     // and on the right column v = 2..9 (8): 14 of 36 miss -> 22.
     // Boundary P = 22/52, R = 22/36, F = 2*22/(52 + 36) = 0.5.
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 5, 1, 14, 10, 1);
-    rect(pred, 5, 1, 10, 10, 1);
-    rect(pred, 11, 1, 14, 10, 2);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 5, 1, 14, 10, 1);
+    fill_rect(pred, 5, 1, 10, 10, 1);
+    fill_rect(pred, 11, 1, 14, 10, 2);
     const ImageScore s = score_image(pred, gt);
     EXPECT_EQ(s.boundary_tolerance_px, 1);
     EXPECT_DOUBLE_EQ(s.overlap_p, 0.6);
@@ -209,10 +200,10 @@ TEST(ScoreImage, MergedObjects) {
     // boundary: its left column (10) and u = 3, 4 on the top and bottom rows (4): 26 hit.
     // B's boundary pixels away from the prediction's: its left column at v = 3..8 (6):
     // 26 hit. Boundary P = 26/40, R = 26/56, F = 52/96.
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 2, 1, 5, 10, 1);
-    rect(gt, 6, 1, 13, 10, 2);
-    rect(pred, 2, 1, 13, 10, 4);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 2, 1, 5, 10, 1);
+    fill_rect(gt, 6, 1, 13, 10, 2);
+    fill_rect(pred, 2, 1, 13, 10, 4);
     const ImageScore s = score_image(pred, gt);
     EXPECT_DOUBLE_EQ(s.overlap_p, 80.0 / 120.0);
     EXPECT_DOUBLE_EQ(s.overlap_r, 80.0 / 120.0);
@@ -229,10 +220,10 @@ TEST(ScoreImage, MergedObjects) {
 TEST(ScoreImage, MissedObject) {
     // GT: two 4 x 5 objects far apart; the prediction finds only the first, exactly.
     // Overlap P = 20/20, R = 20/40, F = 2/3; boundaries 14 px each: P = 1, R = 1/2, F = 2/3.
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 1, 1, 4, 5, 1);
-    rect(gt, 12, 1, 15, 5, 2);
-    rect(pred, 1, 1, 4, 5, 7);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 1, 1, 4, 5, 1);
+    fill_rect(gt, 12, 1, 15, 5, 2);
+    fill_rect(pred, 1, 1, 4, 5, 7);
     const ImageScore s = score_image(pred, gt);
     EXPECT_DOUBLE_EQ(s.overlap_p, 1.0);
     EXPECT_DOUBLE_EQ(s.overlap_r, 0.5);
@@ -244,8 +235,8 @@ TEST(ScoreImage, MissedObject) {
 }
 
 TEST(ScoreImage, EmptyPrediction_PrecisionOneRecallZero) {
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 1, 1, 4, 5, 1);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 1, 1, 4, 5, 1);
     const ImageScore s = score_image(pred, gt);
     expect_all(s, 1, 0, 0);
     EXPECT_DOUBLE_EQ(s.detected_share, 0.0);
@@ -255,8 +246,8 @@ TEST(ScoreImage, EmptyPrediction_PrecisionOneRecallZero) {
 }
 
 TEST(ScoreImage, EmptyGroundTruth_PrecisionZeroRecallOne) {
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(pred, 1, 1, 4, 5, 3);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(pred, 1, 1, 4, 5, 3);
     const ImageScore s = score_image(pred, gt);
     expect_all(s, 0, 1, 0);
     EXPECT_DOUBLE_EQ(s.detected_share, 0.0);
@@ -264,7 +255,7 @@ TEST(ScoreImage, EmptyGroundTruth_PrecisionZeroRecallOne) {
 }
 
 TEST(ScoreImage, BothEmpty_AllOne) {
-    const ImageScore s = score_image(blank(20, 12), blank(20, 12));
+    const ImageScore s = score_image(blank_labels(20, 12), blank_labels(20, 12));
     expect_all(s, 1, 1, 1);
     EXPECT_DOUBLE_EQ(s.detected_share, 1.0);
 }
@@ -273,9 +264,9 @@ TEST(ScoreImage, BoundaryShiftedTwoPixels_WithinTolerance) {
     // 640 x 480: tolerance 3 px. A 20 x 20 square, predicted 2 px to the right.
     // Overlap: 18 x 20 = 360 of 400 on both sides: P = R = F = 0.9. Every boundary pixel of
     // either square lies within 2 px of the other's boundary: boundary P = R = F = 1.
-    LabelImage gt = blank(640, 480), pred = blank(640, 480);
-    rect(gt, 100, 100, 119, 119, 1);
-    rect(pred, 102, 100, 121, 119, 1);
+    LabelImage gt = blank_labels(640, 480), pred = blank_labels(640, 480);
+    fill_rect(gt, 100, 100, 119, 119, 1);
+    fill_rect(pred, 102, 100, 121, 119, 1);
     const ImageScore s = score_image(pred, gt);
     EXPECT_EQ(s.boundary_tolerance_px, 3);
     EXPECT_DOUBLE_EQ(s.overlap_p, 0.9);
@@ -294,9 +285,9 @@ TEST(ScoreImage, BoundaryShiftedFourPixels_OutsideTolerance) {
     // u = 123 is 4 px from everything (0 of 20); its top and bottom rows without the corners
     // (u = 105..122, 18 each) are on the GT's rows or within 3 px of their end: 8 + 36 = 44.
     // The GT's side is the mirror image: 44 of 76. Boundary P = R = F = 44/76.
-    LabelImage gt = blank(640, 480), pred = blank(640, 480);
-    rect(gt, 100, 100, 119, 119, 1);
-    rect(pred, 104, 100, 123, 119, 1);
+    LabelImage gt = blank_labels(640, 480), pred = blank_labels(640, 480);
+    fill_rect(gt, 100, 100, 119, 119, 1);
+    fill_rect(pred, 104, 100, 123, 119, 1);
     const ImageScore s = score_image(pred, gt);
     EXPECT_DOUBLE_EQ(s.overlap_p, 0.8);
     EXPECT_DOUBLE_EQ(s.overlap_r, 0.8);
@@ -309,9 +300,9 @@ TEST(ScoreImage, BoundaryShiftedFourPixels_OutsideTolerance) {
 TEST(ScoreImage, ImageBorderIsNoBoundary) {
     // An object filling the left half: its boundary is the one column facing the right half.
     // Predicting one column too wide is 1 px off, within the 1 px tolerance.
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 0, 0, 9, 11, 1);
-    rect(pred, 0, 0, 10, 11, 1);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 0, 0, 9, 11, 1);
+    fill_rect(pred, 0, 0, 10, 11, 1);
     const ImageScore s = score_image(pred, gt);
     EXPECT_DOUBLE_EQ(s.boundary_p, 1.0);
     EXPECT_DOUBLE_EQ(s.boundary_r, 1.0);
@@ -329,14 +320,14 @@ TEST(ScoreImage, BoundaryMatchesBruteForceDilation) {
     std::mt19937 rng(3);
     const int w = 64, h = 48;
     for (int trial = 0; trial < 20; ++trial) {
-        LabelImage gt = blank(w, h), pred = blank(w, h);
+        LabelImage gt = blank_labels(w, h), pred = blank_labels(w, h);
         std::uniform_int_distribution<int> pu(0, w - 1), pv(0, h - 1), sz(3, 20), id(1, 6);
         for (int k = 0; k < 8; ++k) {
             const int u = pu(rng), v = pv(rng);
-            rect(gt, u, v, std::min(w - 1, u + sz(rng)), std::min(h - 1, v + sz(rng)),
+            fill_rect(gt, u, v, std::min(w - 1, u + sz(rng)), std::min(h - 1, v + sz(rng)),
                  static_cast<std::uint16_t>(id(rng)));
             const int u2 = pu(rng), v2 = pv(rng);
-            rect(pred, u2, v2, std::min(w - 1, u2 + sz(rng)), std::min(h - 1, v2 + sz(rng)),
+            fill_rect(pred, u2, v2, std::min(w - 1, u2 + sz(rng)), std::min(h - 1, v2 + sz(rng)),
                  static_cast<std::uint16_t>(id(rng)));
         }
         EvalParams params;
@@ -394,11 +385,11 @@ TEST(ScoreImage, BoundaryMatchesBruteForceDilation) {
 
 TEST(ScoreImage, NoCommonPixel_IsNoMatch) {
     // Two predicted objects, one GT object overlapping only the first: one match.
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 1, 1, 4, 4, 1);
-    rect(gt, 10, 1, 13, 4, 2);
-    rect(pred, 1, 1, 4, 4, 1);
-    rect(pred, 1, 8, 4, 10, 2);  // touches no GT object
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 1, 1, 4, 4, 1);
+    fill_rect(gt, 10, 1, 13, 4, 2);
+    fill_rect(pred, 1, 1, 4, 4, 1);
+    fill_rect(pred, 1, 8, 4, 10, 2);  // touches no GT object
     const ImageScore s = score_image(pred, gt);
     ASSERT_EQ(s.matches.size(), 1u);
     EXPECT_EQ(s.matches[0].gt_id, 1);
@@ -407,17 +398,17 @@ TEST(ScoreImage, NoCommonPixel_IsNoMatch) {
 }
 
 TEST(ScoreImage, SizeMismatch_Throws) {
-    EXPECT_THROW(score_image(blank(20, 12), blank(12, 20)), InputError);
-    LabelImage broken = blank(20, 12);
+    EXPECT_THROW(score_image(blank_labels(20, 12), blank_labels(12, 20)), InputError);
+    LabelImage broken = blank_labels(20, 12);
     broken.labels.pop_back();
-    EXPECT_THROW(score_image(broken, blank(20, 12)), InputError);
+    EXPECT_THROW(score_image(broken, blank_labels(20, 12)), InputError);
 }
 
 TEST(Summarize, MacroAverageOverImages) {
-    LabelImage gt = blank(20, 12), pred = blank(20, 12);
-    rect(gt, 1, 1, 4, 5, 1);
-    rect(gt, 12, 1, 15, 5, 2);
-    rect(pred, 1, 1, 4, 5, 7);
+    LabelImage gt = blank_labels(20, 12), pred = blank_labels(20, 12);
+    fill_rect(gt, 1, 1, 4, 5, 1);
+    fill_rect(gt, 12, 1, 15, 5, 2);
+    fill_rect(pred, 1, 1, 4, 5, 7);
     const ImageScore missed = score_image(pred, gt);            // F 2/3, P 1, R 1/2
     const ImageScore perfect = score_image(gt, gt);             // all 1
     const EvalSummary m = summarize({missed, perfect});
@@ -442,14 +433,14 @@ namespace {
 void moving_sequence(std::vector<LabelImage>& preds, std::vector<LabelImage>& gts) {
     const std::uint16_t id1[5] = {1, 1, 2, 2, 1};
     for (int t = 0; t < 5; ++t) {
-        LabelImage gt = blank(10, 4), pred = blank(10, 4);
-        rect(gt, 0, 0, 3, 3, 1);
-        rect(pred, 0, 0, 3, 3, id1[t]);
+        LabelImage gt = blank_labels(10, 4), pred = blank_labels(10, 4);
+        fill_rect(gt, 0, 0, 3, 3, 1);
+        fill_rect(pred, 0, 0, 3, 3, id1[t]);
         if (t != 2) {
-            rect(gt, 6, 0, 7, 3, 2);
-            rect(pred, 6, 0, 7, 3, 3);
+            fill_rect(gt, 6, 0, 7, 3, 2);
+            fill_rect(pred, 6, 0, 7, 3, 3);
         }
-        if (t == 0) rect(pred, 9, 0, 9, 0, 5);
+        if (t == 0) fill_rect(pred, 9, 0, 9, 0, 5);
         gts.push_back(gt);
         preds.push_back(pred);
     }
@@ -490,9 +481,9 @@ TEST(SequenceScorer, MissesAreNoSwitches) {
         SequenceScorer scorer;
         const std::uint16_t ids[3] = {4, 0, last};
         for (int t = 0; t < 3; ++t) {
-            LabelImage gt = blank(10, 4), pred = blank(10, 4);
-            rect(gt, 0, 0, 3, 3, 1);
-            rect(pred, 0, 0, 3, 3, ids[t]);
+            LabelImage gt = blank_labels(10, 4), pred = blank_labels(10, 4);
+            fill_rect(gt, 0, 0, 3, 3, 1);
+            fill_rect(pred, 0, 0, 3, 3, ids[t]);
             scorer.add(pred, gt);
         }
         const TemporalReport r = scorer.report();
@@ -506,11 +497,11 @@ TEST(SequenceScorer, MissesAreNoSwitches) {
 TEST(SequenceScorer, StableSequence_NoFlicker) {
     std::vector<LabelImage> preds, gts;
     for (int t = 0; t < 4; ++t) {
-        LabelImage gt = blank(10, 4);
-        rect(gt, 0, 0, 3, 3, 2);
+        LabelImage gt = blank_labels(10, 4);
+        fill_rect(gt, 0, 0, 3, 3, 2);
         gts.push_back(gt);
-        LabelImage pred = blank(10, 4);
-        rect(pred, 0, 0, 4, 3, 8);  // one column too wide, but the same every frame
+        LabelImage pred = blank_labels(10, 4);
+        fill_rect(pred, 0, 0, 4, 3, 8);  // one column too wide, but the same every frame
         preds.push_back(pred);
     }
     const TemporalReport r = score_sequence(preds, gts);
@@ -522,7 +513,7 @@ TEST(SequenceScorer, StableSequence_NoFlicker) {
 
 TEST(SequenceScorer, SizeChange_Throws) {
     SequenceScorer scorer;
-    scorer.add(blank(10, 4), blank(10, 4));
-    EXPECT_THROW(scorer.add(blank(4, 10), blank(4, 10)), InputError);
-    EXPECT_THROW(score_sequence({blank(10, 4)}, {}), InputError);
+    scorer.add(blank_labels(10, 4), blank_labels(10, 4));
+    EXPECT_THROW(scorer.add(blank_labels(4, 10), blank_labels(4, 10)), InputError);
+    EXPECT_THROW(score_sequence({blank_labels(10, 4)}, {}), InputError);
 }

@@ -109,13 +109,7 @@ ObjectRun run_moving_sequence(float psi, int frames) {
     LabelImage segments, objects;
     std::vector<DetectedObject> list;
     for (int t = 0; t < frames; ++t) {
-        Scene s;
-        s.width = 320;
-        s.height = 240;
-        s.pitch_rad = 0.5f;
-        s.table_y = 0.6f;
-        s.table_near = 0.4f;
-        s.table_far = 1.6f;
+        Scene s = pitched_tabletop_scene();
         s.noise_seed = static_cast<std::uint32_t>(t + 1);
         SceneBox red;
         red.x = -0.3f + 0.025f * static_cast<float>(t);

@@ -34,16 +34,6 @@ LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
     return out;
 }
 
-Scene pitched_scene() {
-    Scene s;
-    s.width = 320;
-    s.height = 240;
-    s.pitch_rad = 0.5f;
-    s.table_y = 0.6f;
-    s.table_near = 0.4f;
-    s.table_far = 1.6f;
-    return s;
-}
 }  // namespace
 
 TEST(SegmentParams, Validate_NamesTheFlag) {
@@ -64,7 +54,7 @@ TEST(SegmentParams, Validate_NamesTheFlag) {
 // Two boxes of one colour, the small one standing in front of the tall one and touching
 // it: their surfaces meet at a concave junction, which is cut.
 TEST(SegmentObjects, TouchingSameColourBoxes_SeparatedAtTheConcaveJunction) {
-    Scene s = pitched_scene();
+    Scene s = pitched_tabletop_scene();
     SceneBox tall;
     tall.x = 0.05f;
     tall.z = 1.0f;
@@ -92,7 +82,7 @@ TEST(SegmentObjects, TouchingSameColourBoxes_SeparatedAtTheConcaveJunction) {
 // tell them apart; the colour cue (hybrid) can, because they differ in colour and meet along
 // a straight boundary across a flat surface.
 TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
-    Scene s = pitched_scene();
+    Scene s = pitched_tabletop_scene();
     s.noise_seed = 7;
     SceneBox red;
     red.x = -0.075f;
@@ -122,7 +112,7 @@ TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
 // The colour cue leaves a box alone whose faces differ in shade: the colour boundary runs
 // along a convex edge, not across a flat surface.
 TEST(SegmentObjects, ColourCue_DoesNotSplitOneBox) {
-    Scene s = pitched_scene();
+    Scene s = pitched_tabletop_scene();
     SceneBox box;
     box.z = 1.0f;
     s.boxes = {box};

@@ -95,6 +95,30 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
     return f;
 }
 
+Scene pitched_tabletop_scene() {
+    Scene s;
+    s.width = 320;
+    s.height = 240;
+    s.pitch_rad = 0.5f;
+    s.table_y = 0.6f;
+    s.table_near = 0.4f;
+    s.table_far = 1.6f;
+    return s;
+}
+
+LabelImage blank_labels(int w, int h) {
+    LabelImage l;
+    l.width = w;
+    l.height = h;
+    l.labels.assign(static_cast<std::size_t>(w) * h, 0);
+    return l;
+}
+
+void fill_rect(LabelImage& l, int u0, int v0, int u1, int v1, std::uint16_t id) {
+    for (int v = v0; v <= v1; ++v)
+        for (int u = u0; u <= u1; ++u) l.labels[static_cast<std::size_t>(v) * l.width + u] = id;
+}
+
 double dominant_share(const std::vector<std::uint16_t>& labels, const std::vector<int>& truth,
                       int id, int* dominant) {
     std::map<int, std::size_t> counts;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "wul3d/backprojection.hpp"
+#include "wul3d/clustering.hpp"
 #include "wul3d/frame.hpp"
 
 namespace wul3d::test {
@@ -35,6 +36,15 @@ PinholeIntrinsics scene_intrinsics(int width, int height);
 
 /// Renders the scene; depth in 0.1 mm units. `truth` gets one id per pixel.
 RgbdFrame render_scene(const Scene& scene, std::vector<int>* truth = nullptr);
+
+/// The tilted tabletop used by the plane, segmentation and object tests: the camera pitched
+/// down 0.5 rad over a table 0.6 m below it, from 0.4 to 1.6 m away; no boxes yet.
+Scene pitched_tabletop_scene();
+
+/// A w x h label image, all 0.
+LabelImage blank_labels(int w, int h);
+/// Sets the pixels u0 <= u <= u1, v0 <= v <= v1 (inclusive) to `id`.
+void fill_rect(LabelImage& l, int u0, int v0, int u1, int v1, std::uint16_t id);
 
 /// The share of the pixels with truth id `id` whose label is the most common label among
 /// them; `dominant` gets that label.
