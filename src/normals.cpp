@@ -1,5 +1,6 @@
 #include "wul3d/normals.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -93,6 +94,75 @@ void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, N
             out.ny[p] = n.y * s;
             out.nz[p] = n.z * s;
             out.valid[p] = 1;
+        }
+    }
+}
+
+void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out) {
+    if (radius_px < 1 || radius_px > 64) {
+        std::ostringstream msg;
+        msg << "normal smoothing radius = " << radius_px << " px: must be in [1, 64]";
+        throw ParamError(msg.str());
+    }
+    const int W = in.width, H = in.height, r = radius_px;
+    const std::size_t N = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
+    out.resize(W, H);
+    // Horizontal running sums of (nx, ny, nz) into scratch (3 planes), then vertical ones.
+    scratch.resize(3 * N);
+    float* hx = scratch.data();
+    float* hy = hx + N;
+    float* hz = hy + N;
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * W;
+        float sx = 0, sy = 0, sz = 0;
+        auto add = [&](int u, float sign) {
+            const std::size_t p = row + u;
+            if (!in.valid[p]) return;
+            sx += sign * in.nx[p];
+            sy += sign * in.ny[p];
+            sz += sign * in.nz[p];
+        };
+        for (int u = 0; u < std::min(r, W); ++u) add(u, 1.0f);
+        for (int u = 0; u < W; ++u) {
+            if (u + r < W) add(u + r, 1.0f);
+            if (u - r - 1 >= 0) add(u - r - 1, -1.0f);
+            hx[row + u] = sx;
+            hy[row + u] = sy;
+            hz[row + u] = sz;
+        }
+    }
+    // Vertical pass by column blocks, so that each thread walks rows contiguously.
+    constexpr int kBlock = 64;
+    const int blocks = (W + kBlock - 1) / kBlock;
+#pragma omp parallel for schedule(static)
+    for (int b = 0; b < blocks; ++b) {
+        const int u0 = b * kBlock, u1 = std::min(W, u0 + kBlock);
+        float sx[kBlock] = {}, sy[kBlock] = {}, sz[kBlock] = {};
+        auto add = [&](int v, float sign) {
+            const std::size_t row = static_cast<std::size_t>(v) * W;
+            for (int u = u0; u < u1; ++u) {
+                sx[u - u0] += sign * hx[row + u];
+                sy[u - u0] += sign * hy[row + u];
+                sz[u - u0] += sign * hz[row + u];
+            }
+        };
+        for (int v = 0; v < std::min(r, H); ++v) add(v, 1.0f);
+        for (int v = 0; v < H; ++v) {
+            if (v + r < H) add(v + r, 1.0f);
+            if (v - r - 1 >= 0) add(v - r - 1, -1.0f);
+            const std::size_t row = static_cast<std::size_t>(v) * W;
+            for (int u = u0; u < u1; ++u) {
+                const std::size_t p = row + u;
+                const float x = sx[u - u0], y = sy[u - u0], z = sz[u - u0];
+                const float len = std::sqrt(x * x + y * y + z * z);
+                const bool ok = in.valid[p] && len > 1e-6f;
+                const float s = ok ? 1.0f / len : 0.0f;
+                out.nx[p] = x * s;
+                out.ny[p] = y * s;
+                out.nz[p] = z * s;
+                out.valid[p] = ok;
+            }
         }
     }
 }

@@ -96,6 +96,10 @@ void ObjectParams::validate() const {
     require(max_lost_frames >= 0, "max_lost_frames", max_lost_frames, ">= 0");
     require(min_points >= 1, "min_points", min_points, ">= 1");
     require(scene_cut_share > 0 && scene_cut_share <= 1, "scene_cut_share", scene_cut_share, "in (0, 1]");
+    require(rearranged_share > 0 && rearranged_share <= 1, "rearranged_share", rearranged_share, "in (0, 1]");
+    require(surface_change_m > 0, "surface_change_m", surface_change_m, "> 0");
+    require(surface_change_rel >= 0, "surface_change_rel", surface_change_rel, ">= 0");
+    require(surface_change_rgb > 0, "surface_change_rgb", surface_change_rgb, "> 0");
 }
 
 ObjectTracker::ObjectTracker(const ObjectParams& params) : params_(params) {
@@ -133,23 +137,47 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         has_mu_.assign(N, 0);
         slot_of_.assign(N, 0);
         prev_z_.assign(N, 0.0f);
+        prev_rgb_.assign(3 * N, 0);
+        changed_.assign(N, 0);
         reset();
     }
     {
         // A scene cut: most surfaces moved at once. Weights and tracks start afresh.
-        std::size_t both = 0, moved = 0;
+        // A pixel whose surface changed (an object arrived, left or moved over it) forgets
+        // its weights: they are the history of another surface.
+        std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
+        const float rgb2 = params_.surface_change_rgb * params_.surface_change_rgb;
         for (std::size_t p = 0; p < N; ++p) {
             const float z = cloud.valid[p] ? cloud.z[p] : 0.0f;
+            std::uint8_t* rgb = prev_rgb_.data() + 3 * p;
             if (z > 0 && prev_z_[p] > 0) {
                 ++both;
-                moved += std::fabs(z - prev_z_[p]) > 0.05f;
+                const float dz = std::fabs(z - prev_z_[p]);
+                moved += dz > 0.05f;
+                const float dr = cloud.r[p] - rgb[0], dg = cloud.g[p] - rgb[1], db = cloud.b[p] - rgb[2];
+                const bool depth_moved = dz > params_.surface_change_m + params_.surface_change_rel * z * z;
+                held += has_mu_[p];
+                held_moved += has_mu_[p] && depth_moved;
+                // Reset after the votes below: the old weights still say which track was
+                // here, evidence of overlap for a moving object.
+                changed_[p] = has_mu_[p] && (depth_moved || dr * dr + dg * dg + db * db > rgb2);
+            } else {
+                changed_[p] = 0;
             }
             prev_z_[p] = z;
+            rgb[0] = static_cast<std::uint8_t>(cloud.r[p]);
+            rgb[1] = static_cast<std::uint8_t>(cloud.g[p]);
+            rgb[2] = static_cast<std::uint8_t>(cloud.b[p]);
         }
-        if (tau_ > 0 && (both == 0 || static_cast<double>(moved) >
-                                          params_.scene_cut_share * static_cast<double>(both))) {
+        // Most of the surfaces the objects held moved: the objects were rearranged (a folder
+        // of separate scenes), not moved along.
+        const bool objects_moved = held > 0 && static_cast<double>(held_moved) >
+                                                   params_.rearranged_share * static_cast<double>(held);
+        if (tau_ > 0 && (both == 0 || objects_moved ||
+                         static_cast<double>(moved) > params_.scene_cut_share * static_cast<double>(both))) {
             std::fill(mu_.begin(), mu_.end(), PixelWeights{});
             std::fill(has_mu_.begin(), has_mu_.end(), 0);
+            std::fill(changed_.begin(), changed_.end(), 0);
             tracks_.assign(Kz, Track{});
             ++scene_cuts_;
         }
@@ -251,8 +279,25 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int s = segments.labels[p];
             const int slot = s ? seg_slot_[static_cast<std::size_t>(s)] : -1;
+            if (changed_[p]) {
+                mu_[p] = PixelWeights{};
+                has_mu_[p] = 0;
+            }
             if (slot >= 0) {
-                slot_of_[p] = static_cast<std::uint8_t>(update_weights(mu_[p], slot, params_.psi) + 1);
+                int label = update_weights(mu_[p], slot, params_.psi);
+                // The arg-max runs over the objects seen in this frame: a track with no
+                // segment now must not hold pixels as a ghost fragment of another object.
+                if (!slot_taken[static_cast<std::size_t>(label)]) {
+                    const PixelWeights& w = mu_[p];
+                    label = slot;
+                    int best = -1;
+                    for (int q = 0; q < PixelWeights::kSlots; ++q)
+                        if (w.mu[q] > best && slot_taken[w.cluster[q]]) {
+                            best = w.mu[q];
+                            label = w.cluster[q];
+                        }
+                }
+                slot_of_[p] = static_cast<std::uint8_t>(label + 1);
                 has_mu_[p] = 1;
             } else {
                 if (cloud.valid[p] && has_mu_[p]) {

@@ -36,6 +36,8 @@ void PlaneParams::validate() const {
     require(min_up >= -1 && min_up <= 1, "min_up", min_up, "in [-1, 1]");
     require(max_object_height_m > 0, "max_object_height_m", max_object_height_m, "> 0");
     require(hull_margin_px >= 0, "hull_margin_px", hull_margin_px, ">= 0");
+    require(island_min_height_m > 0, "island_min_height_m", island_min_height_m, "> 0");
+    require(island_max_share >= 0 && island_max_share <= 1, "island_max_share", island_max_share, "in [0, 1]");
 }
 
 namespace {
@@ -74,6 +76,71 @@ struct Grid {
         return static_cast<std::size_t>(g / w) * s * W + static_cast<std::size_t>(g % w) * s;
     }
 };
+
+}  // namespace
+
+namespace {
+
+/// On-plane patches that the objects enclose (a bowl's inner bottom seen through its
+/// opening) are object material, not the support: a 4-connected patch of removed on-band
+/// pixels that touches neither the image border nor other removed points, borders object
+/// points, is small and sits on average above the plane is given back (kPlaneInside).
+template <class Band>
+std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
+                            const std::vector<std::uint8_t>& active, const Plane& pl,
+                            const Band& on_band, PlaneWorkspace& ws,
+                            std::vector<std::uint8_t>& classes) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t N = cloud.size();
+    ws.island.assign(N, 0);
+    ws.queue.resize(N);
+    auto on_plane = [&](std::size_t p) {
+        if (!active[p] || classes[p] != kPlaneRemoved) return false;
+        const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+        return std::fabs(h) <= on_band(cloud.z[p]);
+    };
+    const double max_size = params.island_max_share * static_cast<double>(N);
+    std::size_t restored = 0;
+    int id = 0;
+    for (std::size_t seed = 0; seed < N; ++seed) {
+        if (ws.island[seed] || !on_plane(seed)) continue;
+        ++id;
+        int head = 0, tail = 0;
+        ws.queue[tail++] = static_cast<int>(seed);
+        ws.island[seed] = id;
+        bool open = false;
+        std::size_t touches_object = 0;
+        double height = 0;
+        while (head < tail) {
+            const int p = ws.queue[head++];
+            const std::size_t pz = static_cast<std::size_t>(p);
+            height += pl.height(cloud.x[pz], cloud.y[pz], cloud.z[pz]);
+            const int u = p % W, v = p / W;
+            if (u == 0 || v == 0 || u == W - 1 || v == H - 1) {
+                open = true;
+                continue;
+            }
+            for (const int q : {p - 1, p + 1, p - W, p + W}) {
+                const std::size_t qz = static_cast<std::size_t>(q);
+                if (ws.island[qz]) continue;
+                if (on_plane(qz)) {
+                    ws.island[qz] = id;
+                    ws.queue[tail++] = q;
+                } else if (classes[qz] != kPlaneRemoved) {
+                    ++touches_object;
+                } else if (active[qz]) {
+                    open = true;  // beside support or room points that are not on the plane
+                }
+            }
+        }
+        if (open || touches_object == 0 || tail > max_size ||
+            height / tail <= params.island_min_height_m)
+            continue;
+        for (int i = 0; i < tail; ++i) classes[static_cast<std::size_t>(ws.queue[i])] = kPlaneInside;
+        restored += static_cast<std::size_t>(tail);
+    }
+    return restored;
+}
 
 }  // namespace
 
@@ -312,6 +379,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             kept += c != kPlaneRemoved;
         }
     }
+    kept += restore_islands(params, cloud, active, pl, on_band, ws, classes);
     result.kept = kept;
     return result;
 }

@@ -42,10 +42,13 @@ void SegmentParams::validate() const {
     }
     require(depth_jump_m > 0, "depth_jump_m", depth_jump_m, "> 0");
     require(depth_jump_rel >= 0, "depth_jump_rel", depth_jump_rel, ">= 0");
+    require(normal_smooth_px >= 0 && normal_smooth_px <= 16, "normal_smooth_px", normal_smooth_px, "in [0, 16]");
     require(crease_step_px >= 1 && crease_step_px <= 16, "crease_step_px", crease_step_px, "in [1, 16]");
     require(concavity > 0, "concavity", concavity, "> 0");
     require(reattach_px >= 0, "reattach_px", reattach_px, ">= 0");
     require(min_seed_points >= 1, "min_seed_points", min_seed_points, ">= 1");
+    require(merge_max_concave >= 0 && merge_max_concave <= 1, "merge_max_concave", merge_max_concave, "in [0, 1]");
+    require(merge_min_boundary >= 1, "merge_min_boundary", merge_min_boundary, ">= 1");
     require(color_alpha >= 0.002f && color_alpha <= 0.1f, "color_alpha", color_alpha,
             "in [0.002, 0.1] (the paper's range of alpha)");
     require(color_min_distance > 0, "color_min_distance", color_min_distance, "> 0");
@@ -110,7 +113,9 @@ int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentW
 
 /// Grows the labelled pixels into unlabelled foreground (cut pixels, feet, pixels without a
 /// normal, dropped fragments) breadth-first, up to `max_steps`, where depth is continuous.
-std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps) {
+/// With `inside_only`, grows only into kPlaneInside pixels (a container's inside joins the
+/// container, however wide).
+std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool inside_only = false) {
     const int W = x.W, H = x.H;
     const std::size_t N = static_cast<std::size_t>(W) * H;
     int head = 0, tail = 0;
@@ -127,7 +132,9 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps) {
                            v + 1 < H ? p + W : -1};
         for (int q : nb) {
             if (q < 0 || ws.label[q] || x.cls[q] == kPlaneRemoved) continue;
-            if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
+            if (inside_only && x.cls[q] != kPlaneInside) continue;
+            // The inside is enclosed by the object, whatever the depth step at its edge.
+            if (!inside_only && !x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
             ws.label[q] = ws.label[p];
             ws.dist[q] = ws.dist[p] + 1;
             ws.queue[tail++] = q;
@@ -152,6 +159,78 @@ int compact(SegmentWorkspace& ws, int n, int min_points) {
         l = m;
     }
     return next;
+}
+
+int find_root(std::vector<int>& parent, int a) {
+    while (parent[static_cast<std::size_t>(a)] != a) {
+        parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
+        a = parent[static_cast<std::size_t>(a)];
+    }
+    return a;
+}
+
+/// Joins segments that touch along a boundary that is mostly not concave. Each 4-neighbour
+/// pair (p, q) of two segments with continuous depth is tested for a crease between the
+/// pixels a crease step away on either side, inside their own segments; the pair of
+/// segments merges when enough pairs were tested and few were concave. Returns the merges.
+int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    if (prm.merge_max_concave <= 0 || n < 2) return 0;
+    const int W = x.W, H = x.H, s = prm.crease_step_px;
+    ws.edges.clear();
+    for (int v = 0; v < H; ++v) {
+        for (int u = 0; u < W; ++u) {
+            const int p = v * W + u;
+            const int a = ws.label[static_cast<std::size_t>(p)];
+            if (a == 0) continue;
+            const int dirs[2][2] = {{1, 0}, {0, 1}};
+            for (const auto& d : dirs) {
+                if (u + d[0] >= W || v + d[1] >= H) continue;
+                const int q = p + d[0] + d[1] * W;
+                const int b = ws.label[static_cast<std::size_t>(q)];
+                if (b == 0 || b == a) continue;
+                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
+                const int pu = u - s * d[0], pv = v - s * d[1];
+                const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
+                std::uint64_t tested = 0, concave = 0;
+                if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
+                    const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
+                    const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
+                    if (ws.label[pp] == a && ws.label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
+                        tested = 1;
+                        concave = x.concavity(pp, qq) > prm.concavity;
+                    }
+                }
+                const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+                const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+                ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+            }
+        }
+    }
+    std::sort(ws.edges.begin(), ws.edges.end());
+    ws.parent.resize(static_cast<std::size_t>(n) + 1);
+    for (int l = 0; l <= n; ++l) ws.parent[static_cast<std::size_t>(l)] = l;
+    int merges = 0;
+    for (std::size_t i = 0; i < ws.edges.size();) {
+        const std::uint64_t key = ws.edges[i] >> 4;
+        int tested = 0, concave = 0;
+        for (; i < ws.edges.size() && (ws.edges[i] >> 4) == key; ++i) {
+            tested += static_cast<int>((ws.edges[i] >> 1) & 1);
+            concave += static_cast<int>(ws.edges[i] & 1);
+        }
+        if (tested < prm.merge_min_boundary ||
+            static_cast<float>(concave) > prm.merge_max_concave * static_cast<float>(tested))
+            continue;
+        const int ra = find_root(ws.parent, static_cast<int>(key >> 30));
+        const int rb = find_root(ws.parent, static_cast<int>(key & ((1u << 30) - 1)));
+        if (ra == rb) continue;
+        ws.parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+        ++merges;
+    }
+    if (merges == 0) return 0;
+    for (int& l : ws.label)
+        if (l) l = find_root(ws.parent, l);
+    return merges;
 }
 
 /// The colour cue: tries to split each segment in two by 2-means under the paper's
@@ -270,7 +349,12 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
                              const LabelImage& clusters, SegmentWorkspace& ws, LabelImage& out) {
     const int W = cloud.width, H = cloud.height;
     const std::size_t N = cloud.size();
-    const Ctx x{params, cloud, normals, classes, W, H};
+    const NormalMap* crease_normals = &normals;
+    if (params.normal_smooth_px > 0) {
+        smooth_normals(normals, params.normal_smooth_px, ws.smooth_scratch, ws.smooth);
+        crease_normals = &ws.smooth;
+    }
+    const Ctx x{params, cloud, *crease_normals, classes, W, H};
     ws.cut.resize(N);
     ws.label.resize(N);
     ws.queue.resize(N);
@@ -340,7 +424,12 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
         if (ws.label[p] && ws.sizes[static_cast<std::size_t>(ws.label[p])] < params.min_seed_points)
             ws.label[p] = 0;
     stats.reattached = reattach(x, ws, params.reattach_px);
+    stats.reattached += reattach(x, ws, W + H, true);
     n = compact(ws, n, 1);
+    if (params.segmenter != Segmenter::Kmeans) {
+        stats.merges = merge_convex(x, ws, n);
+        if (stats.merges) n = compact(ws, n, 1);
+    }
     if (params.segmenter == Segmenter::Hybrid) {
         stats.color_splits = color_splits(x, ws, n);
         n += stats.color_splits;

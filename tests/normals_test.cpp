@@ -127,3 +127,38 @@ TEST(NormalParams, Validate) {
     p.max_depth_jump_rel = 0;
     EXPECT_THROW(p.validate(), ParamError);
 }
+
+// Smoothing: on a noisy plane the averaged normals lie closer to the true one than the raw
+// ones; a pixel without a normal stays without one; the radius is checked.
+TEST(SmoothNormals, NoisyPlane_CloserToTheTruth_InvalidStaysInvalid) {
+    NormalMap raw;
+    raw.resize(64, 48);
+    std::uint32_t state = 12345;
+    auto noise = [&] {
+        state = state * 1664525u + 1013904223u;
+        return (static_cast<float>(state >> 8) / 16777216.0f - 0.5f) * 0.6f;
+    };
+    for (std::size_t p = 0; p < raw.valid.size(); ++p) {
+        const float x = noise(), y = noise(), z = -1.0f;
+        const float len = std::sqrt(x * x + y * y + z * z);
+        raw.nx[p] = x / len;
+        raw.ny[p] = y / len;
+        raw.nz[p] = z / len;
+        raw.valid[p] = p % 97 != 0;
+    }
+    NormalMap smooth;
+    std::vector<float> scratch;
+    smooth_normals(raw, 3, scratch, smooth);
+    double raw_err = 0, smooth_err = 0;
+    std::size_t n = 0;
+    for (std::size_t p = 0; p < raw.valid.size(); ++p) {
+        EXPECT_EQ(smooth.valid[p], raw.valid[p]);
+        if (!raw.valid[p]) continue;
+        EXPECT_NEAR(smooth.nx[p] * smooth.nx[p] + smooth.ny[p] * smooth.ny[p] + smooth.nz[p] * smooth.nz[p], 1.0f, 1e-4f);
+        raw_err += std::acos(std::min(1.0f, -raw.nz[p]));
+        smooth_err += std::acos(std::min(1.0f, -smooth.nz[p]));
+        ++n;
+    }
+    EXPECT_LT(smooth_err, 0.35 * raw_err);
+    EXPECT_THROW(smooth_normals(raw, 0, scratch, smooth), ParamError);
+}

@@ -212,3 +212,65 @@ TEST(ObjectTracker, SceneCut_StartsNewTracks) {
     }
     EXPECT_EQ(tracker.scene_cuts(), 1);
 }
+
+// Objects rearranged between two shots while the table stays (the OSD captures): most
+// object pixels see another surface, so the tracks restart although most of the image (the
+// table) did not move; one object sliding a little does not.
+TEST(ObjectTracker, ObjectsRearranged_StartNewTracks_ASlidingObjectDoesNot) {
+    auto run = [](int shift_px) {
+        ObjectTracker tracker(ObjectParams{});
+        OrganizedCloud cloud;
+        cloud.resize(80, 60);
+        const std::size_t N = 80 * 60;
+        LabelImage segments{80, 60, std::vector<std::uint16_t>(N, 0)}, objects;
+        std::vector<DetectedObject> list;
+        for (int frame = 0; frame < 2; ++frame) {
+            const int x0 = 20 + frame * shift_px;
+            for (std::size_t p = 0; p < N; ++p) {
+                const int u = static_cast<int>(p % 80), v = static_cast<int>(p / 80);
+                const bool object = u >= x0 && u < x0 + 20 && v >= 20 && v < 40;
+                cloud.valid[p] = 1;
+                cloud.z[p] = object ? 1.0f : 1.3f;  // a 20 x 20 px block 30 cm before the table
+                segments.labels[p] = object ? 1 : 0;
+            }
+            tracker.step(cloud, segments, 1, LabelImage{}, objects, list);
+            EXPECT_EQ(list.size(), 1u);
+        }
+        return std::pair(tracker.scene_cuts(), list.empty() ? 0 : list[0].track_id);
+    };
+    const auto moved_far = run(30);   // the block is elsewhere: all its pixels changed
+    EXPECT_EQ(moved_far.first, 1);
+    EXPECT_EQ(moved_far.second, 2);
+    const auto slid = run(3);         // 3 of 20 columns changed: the same object, moved
+    EXPECT_EQ(slid.first, 0);
+    EXPECT_EQ(slid.second, 1);
+}
+
+// A pixel whose surface changed forgets its weights: with psi = 0.5 a pixel that held the
+// left object for many frames would need two frames of evidence to change object, but when
+// the other object arrives over it (depth moved) it changes at once.
+TEST(ObjectTracker, PixelWhoseSurfaceChanged_TakesTheNewObjectAtOnce) {
+    ObjectTracker tracker(ObjectParams{});
+    OrganizedCloud cloud;
+    cloud.resize(60, 20);
+    const std::size_t N = 60 * 20;
+    LabelImage segments{60, 20, std::vector<std::uint16_t>(N, 0)}, objects;
+    std::vector<DetectedObject> list;
+    // Two blocks side by side at 1 m; then the right one grows over columns 25-29, which
+    // come 10 cm nearer (a new surface), while the left one keeps columns 10-24.
+    for (int frame = 0; frame < 6; ++frame) {
+        const int boundary = frame < 5 ? 30 : 25;
+        for (std::size_t p = 0; p < N; ++p) {
+            const int u = static_cast<int>(p % 60);
+            cloud.valid[p] = 1;
+            cloud.z[p] = (frame == 5 && u >= 25 && u < 30) ? 0.9f : 1.0f;
+            segments.labels[p] = u < 10 ? 0 : (u < boundary ? 1 : 2);
+        }
+        tracker.step(cloud, segments, 2, LabelImage{}, objects, list);
+    }
+    ASSERT_EQ(list.size(), 2u);
+    const std::uint16_t right = objects.labels[45], left = objects.labels[15];
+    EXPECT_NE(right, left);
+    for (int u = 25; u < 30; ++u) EXPECT_EQ(objects.labels[static_cast<std::size_t>(u)], right) << u;
+    EXPECT_EQ(tracker.scene_cuts(), 0);
+}

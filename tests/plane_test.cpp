@@ -9,6 +9,7 @@
 #include "wul3d/background.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/segmentation.hpp"
 
 using namespace wul3d;
 using namespace wul3d::test;
@@ -166,5 +167,77 @@ TEST(RemoveSupportPlane, RealUncroppedTabletops_ChoosesTheTableUnderTheObjects) 
         }
         EXPECT_GT(kept, 5000u);
         EXPECT_LT(static_cast<double>(kept) / static_cast<double>(active), 0.45);
+    }
+}
+
+// A container's inside seen through its opening: a patch enclosed by a box's pixels is
+// replaced by the table surface raised by `lift` (a bowl's inner bottom). Raised by 6 mm it
+// is given back to the objects (kPlaneInside) and segmentation joins it to the box; flush
+// with the table it is table seen through a gap, and goes.
+TEST(RemoveSupportPlane, EnclosedPatchAboveThePlane_IsAContainersInside) {
+    for (const float lift : {0.006f, 0.0f}) {
+        SCOPED_TRACE(lift);
+        Scene s = pitched_tabletop_scene();
+        SceneBox box;
+        box.x = 0.0f;
+        box.z = 1.0f;
+        box.w = box.d = 0.25f;
+        box.h = 0.1f;
+        s.boxes = {box};
+        std::vector<int> truth;
+        Prepared f;
+        f.frame = render_scene(s, &truth);
+        prepare(f);
+        PlaneWorkspace ws;
+        std::vector<std::uint8_t> classes;
+        const PlaneResult first = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
+                                                       f.normals, f.active, ws, classes);
+        ASSERT_TRUE(first.found);
+        // The patch: box pixels at least 12 px inside the box's image region.
+        const int W = f.cloud.width, H = f.cloud.height;
+        std::vector<std::uint8_t> patch(truth.size(), 0);
+        std::size_t patch_size = 0;
+        for (int v = 12; v < H - 12; ++v)
+            for (int u = 12; u < W - 12; ++u) {
+                bool inside = true;
+                for (int d = -12; d <= 12 && inside; d += 3)
+                    inside = truth[static_cast<std::size_t>(v + d) * W + u] == kTruthBox0 &&
+                             truth[static_cast<std::size_t>(v) * W + u + d] == kTruthBox0;
+                if (!inside) continue;
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                // Move the point along its ray onto the plane raised by `lift`.
+                const Plane& pl = first.support;
+                const float dx = f.cloud.x[p] / f.cloud.z[p], dy = f.cloud.y[p] / f.cloud.z[p];
+                const float t = (lift - pl.d) / (pl.nx * dx + pl.ny * dy + pl.nz);
+                f.cloud.x[p] = t * dx;
+                f.cloud.y[p] = t * dy;
+                f.cloud.z[p] = t;
+                patch[p] = 1;
+                ++patch_size;
+            }
+        ASSERT_GT(patch_size, 300u);
+        estimate_normals(NormalParams{}, f.cloud, f.normals);
+        remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud, f.normals, f.active, ws, classes);
+        std::size_t inside = 0, removed = 0;
+        for (std::size_t p = 0; p < patch.size(); ++p) {
+            if (!patch[p]) continue;
+            inside += classes[p] == kPlaneInside;
+            removed += classes[p] == kPlaneRemoved;
+        }
+        if (lift > 0) {
+            EXPECT_GT(static_cast<double>(inside) / static_cast<double>(patch_size), 0.9);
+            SegmentWorkspace sws;
+            LabelImage segments;
+            segment_objects(SegmentParams{}, f.cloud, f.normals, classes, LabelImage{}, sws, segments);
+            int box_label = 0;
+            EXPECT_GT(dominant_share(segments.labels, truth, kTruthBox0, &box_label), 0.95);
+            std::size_t joined = 0;
+            for (std::size_t p = 0; p < patch.size(); ++p)
+                joined += patch[p] && segments.labels[p] == box_label;
+            EXPECT_GT(static_cast<double>(joined) / static_cast<double>(patch_size), 0.9);
+        } else {
+            EXPECT_EQ(inside, 0u);
+            EXPECT_GT(static_cast<double>(removed) / static_cast<double>(patch_size), 0.9);
+        }
     }
 }

@@ -33,4 +33,10 @@ struct NormalMap {
 
 void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, NormalMap& out);
 
+/// Normals averaged over a (2 radius + 1)^2 window of valid normals and renormalized: less
+/// sensor noise for tests that compare normals a few pixels apart (segmentation's crease
+/// cuts). Separable running sums, O(N) whatever the radius; a pixel without a normal stays
+/// without one. `scratch` is resized as needed and reused.
+void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out);
+
 }  // namespace wul3d

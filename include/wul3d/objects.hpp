@@ -31,6 +31,17 @@ struct ObjectParams {
                                    ///< both frames moved by over 5 cm, the scene changed (a cut
                                    ///< in the recording, or a folder of unrelated frames): the
                                    ///< weights and tracks start afresh (new track ids); (0, 1]
+    float rearranged_share = 0.4f;  ///< ... and so when more than this share of the pixels
+                                    ///< that held objects saw their surface move (objects
+                                    ///< rearranged between two shots; an object sliding at
+                                    ///< video rate moves a quarter at most); (0, 1]
+    float surface_change_m = 0.02f;    ///< a pixel whose depth moved by more than this plus
+    float surface_change_rel = 0.01f;  ///< this times z^2 since the last frame sees another
+                                       ///< surface: its weights are history of something else
+                                       ///< and are forgotten; > 0 and >= 0
+    float surface_change_rgb = 80.0f;  ///< ... the same when its colour moved by more than
+                                       ///< this (RGB distance, 0-255): a new object at the
+                                       ///< depth of the old one; > 0
 
     void validate() const;  ///< throws ParamError naming the field
 };
@@ -89,6 +100,8 @@ private:
     std::vector<std::uint8_t> has_mu_;    ///< 1 where a pixel's weights are not all zero
     std::vector<std::uint8_t> slot_of_;   ///< arg-max slot + 1 per pixel this frame, 0 none
     std::vector<float> prev_z_;           ///< last frame's depth (0 = none), for scene cuts
+    std::vector<std::uint8_t> prev_rgb_;  ///< last frame's colour, 3 bytes a pixel
+    std::vector<std::uint8_t> changed_;   ///< 1 where the pixel's surface changed this frame
     int scene_cuts_ = 0;
     // per-frame scratch
     std::vector<double> votes_, seg_sums_, obj_sums_;

@@ -37,6 +37,10 @@ struct PlaneParams {
                                    ///< n_y > 0); [-1, 1]
     float max_object_height_m = 0.5f;  ///< points up to this height over the support count as
                                        ///< standing on it; > 0
+    float island_min_height_m = 0.0025f;  ///< an on-plane patch enclosed by object points (a
+                                         ///< bowl's or box's inner bottom) whose mean height
+                                         ///< is above this belongs to the object; > 0
+    float island_max_share = 0.05f;  ///< ... and holds at most this share of the image; [0, 1]
     int hull_margin_px = 12;       ///< objects' feet may lie this far outside the support's
                                    ///< image-space convex hull; >= 0
 
@@ -57,6 +61,7 @@ enum PlaneClass : std::uint8_t {
     kPlaneRemoved = 0,     ///< not active, on or below the support, or off its extent
     kPlaneObject = 1,      ///< above the support and over it: object material
     kPlaneFoot = 2,        ///< on the support's band but not facing like it: maybe a foot
+    kPlaneInside = 3,      ///< on the band but enclosed by object points: a container's inside
 };
 
 struct PlaneResult {
@@ -73,6 +78,8 @@ struct PlaneWorkspace {
     std::vector<double> sums;         ///< per region: count, sum x, y, z, xx, xy, xz, yy, yz, zz
     std::vector<std::uint8_t> hull;   ///< grid-resolution mask of the support's extent
     std::vector<int> hull_points;     ///< (gu, gv) pairs of support inliers
+    std::vector<int> island;          ///< per pixel: on-plane component id + 1, 0 none
+    std::vector<int> queue;
 };
 
 /// Finds the support plane among the `active` points and classifies every pixel

@@ -4,7 +4,8 @@
 /// (plane.hpp). The geometric segmenter cuts the surface where it folds inward (a concave
 /// crease: a per-pixel version of LCCP's convexity test between neighbouring normals) and
 /// where depth jumps, takes connected components, then re-attaches the cut pixels and the
-/// objects' feet to the component they touch. The hybrid segmenter adds the colour cue of
+/// objects' feet to the component they touch and merges segments that meet along a boundary
+/// that is mostly not concave. The hybrid segmenter adds the colour cue of
 /// the paper's weighted clustering where geometry is silent (two flush boxes of different
 /// colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
 #include <cstdint>
@@ -31,12 +32,20 @@ struct SegmentParams {
     float depth_jump_m = 0.004f;    ///< neighbours whose depths differ by more than
     float depth_jump_rel = 0.012f;  ///< depth_jump_m + depth_jump_rel * z^2 are not connected;
                                     ///< > 0 and >= 0 (Kinect depth noise grows with z^2)
-    int crease_step_px = 3;         ///< normals compared this many pixels apart; [1, 16]
-    float concavity = 0.4f;         ///< (n_p - n_q) . (X_q - X_p) / |X_q - X_p| above this is a
+    int crease_step_px = 5;         ///< normals compared this many pixels apart; [1, 16]
+    int normal_smooth_px = 3;       ///< the crease tests use normals averaged over a window of
+                                    ///< this radius (sensor noise); [0, 16], 0 = raw normals
+    float concavity = 0.3f;         ///< (n_p - n_q) . (X_q - X_p) / |X_q - X_p| above this is a
                                     ///< concave crease (LCCP's test, per pixel); > 0
     int reattach_px = 8;            ///< cut pixels and feet join a segment up to this far; >= 0
     int min_seed_points = 40;       ///< components smaller than this before re-attachment are
                                     ///< cut pixels too; >= 1
+    // Merge (LCCP's merge on segments): two segments that meet, with continuous depth, along
+    // a boundary that is mostly not concave were split by noise or a thin convex edge (a
+    // bowl's rim, a box's front edge), not by a junction of two objects.
+    float merge_max_concave = 0.3f;  ///< largest share of concave pairs on such a boundary;
+                                     ///< [0, 1], 0 = never merge
+    int merge_min_boundary = 6;      ///< boundary pairs with a crease test at least; >= 1
     // Colour cue (hybrid): a segment is split in two by the paper's distance (eq. 4, 6) with a
     // colour-heavy alpha when the two parts differ in colour, are each large, meet along a
     // short boundary, and that boundary crosses a smooth surface (no crease: shading on two
@@ -53,6 +62,8 @@ struct SegmentParams {
 
 /// Scratch, sized once per resolution.
 struct SegmentWorkspace {
+    NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
+    std::vector<float> smooth_scratch;
     std::vector<std::uint8_t> cut;     ///< 1 = may seed a component
     std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
     std::vector<int> label;    ///< 0 none, 1..n
@@ -63,12 +74,15 @@ struct SegmentWorkspace {
     std::vector<int> offsets;  ///< counting sort of pixels by label
     std::vector<int> order;
     std::vector<std::uint8_t> part;
+    std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
+    std::vector<int> parent;           ///< union-find over segments
 };
 
 /// What segmentation did, as data.
 struct SegmentStats {
     int segments = 0;      ///< objects written to `out`
     int color_splits = 0;  ///< segments the colour cue split
+    int merges = 0;        ///< segment pairs joined across a non-concave boundary
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached
 };
 
