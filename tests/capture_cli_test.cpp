@@ -108,6 +108,7 @@ TEST_F(FakenectReplay, RecordAndRun_MatchTheOriginalsAndEachOther) {
     EXPECT_NE(s["camera"]["device"].get<std::string>().find("fakenect"), std::string::npos);
 
     std::vector<double> errors_mm;
+    double min_agreement = 1.0;
     std::size_t orig_valid = 0, lost = 0, within = 0, both = 0;
     std::size_t orig_in_view = 0, lost_in_view = 0;  // pixels the IR camera can see
     const wul3d::StereoCalibration k1 = wul3d::kinect_v1_calibration();
@@ -153,9 +154,11 @@ TEST_F(FakenectReplay, RecordAndRun_MatchTheOriginalsAndEachOther) {
             within += err_mm <= 0.5 * wul3d::kinect_v1_step_m(z) * 1000.0 + 1.0;
         }
         // Labels: `run --camera` against `run` on the recorded frames.
-        for (const char* file : {"labels.png", "objects.png"})
-            EXPECT_GE(label_agreement(live / name / file, replay / name / file), 0.99)
-                << name << "/" << file;
+        for (const char* file : {"labels.png", "objects.png"}) {
+            const double agree = label_agreement(live / name / file, replay / name / file);
+            min_agreement = std::min(min_agreement, agree);
+            EXPECT_GE(agree, 0.99) << name << "/" << file;
+        }
     }
     ASSERT_GT(both, 0u);
     std::sort(errors_mm.begin(), errors_mm.end());
@@ -170,7 +173,8 @@ TEST_F(FakenectReplay, RecordAndRun_MatchTheOriginalsAndEachOther) {
               << 100.0 * within_share << " % within half a raw step + 1 mm; "
               << 100.0 * lost_share << " % of the original depth pixels lost ("
               << 100.0 * lost_in_view_share << " % of those the IR camera sees)"
-              << std::endl;
+              << "; labels of run --camera vs run on the recorded frames: "
+              << 100.0 * min_agreement << " % of pixels the same (worst frame)" << std::endl;
     EXPECT_GE(within_share, 0.95);
     // Most of the loss is the border of the colour image that the Kinect v1's IR camera does
     // not see (the RGB camera's view is wider); the rest is the shadow beside objects, seen
