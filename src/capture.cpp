@@ -20,7 +20,7 @@ struct Backend {
     std::unique_ptr<CameraDevice> (*open)(const std::string&);
 };
 
-std::unique_ptr<CameraDevice> not_built(const std::string&) { return nullptr; }
+[[maybe_unused]] std::unique_ptr<CameraDevice> not_built(const std::string&) { return nullptr; }
 
 const Backend kBackends[] = {
 #ifdef WUL3D_WITH_FREENECT
