@@ -32,14 +32,16 @@ namespace {
 const char* const kNoHang = "60";  // seconds: every command here runs under `timeout`
 
 /// The wul3d command under `timeout`, optionally through fakenect replaying `dump`.
-CommandResult wul3d_cmd(const std::vector<std::string>& args, const std::string& dump = "") {
+CommandResult wul3d_cmd(const std::vector<std::string>& args, const std::string& dump = "",
+                        std::vector<wul3d::test::EnvChange> env = {}) {
     std::vector<std::string> argv = {"timeout", kNoHang};
     if (!dump.empty()) argv.insert(argv.end(), {"fakenect", dump});
     argv.push_back(wul3d::test::cli_path().string());
     argv.insert(argv.end(), args.begin(), args.end());
     // Without fakenect the real libfreenect must be used: no dump path inherited.
-    return run_command(argv, {{"FAKENECT_PATH", dump.empty() ? std::nullopt
-                                                             : std::optional<std::string>(dump)}});
+    env.emplace_back("FAKENECT_PATH",
+                     dump.empty() ? std::nullopt : std::optional<std::string>(dump));
+    return run_command(argv, env);
 }
 
 bool have_fakenect() { return run_command({"sh", "-c", "command -v fakenect"}).exit_code == 0; }
@@ -249,10 +251,18 @@ TEST(CaptureCli, NoKinect_OneLineExit2) {
 
 TEST(CaptureCli, NoOpenNI2Device_OneLineExit2) {
     TempDir tmp;
-    expect_one_line_exit_2(wul3d_cmd({"run", "--camera", "openni2", "--out", (tmp / "o").string()}),
+    // Leak checking is off for these processes: OpenNI2 loads its device drivers with dlopen
+    // and they keep allocations from their static initializers until they are unloaded at
+    // shutdown, so LeakSanitizer reports them from an unknown module that no suppression can
+    // name (measured: about 110 kB in 1 500 blocks, all under dl_init). wul3d's own capture
+    // code is leak-checked by the freenect and scripted-camera tests.
+    const std::vector<wul3d::test::EnvChange> no_leak_check = {{"ASAN_OPTIONS", "detect_leaks=0"}};
+    expect_one_line_exit_2(wul3d_cmd({"run", "--camera", "openni2", "--out", (tmp / "o").string()},
+                                     "", no_leak_check),
                            "no OpenNI2 device found");
     expect_one_line_exit_2(
-        wul3d_cmd({"run", "--camera", "openni2:/nonexistent/take.oni", "--out", (tmp / "o").string()}),
+        wul3d_cmd({"run", "--camera", "openni2:/nonexistent/take.oni", "--out", (tmp / "o").string()},
+                  "", no_leak_check),
         "/nonexistent/take.oni: no such file");
 }
 
