@@ -5,9 +5,9 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <exception>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -263,7 +263,8 @@ void run(const RunOptions& o) {
         per_frame.push_back(std::move(f));
         ++i;
         progress.update(i, 1000.0 / std::max(1e-9, median(compute_ms)));
-        if (video) video->write(frame, r, selection ? &selected_mask : nullptr, i - 1, n_total,
+        if (video) video->write(frame, r, selection ? &selected_mask : nullptr, i - 1,
+                                n_total ? n_total : i,  // live without --frames: no end known
                                 1000.0 / std::max(1e-9, median(compute_ms)));
     }
     const std::size_t n_frames = i;
