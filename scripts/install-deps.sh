@@ -16,6 +16,9 @@
 #                                                  GLFW/OpenGL 3 backends); built only when found
 #   xvfb xauth libgl1-mesa-dri                     the viewer's test: a virtual X server (xvfb-run)
 #                                                  and Mesa's software OpenGL
+#   libfreenect-dev libopenni2-dev                 live cameras: Kinect v1 (libfreenect), OpenNI2 devices
+#                                                  and .oni files; each backend built only when found
+#   libfreenect-bin                                fakenect: the capture tests replay a Kinect v1 dump
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -40,6 +43,9 @@ packages=(
   xvfb
   xauth
   libgl1-mesa-dri
+  libfreenect-dev
+  libfreenect-bin
+  libopenni2-dev
 )
 
 missing=()

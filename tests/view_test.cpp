@@ -158,3 +158,24 @@ TEST(ViewCommand, ScreenshotUnderXvfb_ClusterColoursWhereTheObjectsAre) {
 #endif
 
 }  // namespace
+
+// `view --camera freenect` under fakenect: the live path of the viewer plays the replayed
+// sample frames (exported with export-fakenect) and writes its screenshot.
+TEST(ViewCommand, LiveCameraUnderFakenect_PlaysAndScreenshots) {
+    if (!WUL3D_VIEWER_BUILT) GTEST_SKIP() << "built without viewer support";
+    ASSERT_TRUE(in_path("xvfb-run")) << "xvfb-run not found (scripts/install-deps.sh)";
+    ASSERT_TRUE(in_path("fakenect")) << "fakenect not found: install libfreenect-bin";
+    TempDir tmp;
+    const fs::path dump = tmp / "dump", shot = tmp / "live.png";
+    const CommandResult e = wul3d::test::run_cli(
+        {"export-fakenect", (sample_dir() / "uois_tabletop").string(), dump.string()});
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    const auto r = run_with_env(
+        {"timeout", "120", "xvfb-run", "-a", "-s", "-screen 0 1600x900x24", "fakenect",
+         dump.string(), cli_path().string(), "view", "--camera", "freenect", "--lossless",
+         "--screenshot", shot.string(), "--exit-after", "3"},
+        {{"LIBGL_ALWAYS_SOFTWARE", "1"}, {"ASAN_OPTIONS", "detect_leaks=0"}});
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_TRUE(fs::is_regular_file(shot)) << r.out;
+    EXPECT_NE(r.out.find("clusters panel at "), std::string::npos) << r.out;
+}

@@ -11,6 +11,8 @@ void add_run_command(CLI::App& app);
 void add_bench_command(CLI::App& app);  ///< `wul3d bench` (bench_command.cpp)
 void add_eval_command(CLI::App& app);
 void add_view_command(CLI::App& app);  ///< `wul3d view` (view_command.cpp or view_unavailable.cpp)
+void add_record_command(CLI::App& app);           ///< `wul3d record` (record_command.cpp)
+void add_export_fakenect_command(CLI::App& app);  ///< `wul3d export-fakenect`
 
 /// Prints "wul3d: <message>" as one line on stderr and returns `code`.
 int report(const std::exception& e, int code);

@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
     wul3d::cli::add_bench_command(app);
     wul3d::cli::add_eval_command(app);
     wul3d::cli::add_view_command(app);
+    wul3d::cli::add_record_command(app);
+    wul3d::cli::add_export_fakenect_command(app);
     try {
         try {
             app.parse(argc, argv);

@@ -30,8 +30,14 @@ std::vector<double> parse_numbers(const std::string& flag, const std::string& te
 }
 
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
-    cmd->add_option("input", o.input, "Frame folder(s), TUM RGB-D sequence, or unregistered frames")
-        ->required();
+    cmd->add_option("input", o.input,
+                    "Frame folder(s), TUM RGB-D sequence, or unregistered frames (or --camera)");
+    cmd->add_option("--camera", o.camera,
+                    "Live camera instead of INPUT: freenect[:INDEX] (Kinect v1), "
+                    "openni2[:URI|FILE.oni], freenect2[:SERIAL], realsense[:SERIAL]");
+    cmd->add_flag("--lossless", o.lossless,
+                  "With --camera: capture waits for processing instead of dropping frames "
+                  "(for replays: fakenect, .oni)");
     cmd->add_option("--format", o.format, "auto|frames|tum|unregistered")->capture_default_str();
     cmd->add_option("--preset", o.preset, "paper: the paper's parameters");
     cmd->add_option("--k", o.k, "Number of clusters (default 7)");

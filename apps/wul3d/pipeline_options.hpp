@@ -15,7 +15,9 @@
 namespace wul3d::cli {
 
 struct PipelineOptions {
-    std::string input;
+    std::string input;   // a recording, or
+    std::string camera;  // --camera BACKEND[:ARG], a live camera (capture.hpp)
+    bool lossless = false;  // --lossless: capture waits for processing (replays, tests)
     std::string format = "auto";
     std::string preset;
     std::string tum_camera;
@@ -32,7 +34,7 @@ struct PipelineOptions {
     std::optional<std::uint64_t> seed;
 };
 
-/// Registers the input positional and every shared option on `cmd`.
+/// Registers the input positional (or --camera) and every shared option on `cmd`.
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o);
 
 /// The preset, then every parameter given; validated (ParamError names the flag's field).

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "frame_feed.hpp"
 #include "pipeline_options.hpp"
 #include "video_writer.hpp"
 #include "wul3d/error.hpp"
@@ -60,8 +62,13 @@ public:
         : total_(total), enabled_(enabled && ::isatty(STDERR_FILENO)) {}
     void update(std::size_t done, double fps) {
         if (!enabled_) return;
+        if (total_ == 0) {  // a live camera: no end known
+            std::cerr << "\r" << done << " frames  " << std::fixed << std::setprecision(1) << fps
+                      << " FPS" << std::flush;
+            return;
+        }
         const int width = 30;
-        const int filled = total_ ? static_cast<int>(width * done / total_) : width;
+        const int filled = static_cast<int>(width * done / total_);
         std::cerr << "\r[" << std::string(filled, '#') << std::string(width - filled, ' ')
                   << "] " << done << "/" << total_ << "  " << std::fixed << std::setprecision(1)
                   << fps << " FPS" << std::flush;
@@ -147,9 +154,12 @@ void run(const RunOptions& o) {
     }
     apply_threads(o.pipeline);
 
-    auto source = open_source(o.pipeline.input, source_options);
-    const std::size_t n_frames =
-        o.max_frames ? std::min(o.max_frames, source->size()) : source->size();
+    install_stop_signals();
+    FrameFeed feed(o.pipeline, source_options);
+    // A recording has a known length; a camera runs until --frames, Ctrl-C or its end.
+    const std::size_t n_total =
+        feed.live() ? o.max_frames
+                    : (o.max_frames ? std::min(o.max_frames, feed.size()) : feed.size());
 
     const fs::path out_dir(o.out_dir);
     std::error_code ec;
@@ -165,21 +175,41 @@ void run(const RunOptions& o) {
     std::vector<double> compute_ms;
     nlohmann::json per_frame = nlohmann::json::array();
     bool said_depth_only = false;
-    Progress progress(n_frames, !o.quiet);
+    Progress progress(n_total, !o.quiet);
     using Clock = std::chrono::steady_clock;
     const auto run_start = Clock::now();
     std::optional<RunVideo> video;
     if (!o.video.empty()) video.emplace(o.video);
 
-    for (std::size_t i = 0; i < n_frames; ++i) {
-        source->read(i, item);
+    std::size_t i = 0;  // frames processed
+    std::string stopped_by = "end";
+    std::exception_ptr lost;  // DeviceLost: rethrown (exit 3) once the outputs are final
+    for (;;) {
+        if (n_total && i >= n_total) {
+            stopped_by = feed.live() || n_total < feed.size() ? "frames" : "end";
+            break;
+        }
+        FrameFeed::Status status;
+        try {
+            status = feed.next(item);
+        } catch (const DeviceLost&) {
+            lost = std::current_exception();
+            stopped_by = "device_lost";
+            break;
+        }
+        if (status == FrameFeed::Status::End) break;
+        if (status == FrameFeed::Status::Stopped) {
+            stopped_by = "signal";
+            break;
+        }
+        const std::string name = feed.name();
         const FrameResult& r = item.is_raw
-                                   ? pipeline.process(item.raw, *source->calibration(),
+                                   ? pipeline.process(item.raw, *feed.calibration(),
                                                       source_options.registration)
                                    : pipeline.process(item.frame);
         const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
         if (!frame.has_color() && !said_depth_only) {
-            std::cerr << "wul3d: note: " << source->name(i)
+            std::cerr << "wul3d: note: " << name
                       << " has no colour image; clustering on position and normals only\n";
             said_depth_only = true;
         }
@@ -201,7 +231,7 @@ void run(const RunOptions& o) {
         }
 
         const auto t_out = Clock::now();
-        write_frame(out_dir, source->name(i), pipeline, r, selection ? &selected_mask : nullptr,
+        write_frame(out_dir, name, pipeline, r, selection ? &selected_mask : nullptr,
                     selected_object ? &selected_object_mask : nullptr,
                     object_selected ? selected_object->label() : 0, o.ply);
         const double out_ms =
@@ -218,7 +248,7 @@ void run(const RunOptions& o) {
         stage_ms["objects"].push_back(r.times.objects);
         stage_ms["output"].push_back(out_ms);
         compute_ms.push_back(r.times.total());
-        nlohmann::json f = {{"name", source->name(i)},
+        nlohmann::json f = {{"name", name},
                             {"points", r.stats.points},
                             {"active_points", r.active_points},
                             {"seeded", r.stats.seeded},
@@ -231,10 +261,13 @@ void run(const RunOptions& o) {
                             {"objects", r.object_list.size()}};
         if (selection) f["selected_pixels"] = selection->pixels();
         per_frame.push_back(std::move(f));
-        progress.update(i + 1, 1000.0 / std::max(1e-9, median(compute_ms)));
-        if (video) video->write(frame, r, selection ? &selected_mask : nullptr, i, n_frames,
+        ++i;
+        progress.update(i, 1000.0 / std::max(1e-9, median(compute_ms)));
+        if (video) video->write(frame, r, selection ? &selected_mask : nullptr, i - 1,
+                                n_total ? n_total : i,  // live without --frames: no end known
                                 1000.0 / std::max(1e-9, median(compute_ms)));
     }
+    const std::size_t n_frames = i;
     progress.finish();
     if (video) video->close();
 
@@ -245,8 +278,18 @@ void run(const RunOptions& o) {
         std::chrono::duration<double>(Clock::now() - run_start).count();
     const auto& c = params.cluster;
     nlohmann::json summary;
-    summary["input"] = o.pipeline.input;
-    summary["format"] = input_format_name(source->format());
+    if (feed.live()) {
+        summary["input"] = nullptr;
+        summary["camera"] = {{"spec", o.pipeline.camera},
+                             {"device", feed.description()},
+                             {"lossless", o.pipeline.lossless}};
+        summary["frames_captured"] = feed.captured();
+        summary["frames_dropped"] = feed.dropped();
+    } else {
+        summary["input"] = o.pipeline.input;
+    }
+    summary["format"] = feed.format();
+    summary["stopped_by"] = stopped_by;
     summary["parameters"] = {{"k", c.k},
                              {"alpha", c.alpha},
                              {"delta", c.delta},
@@ -280,16 +323,23 @@ void run(const RunOptions& o) {
               << (n_frames == 1 ? "" : "s") << ", k = " << c.k << ": " << fps << " FPS ("
               << ms << " ms/frame without disk I/O), peak " << std::setprecision(0) << rss
               << " MB -> " << o.out_dir << std::endl;
+    restore_signals();
+    if (lost) std::rethrow_exception(lost);
+    if (stopped_by == "signal")
+        std::cerr << "wul3d: stopped by a signal after " << n_frames << " frames; outputs complete\n";
+    else if (feed.live() && n_frames == 0)
+        throw InputError(feed.description() + ": ended before the first frame");
 }
 
 }  // namespace
 
 void add_run_command(CLI::App& app) {
     auto opts = std::make_shared<RunOptions>();
-    CLI::App* cmd = app.add_subcommand("run", "Detect objects in an RGB-D recording");
+    CLI::App* cmd = app.add_subcommand("run", "Detect objects in an RGB-D recording or from a live camera (--camera)");
     add_pipeline_options(cmd, opts->pipeline);
     cmd->add_option("-o,--out", opts->out_dir, "Output folder")->required();
-    cmd->add_option("--frames", opts->max_frames, "Stop after N frames (default: all)")
+    cmd->add_option("--frames", opts->max_frames,
+                    "Stop after N frames (default: all; with --camera: until Ctrl-C or its end)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_option("--video", opts->video,

@@ -7,6 +7,7 @@
 #include "cli.hpp"
 #include "pipeline_options.hpp"
 #include "viewer_app.hpp"
+#include "wul3d/capture.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d::cli {
@@ -21,6 +22,13 @@ struct ViewOptions {
 ViewerConfig make_config(const ViewOptions& o) {
     ViewerConfig c;
     c.input = o.pipeline.input;
+    c.camera = o.pipeline.camera;
+    c.lossless = o.pipeline.lossless;
+    if (c.camera.empty() == c.input.empty())
+        throw ParamError(c.camera.empty() ? "an INPUT or --camera is required"
+                                          : "give an INPUT or --camera, not both");
+    if (c.lossless && c.camera.empty()) throw ParamError("--lossless needs --camera");
+    if (!c.camera.empty()) parse_camera_spec(c.camera);  // an unknown backend: exit 2 now
     c.params = make_pipeline_params(o.pipeline);
     c.source = make_source_options(o.pipeline);
     c.select = selected_pixel(o.pipeline);

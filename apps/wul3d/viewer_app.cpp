@@ -20,8 +20,10 @@
 #include <string>
 #include <vector>
 
+#include "frame_feed.hpp"
 #include "video_writer.hpp"
 #include "viewer_gl.hpp"
+#include "wul3d/capture.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/objects.hpp"
 #include "wul3d/visualization.hpp"
@@ -114,7 +116,22 @@ class Viewer {
 public:
     Viewer(const ViewerConfig& config, GLFWwindow* window)
         : cfg_(config), window_(window), params_(config.params), pending_(config.params) {
-        source_ = open_source(cfg_.input, cfg_.source);
+        if (cfg_.camera.empty()) {
+            source_ = open_source(cfg_.input, cfg_.source);
+        } else {
+            LiveOptions live;
+            live.lossless = cfg_.lossless;
+            live_ = std::make_unique<LiveSource>(open_camera(parse_camera_spec(cfg_.camera)), live);
+            // The first frame, before the window shows anything: a camera that delivers none
+            // ends in DeviceLost (LiveOptions::stall_timeout), a replay that ends in InputError.
+            for (;;) {
+                const LiveSource::Next r = live_->next(item_, std::chrono::milliseconds(100));
+                if (r == LiveSource::Next::Frame) break;
+                if (r == LiveSource::Next::End)
+                    throw InputError(live_->description() + ": ended before the first frame");
+                if (stop_requested()) throw InputError("stopped before the first frame");
+            }
+        }
         delta_is_one_minus_alpha_ =
             std::abs(params_.cluster.alpha + params_.cluster.delta - 1.0f) < 1e-6f;
         pipeline_ = std::make_unique<Pipeline>(params_);
@@ -149,7 +166,9 @@ private:
 
     ViewerConfig cfg_;
     GLFWwindow* window_;
-    std::unique_ptr<FrameSource> source_;
+    std::unique_ptr<FrameSource> source_;  // a recording, or
+    std::unique_ptr<LiveSource> live_;     // a live camera (newest frame wins)
+    bool live_ended_ = false;              // a replayed camera reached its end
     SourceItem item_;
     std::unique_ptr<Pipeline> pipeline_;
     PipelineParams params_;   // what the pipeline runs with
@@ -193,9 +212,11 @@ private:
 // ---- frames --------------------------------------------------------------------------------
 
 void Viewer::process(std::size_t index) {
-    source_->read(index, item_);
+    // Live: item_ already holds the frame (taken from the camera, or the one on screen).
+    if (!live_) source_->read(index, item_);
+    const StereoCalibration* calibration = live_ ? live_->calibration() : source_->calibration();
     const auto run_once = [&]() -> const FrameResult& {
-        return item_.is_raw ? pipeline_->process(item_.raw, *source_->calibration(),
+        return item_.is_raw ? pipeline_->process(item_.raw, *calibration,
                                                  cfg_.source.registration)
                             : pipeline_->process(item_.frame);
     };
@@ -400,9 +421,16 @@ void Viewer::draw_controls(const Rect& area) {
     ImGui::SetNextWindowSize(ImVec2(area.w, area.h));
     ImGui::Begin("wul3d view", nullptr, kPanelFlags & ~ImGuiWindowFlags_NoScrollbar &
                                             ~ImGuiWindowFlags_NoScrollWithMouse);
-    const std::size_t n = source_->size();
-    ImGui::TextWrapped("%s", cfg_.input.c_str());
-    ImGui::Text("frame %zu / %zu   %s", current_ + 1, n, frame_->name.c_str());
+    if (live_) {
+        ImGui::TextWrapped("%s", live_->description().c_str());
+        ImGui::Text("%s   %llu captured, %llu dropped%s", frame_->name.c_str(),
+                    static_cast<unsigned long long>(live_->captured()),
+                    static_cast<unsigned long long>(live_->dropped()),
+                    live_ended_ ? ", ended" : "");
+    } else {
+        ImGui::TextWrapped("%s", cfg_.input.c_str());
+        ImGui::Text("frame %zu / %zu   %s", current_ + 1, source_->size(), frame_->name.c_str());
+    }
 
     if (ImGui::CollapsingHeader("Playback", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (ImGui::Button(playing_ ? "Pause" : "Play", ImVec2(70, 0))) playing_ = !playing_;
@@ -580,8 +608,12 @@ void Viewer::draw_cloud(const Rect& area) {
     dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(tex)), pos,
                  ImVec2(pos.x + size.x, pos.y + size.y), ImVec2(0, 1), ImVec2(1, 0));
     char line[160];
-    std::snprintf(line, sizeof line, "frame %zu/%zu  %s   k = %d", current_ + 1,
-                  source_->size(), frame_->name.c_str(), params_.cluster.k);
+    if (live_)
+        std::snprintf(line, sizeof line, "live  %s   k = %d", frame_->name.c_str(),
+                      params_.cluster.k);
+    else
+        std::snprintf(line, sizeof line, "frame %zu/%zu  %s   k = %d", current_ + 1,
+                      source_->size(), frame_->name.c_str(), params_.cluster.k);
     dl->AddText(ImVec2(pos.x + 10, pos.y + 8), IM_COL32(235, 235, 235, 255), line);
     dl->AddText(ImVec2(pos.x + 10, pos.y + size.y - 22), IM_COL32(150, 155, 165, 255),
                 "left drag: orbit   right drag: pan   wheel: zoom   R: reset   click: select");
@@ -647,24 +679,43 @@ void Viewer::take_screenshot(const std::string& path, bool scripted) {
 void Viewer::run() {
     last_frame_time_ = Clock::now();
     int settle = 0;  // UI frames drawn after the last scripted frame (layout settles in two)
-    while (!glfwWindowShouldClose(window_)) {
+    install_stop_signals();
+    while (!glfwWindowShouldClose(window_) && !stop_requested()) {
         glfwPollEvents();
         handle_keys();
 
-        const std::size_t n = source_->size();
-        const bool at_end = current_ + 1 >= n;
         const bool scripted_done = scripted_ && played_ >= static_cast<std::size_t>(cfg_.exit_after);
-        const double since =
-            std::chrono::duration<double>(Clock::now() - last_frame_time_).count();
-        const bool due = playing_ && !scripted_done && (!at_end || loop_) &&
-                         (scripted_ || !real_time_ || since >= 1.0 / kRecordingFps);
-        if (due || step_) {
-            last_frame_time_ = Clock::now();
-            process(at_end ? 0 : current_ + 1);
-        } else if (params_dirty_ && !playing_) {
-            process(current_);  // paused: show the new parameters on this frame
+        if (live_) {
+            // The camera sets the pace: take the newest frame when there is one. DeviceLost
+            // propagates (exit 3).
+            if ((playing_ || step_) && !scripted_done && !live_ended_) {
+                const LiveSource::Next r = live_->next(item_, std::chrono::milliseconds(5));
+                if (r == LiveSource::Next::Frame) {
+                    process(current_ + 1);
+                    step_ = false;
+                } else if (r == LiveSource::Next::End) {
+                    live_ended_ = true;
+                    status_ = "the camera's replay ended";
+                    if (scripted_) break;
+                }
+            } else if (params_dirty_) {
+                process(current_);  // paused: the new parameters on the frame on screen
+            }
+        } else {
+            const std::size_t n = source_->size();
+            const bool at_end = current_ + 1 >= n;
+            const double since =
+                std::chrono::duration<double>(Clock::now() - last_frame_time_).count();
+            const bool due = playing_ && !scripted_done && (!at_end || loop_) &&
+                             (scripted_ || !real_time_ || since >= 1.0 / kRecordingFps);
+            if (due || step_) {
+                last_frame_time_ = Clock::now();
+                process(at_end ? 0 : current_ + 1);
+            } else if (params_dirty_ && !playing_) {
+                process(current_);  // paused: show the new parameters on this frame
+            }
+            step_ = false;
         }
-        step_ = false;
 
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
@@ -707,12 +758,14 @@ void Viewer::run() {
         }
         glfwSwapBuffers(window_);
     }
+    restore_signals();
 }
 
 }  // namespace
 
 void run_viewer(const ViewerConfig& config) {
-    const std::string title = "wul3d view: " + config.input;
+    const std::string title =
+        "wul3d view: " + (config.camera.empty() ? config.input : "--camera " + config.camera);
     GlfwWindow window(config.width, config.height, title);
     ImGuiSession ui(window.window);
     Viewer viewer(config, window.window);

@@ -12,7 +12,9 @@
 namespace wul3d::cli {
 
 struct ViewerConfig {
-    std::string input;
+    std::string input;       ///< a recording, or
+    std::string camera;      ///< --camera BACKEND[:ARG]: a live camera (capture.hpp)
+    bool lossless = false;   ///< --lossless: capture waits for the viewer (replays)
     SourceOptions source;
     PipelineParams params;
     std::optional<std::pair<int, int>> select;  ///< follow the object under (u, v)

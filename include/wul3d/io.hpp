@@ -51,6 +51,13 @@ void write_depth_png(const std::string& path, const DepthImage& depth);       //
 /// (uchar, the eq. 9 display colour), label (ushort).
 void write_ply(const std::string& path, const OrganizedCloud& cloud, const LabelImage& labels,
                const ColorImage& colors);
+/// `intrinsics.json` (the format read_intrinsics_json reads), doubles written exactly.
+void write_intrinsics_json(const std::string& path, const PinholeIntrinsics& intrinsics,
+                           float depth_scale_m_per_unit);
+/// One frame folder that `open_source` reads back as the same frame: DIR/depth.png,
+/// DIR/intrinsics.json, DIR/color.png (if the frame has colour). Written as DIR.partial,
+/// then renamed, so the folder is complete or absent.
+void write_frame_folder(const std::string& dir, const RgbdFrame& frame);
 /// Writes text (JSON) atomically.
 void write_text_file(const std::string& path, const std::string& text);
 

@@ -1,0 +1,63 @@
+#pragma once
+// Where `run`, `record` and `view` take their frames from: a recording (FrameSource, one
+// frame after the other) or a live camera (LiveSource: its own capture thread, newest frame
+// wins). Also the stop request of SIGINT/SIGTERM, so that a stopped run still finalizes its
+// outputs.
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "pipeline_options.hpp"
+#include "wul3d/capture.hpp"
+#include "wul3d/io.hpp"
+
+namespace wul3d::cli {
+
+/// Catches SIGINT and SIGTERM: the first sets the stop request (a second one kills, as by
+/// default). Call once before a loop that polls stop_requested().
+void install_stop_signals();
+bool stop_requested();
+/// Puts the default handlers back.
+void restore_signals();
+
+class FrameFeed {
+public:
+    enum class Status {
+        Frame,   ///< `item` holds the next frame, named `name()`
+        End,     ///< the recording or the replay ended
+        Stopped, ///< SIGINT/SIGTERM
+    };
+
+    /// From `o.camera` when given (live), else `o.input` with `source` (recording).
+    FrameFeed(const PipelineOptions& o, const SourceOptions& source);
+
+    /// Blocks until the next frame, the end, or a stop request (polled every 100 ms).
+    /// Throws DeviceLost when the camera disappears, InputError for a damaged recording.
+    Status next(SourceItem& item);
+    /// Waits at most `timeout` (live: newest frame; recording: reads the next one).
+    /// Returns Frame, End, Stopped, or, live only, no frame yet: `false` in `got`.
+    Status poll(SourceItem& item, std::chrono::milliseconds timeout, bool& got);
+
+    bool live() const { return live_ != nullptr; }
+    const std::string& name() const { return name_; }  ///< name of the last frame
+    const StereoCalibration* calibration() const;
+    /// Recording: its frame count; live: 0 (unknown).
+    std::size_t size() const { return source_ ? source_->size() : 0; }
+    /// "recording" formats (frames, tum, unregistered) or "camera".
+    std::string format() const;
+    std::string description() const;  ///< camera description or input path
+    std::uint64_t captured() const { return live_ ? live_->captured() : index_; }
+    std::uint64_t dropped() const { return live_ ? live_->dropped() : 0; }
+    /// Random access for `view` (recordings only).
+    FrameSource* source() { return source_.get(); }
+
+private:
+    std::unique_ptr<FrameSource> source_;
+    std::unique_ptr<LiveSource> live_;
+    std::string input_;
+    std::size_t index_ = 0;
+    std::string name_;
+};
+
+}  // namespace wul3d::cli

@@ -1,0 +1,48 @@
+// Writing frames in the frame-folder layout (docs/INPUTS.md, section 1), so that a live
+// session recorded with `wul3d record` replays exactly with `wul3d run`.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+
+namespace wul3d {
+namespace fs = std::filesystem;
+
+void write_intrinsics_json(const std::string& path, const PinholeIntrinsics& K,
+                           float depth_scale_m_per_unit) {
+    // nlohmann::json prints doubles with the fewest digits that read back to the same value.
+    const nlohmann::json j = {{"fx", K.fx},         {"fy", K.fy},
+                              {"cx", K.cx},         {"cy", K.cy},
+                              {"width", K.width},   {"height", K.height},
+                              {"depth_scale_m_per_unit", depth_scale_m_per_unit}};
+    write_text_file(path, j.dump(1) + "\n");
+}
+
+void write_frame_folder(const std::string& dir, const RgbdFrame& frame) {
+    const fs::path final_dir(dir);
+    std::string tmp_name = final_dir.filename().string();
+    tmp_name.insert(0, 1, '.');
+    tmp_name.append(".partial");
+    const fs::path tmp_dir = final_dir.parent_path() / tmp_name;
+    std::error_code ec;
+    fs::remove_all(tmp_dir, ec);
+    fs::create_directories(tmp_dir, ec);
+    if (ec) throw IoError(tmp_dir.string() + ": cannot create folder: " + ec.message());
+    try {
+        write_depth_png((tmp_dir / "depth.png").string(), frame.depth);
+        if (frame.has_color()) write_color_png((tmp_dir / "color.png").string(), frame.color);
+        PinholeIntrinsics K = frame.intrinsics;
+        K.width = frame.depth.width;
+        K.height = frame.depth.height;
+        write_intrinsics_json((tmp_dir / "intrinsics.json").string(), K,
+                              frame.depth.scale_m_per_unit);
+        fs::remove_all(final_dir, ec);
+        fs::rename(tmp_dir, final_dir);
+    } catch (...) {
+        fs::remove_all(tmp_dir, ec);
+        throw;
+    }
+}
+
+}  // namespace wul3d
