@@ -11,7 +11,7 @@
 #   libcli11-dev nlohmann-json3-dev                command line, JSON (header-only)
 #   libgtest-dev libgmock-dev                      the test suite (tests/)
 #   libbenchmark-dev                               the benchmarks (bench/)
-#   python3                                        helper scripts
+#   python3 python3-matplotlib                     helper scripts; the bench plot (scripts/plot-bench.py)
 #   libglfw3-dev libgl-dev libimgui-dev            `wul3d view` (GLFW 3, OpenGL, Dear ImGui with its
 #                                                  GLFW/OpenGL 3 backends); built only when found
 #   xvfb xauth libgl1-mesa-dri                     the viewer's test: a virtual X server (xvfb-run)
@@ -37,6 +37,7 @@ packages=(
   libbenchmark-dev
   libtbb-dev
   python3
+  python3-matplotlib
   libglfw3-dev
   libgl-dev
   libimgui-dev
