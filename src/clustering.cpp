@@ -1,6 +1,7 @@
 #include "wul3d/clustering.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -462,9 +463,18 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
     if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
     centre_normal_.resize(params_.k);
     use_color_ = cloud.has_color;
-    gather(cloud, normals, active);
-
+    using Clock = std::chrono::steady_clock;
+    auto ms_since = [](Clock::time_point& t) {
+        const auto now = Clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+        t = now;
+        return ms;
+    };
     FrameStats stats;
+    auto t = Clock::now();
+    gather(cloud, normals, active);
+    stats.ms.gather = ms_since(t);
+
     stats.points = n_;
     if (!seeded_) {
         if (n_ < static_cast<std::size_t>(params_.k)) {
@@ -476,14 +486,20 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
         seed_kmeanspp();
         seeded_ = true;
         stats.seeded = true;
+        stats.ms.seeding = ms_since(t);
     }
 
     if (n_ > 0) {
         for (int it = 0; it < params_.iters; ++it) {
             assign();
-            if (it + 1 == params_.iters) update_weights_and_labels();
+            stats.ms.assign += ms_since(t);
+            if (it + 1 == params_.iters) {
+                update_weights_and_labels();
+                stats.ms.weights = ms_since(t);
+            }
             stats.mean_f = move_centres();
             stats.reseeded += reseed_empty();
+            stats.ms.centres += ms_since(t);
         }
     } else {
         std::fill(grid_label_.begin(), grid_label_.end(), 0);
@@ -508,6 +524,7 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
                 labels.labels[row + u] = active[row + u] ? grid_label_[grow + u / s] : 0;
         }
     }
+    stats.ms.labels = ms_since(t);
     return stats;
 }
 

@@ -56,6 +56,12 @@ struct FrameStats {
     bool seeded = false;             ///< k-means++ ran on this frame
     int reseeded = 0;                ///< empty clusters re-seeded on this frame
     double mean_f = 0;               ///< mean distance f (eq. 6) of the points to their winner
+    /// Milliseconds in each phase of step(): packing the active points, k-means++ seeding,
+    /// distances and arg-min (eq. 6, every iteration), weight update and labels (eq. 2, 7, 8),
+    /// centre update and re-seeding, full-resolution labels. For the profile in bench/.
+    struct Phases {
+        double gather = 0, seeding = 0, assign = 0, weights = 0, centres = 0, labels = 0;
+    } ms;
 };
 
 /// The feature-space distance f of eq. (6) between a point and a centre, used by tests and
