@@ -70,11 +70,9 @@ Plane fit(const double* s) {
     return p;
 }
 
+/// The coarse grid planes are grown on: w x h points, every s-th pixel of a W-wide image.
 struct Grid {
     int w = 0, h = 0, s = 1, W = 0;
-    std::size_t pixel(int g) const {
-        return static_cast<std::size_t>(g / w) * s * W + static_cast<std::size_t>(g % w) * s;
-    }
 };
 
 }  // namespace
@@ -85,59 +83,109 @@ namespace {
 /// opening) are object material, not the support: a 4-connected patch of removed on-band
 /// pixels that touches neither the image border nor other removed points, borders object
 /// points, is small and sits on average above the plane is given back (kPlaneInside).
-template <class Band>
+/// `ws.on_band` marks the removed on-band pixels (the caller's classification pass). The
+/// patches are found as runs of on-band pixels per row joined by union-find where runs of
+/// consecutive rows overlap: a few thousand runs instead of a flood fill over the table.
 std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
                             const std::vector<std::uint8_t>& active, const Plane& pl,
-                            const Band& on_band, PlaneWorkspace& ws,
-                            std::vector<std::uint8_t>& classes) {
+                            PlaneWorkspace& ws, std::vector<std::uint8_t>& classes) {
     const int W = cloud.width, H = cloud.height;
     const std::size_t N = cloud.size();
-    ws.island.assign(N, 0);
-    ws.queue.resize(N);
-    auto on_plane = [&](std::size_t p) {
-        if (!active[p] || classes[p] != kPlaneRemoved) return false;
-        const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-        return std::fabs(h) <= on_band(cloud.z[p]);
+    const std::uint8_t* band = ws.on_band.data();
+    auto& runs = ws.runs;
+    runs.clear();
+    ws.row_first_run.assign(static_cast<std::size_t>(H) + 1, 0);
+    auto find = [&](int a) {
+        while (runs[static_cast<std::size_t>(a)].parent != a) {
+            auto& r = runs[static_cast<std::size_t>(a)];
+            r.parent = runs[static_cast<std::size_t>(r.parent)].parent;
+            a = r.parent;
+        }
+        return a;
     };
-    const double max_size = params.island_max_share * static_cast<double>(N);
-    std::size_t restored = 0;
-    int id = 0;
-    for (std::size_t seed = 0; seed < N; ++seed) {
-        if (ws.island[seed] || !on_plane(seed)) continue;
-        ++id;
-        int head = 0, tail = 0;
-        ws.queue[tail++] = static_cast<int>(seed);
-        ws.island[seed] = id;
-        bool open = false;
-        std::size_t touches_object = 0;
-        double height = 0;
-        while (head < tail) {
-            const int p = ws.queue[head++];
-            const std::size_t pz = static_cast<std::size_t>(p);
-            height += pl.height(cloud.x[pz], cloud.y[pz], cloud.z[pz]);
-            const int u = p % W, v = p / W;
-            if (u == 0 || v == 0 || u == W - 1 || v == H - 1) {
-                open = true;
+    for (int v = 0; v < H; ++v) {
+        ws.row_first_run[static_cast<std::size_t>(v)] = static_cast<int>(runs.size());
+        const std::uint8_t* row = band + static_cast<std::size_t>(v) * W;
+        for (int u = 0; u < W;) {
+            if (!row[u]) {
+                ++u;
                 continue;
             }
-            for (const int q : {p - 1, p + 1, p - W, p + W}) {
-                const std::size_t qz = static_cast<std::size_t>(q);
-                if (ws.island[qz]) continue;
-                if (on_plane(qz)) {
-                    ws.island[qz] = id;
-                    ws.queue[tail++] = q;
-                } else if (classes[qz] != kPlaneRemoved) {
-                    ++touches_object;
-                } else if (active[qz]) {
-                    open = true;  // beside support or room points that are not on the plane
-                }
+            const int begin = u;
+            while (u < W && row[u]) ++u;
+            const int id = static_cast<int>(runs.size());
+            runs.push_back({v, begin, u, id});
+        }
+        if (v == 0) continue;
+        // Join with the previous row's runs that share a column (4-connectivity).
+        int a = ws.row_first_run[static_cast<std::size_t>(v) - 1];
+        const int a_end = ws.row_first_run[static_cast<std::size_t>(v)];
+        for (int b = a_end; b < static_cast<int>(runs.size()); ++b) {
+            const auto& rb = runs[static_cast<std::size_t>(b)];
+            while (a < a_end && runs[static_cast<std::size_t>(a)].end <= rb.begin) ++a;
+            for (int c = a; c < a_end && runs[static_cast<std::size_t>(c)].begin < rb.end; ++c) {
+                const int ra = find(c), rb_root = find(b);
+                if (ra != rb_root) runs[static_cast<std::size_t>(std::max(ra, rb_root))].parent = std::min(ra, rb_root);
             }
         }
-        if (open || touches_object == 0 || tail > max_size ||
-            height / tail <= params.island_min_height_m)
+    }
+    ws.row_first_run[static_cast<std::size_t>(H)] = static_cast<int>(runs.size());
+    const std::size_t R = runs.size();
+    ws.island_height.assign(R, 0.0);
+    ws.island_size.assign(R, 0);
+    ws.island_flags.assign(R, 0);
+    // A neighbour outside the patch: object material, or a removed active point off the
+    // band (support or room beside it) that opens the patch.
+    auto look = [&](std::size_t q, std::uint8_t& flags) {
+        if (band[q]) return;
+        if (classes[q] != kPlaneRemoved) flags |= 2;
+        else if (active[q]) flags |= 1;
+    };
+    // Per run (in parallel): its heights and what borders it; then summed per island.
+    const auto Rn = static_cast<std::ptrdiff_t>(R);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t i = 0; i < Rn; ++i) {
+        const auto& r = runs[static_cast<std::size_t>(i)];
+        std::uint8_t flags = 0;
+        const std::size_t row = static_cast<std::size_t>(r.row) * W;
+        double height = 0;
+        for (int u = r.begin; u < r.end; ++u) {
+            const std::size_t p = row + static_cast<std::size_t>(u);
+            height += pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+        }
+        if (r.row == 0 || r.row == H - 1 || r.begin == 0 || r.end == W) {
+            flags |= 1;  // touches the image border
+        } else {
+            look(row + static_cast<std::size_t>(r.begin) - 1, flags);
+            look(row + static_cast<std::size_t>(r.end), flags);
+            for (int u = r.begin; u < r.end; ++u) {
+                look(row - W + static_cast<std::size_t>(u), flags);
+                look(row + W + static_cast<std::size_t>(u), flags);
+            }
+        }
+        ws.island_height[static_cast<std::size_t>(i)] = height;
+        ws.island_flags[static_cast<std::size_t>(i)] = flags;
+    }
+    for (std::size_t i = 0; i < R; ++i) {
+        const auto& r = runs[i];
+        const std::size_t root = static_cast<std::size_t>(find(static_cast<int>(i)));
+        ws.island_size[root] += r.end - r.begin;
+        if (root == i) continue;
+        ws.island_height[root] += ws.island_height[i];
+        ws.island_flags[root] |= ws.island_flags[i];
+    }
+    const double max_size = params.island_max_share * static_cast<double>(N);
+    std::size_t restored = 0;
+    for (std::size_t i = 0; i < R; ++i) {
+        const auto& r = runs[i];
+        const std::size_t root = static_cast<std::size_t>(find(static_cast<int>(i)));
+        const int size = ws.island_size[root];
+        if (ws.island_flags[root] != 2 || size > max_size ||
+            ws.island_height[root] / size <= params.island_min_height_m)
             continue;
-        for (int i = 0; i < tail; ++i) classes[static_cast<std::size_t>(ws.queue[i])] = kPlaneInside;
-        restored += static_cast<std::size_t>(tail);
+        std::fill(classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.begin,
+                  classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.end, kPlaneInside);
+        restored += static_cast<std::size_t>(r.end - r.begin);
     }
     return restored;
 }
@@ -165,10 +213,27 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
 
     const float cos_grow = std::cos(params.grow_angle_deg * kDegToRad);
     const float cos_inlier = std::cos(params.inlier_angle_deg * kDegToRad);
-    auto usable = [&](int g) {
-        const std::size_t p = grid.pixel(g);
-        return active[p] && normals.valid[p];
-    };
+    // Gather the grid's points once: every later pass over the grid reads them contiguously.
+    auto& gp = ws.grid;
+    for (auto* a : {&gp.x, &gp.y, &gp.z, &gp.nx, &gp.ny, &gp.nz}) a->resize(static_cast<std::size_t>(G));
+    gp.active.resize(static_cast<std::size_t>(G));
+    gp.usable.resize(static_cast<std::size_t>(G));
+#pragma omp parallel for schedule(static)
+    for (int gv = 0; gv < grid.h; ++gv) {
+        for (int gu = 0; gu < grid.w; ++gu) {
+            const std::size_t g = static_cast<std::size_t>(gv) * grid.w + gu;
+            const std::size_t p = static_cast<std::size_t>(gv) * grid.s * W + static_cast<std::size_t>(gu) * grid.s;
+            gp.x[g] = cloud.x[p];
+            gp.y[g] = cloud.y[p];
+            gp.z[g] = cloud.z[p];
+            gp.nx[g] = normals.nx[p];
+            gp.ny[g] = normals.ny[p];
+            gp.nz[g] = normals.nz[p];
+            gp.active[g] = active[p];
+            gp.usable[g] = active[p] && normals.valid[p];
+        }
+    }
+    auto usable = [&](int g) { return gp.usable[static_cast<std::size_t>(g)] != 0; };
     auto on_band = [&](float z) { return params.on_plane_m + params.on_plane_rel * z * z; };
 
     // 1. Region growing on the grid: a neighbour joins when its normal agrees with the
@@ -185,13 +250,13 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         ws.region[seed] = id;
         while (top > 0) {
             const int g = ws.stack[--top];
-            const std::size_t p = grid.pixel(g);
-            const double x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
+            const std::size_t p = static_cast<std::size_t>(g);
+            const double x = gp.x[p], y = gp.y[p], z = gp.z[p];
             s[0] += 1;
             s[1] += x; s[2] += y; s[3] += z;
             s[4] += x * x; s[5] += x * y; s[6] += x * z;
             s[7] += y * y; s[8] += y * z; s[9] += z * z;
-            s[10] += normals.nx[p]; s[11] += normals.ny[p]; s[12] += normals.nz[p];
+            s[10] += gp.nx[p]; s[11] += gp.ny[p]; s[12] += gp.nz[p];
             const double nlen = std::sqrt(s[10] * s[10] + s[11] * s[11] + s[12] * s[12]);
             const float mnx = static_cast<float>(s[10] / nlen), mny = static_cast<float>(s[11] / nlen),
                         mnz = static_cast<float>(s[12] / nlen);
@@ -202,12 +267,12 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
                                gv > 0 ? g - grid.w : -1, gv + 1 < grid.h ? g + grid.w : -1};
             for (int q : nb) {
                 if (q < 0 || ws.region[q] != -1 || !usable(q)) continue;
-                const std::size_t pq = grid.pixel(q);
-                const float cosq = normals.nx[pq] * mnx + normals.ny[pq] * mny + normals.nz[pq] * mnz;
+                const std::size_t pq = static_cast<std::size_t>(q);
+                const float cosq = gp.nx[pq] * mnx + gp.ny[pq] * mny + gp.nz[pq] * mnz;
                 if (cosq < cos_grow) continue;
-                const float dist = std::fabs(mnx * (cloud.x[pq] - cx) + mny * (cloud.y[pq] - cy) +
-                                             mnz * (cloud.z[pq] - cz));
-                if (dist > params.grow_dist_m + params.on_plane_rel * cloud.z[pq] * cloud.z[pq])
+                const float dist = std::fabs(mnx * (gp.x[pq] - cx) + mny * (gp.y[pq] - cy) +
+                                             mnz * (gp.z[pq] - cz));
+                if (dist > params.grow_dist_m + params.on_plane_rel * gp.z[pq] * gp.z[pq])
                     continue;
                 ws.region[q] = id;
                 ws.stack[top++] = q;
@@ -264,10 +329,10 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     // agrees with the plane's.
     auto is_inlier = [&](const Plane& pl, int g) {
         if (!usable(g)) return false;
-        const std::size_t p = grid.pixel(g);
-        const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-        if (std::fabs(h) > on_band(cloud.z[p])) return false;
-        return normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz >= cos_inlier;
+        const std::size_t p = static_cast<std::size_t>(g);
+        const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
+        if (std::fabs(h) > on_band(gp.z[p])) return false;
+        return gp.nx[p] * pl.nx + gp.ny[p] * pl.ny + gp.nz[p] * pl.nz >= cos_inlier;
     };
 
     // 3. Candidates: merged planes covering min_extent of the grid points with a normal.
@@ -290,10 +355,16 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     auto build_hull = [&](const Plane& pl) {
         ws.hull.assign(static_cast<std::size_t>(G), 0);
         ws.hull_points.clear();
-        for (int g = 0; g < G; ++g) {
-            if (!is_inlier(pl, g)) continue;
-            ws.hull_points.push_back(g % grid.w);
-            ws.hull_points.push_back(g / grid.w);
+        // The hull of a set is the hull of each row's leftmost and rightmost members.
+        for (int gv = 0; gv < grid.h; ++gv) {
+            int first = -1, last = -1;
+            for (int gu = 0; gu < grid.w; ++gu) {
+                if (!is_inlier(pl, gv * grid.w + gu)) continue;
+                if (first < 0) first = gu;
+                last = gu;
+            }
+            if (first < 0) continue;
+            ws.hull_points.insert(ws.hull_points.end(), {first, gv, last, gv});
         }
         if (ws.hull_points.size() < 6) return;
         cv::Mat pts(static_cast<int>(ws.hull_points.size() / 2), 1, CV_32SC2, ws.hull_points.data());
@@ -308,30 +379,36 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             cv::dilate(mask, mask, kernel);
         }
     };
+    // Per pixel in the hot loop below: float arithmetic, grid cell by rounding (no libm call).
+    const float inv_s = 1.0f / static_cast<float>(grid.s);
+    const float gfx = static_cast<float>(K.fx) * inv_s, gfy = static_cast<float>(K.fy) * inv_s;
+    const float gcx = static_cast<float>(K.cx) * inv_s + 0.5f, gcy = static_cast<float>(K.cy) * inv_s + 0.5f;
     auto foot_in_hull = [&](const Plane& pl, float x, float y, float z, float h) {
         const float fx = x - h * pl.nx, fy = y - h * pl.ny, fz = z - h * pl.nz;
         if (fz <= 1e-3f) return false;
-        const double u = K.fx * fx / fz + K.cx, v = K.fy * fy / fz + K.cy;
-        const int gu = static_cast<int>(std::lround(u / grid.s)), gv = static_cast<int>(std::lround(v / grid.s));
-        if (gu < 0 || gv < 0 || gu >= grid.w || gv >= grid.h) return false;
-        return ws.hull[static_cast<std::size_t>(gv) * grid.w + gu] != 0;
+        const float inv_z = 1.0f / fz;
+        const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
+        if (!(gu >= 0.0f && gv >= 0.0f && gu < static_cast<float>(grid.w) && gv < static_cast<float>(grid.h)))
+            return false;
+        return ws.hull[static_cast<std::size_t>(gv) * static_cast<std::size_t>(grid.w) +
+                       static_cast<std::size_t>(gu)] != 0;
     };
 
     // 4. The support: among planes that face up, the one that carries most: score = points
     //    standing on it (at most its extent) + 0.1 x its extent.
     double best_score = -1;
-    int best = -1;
+    int best = -1, hull_of = -1;  // hull_of: the candidate whose extent ws.hull holds
     for (std::size_t c = 0; c < result.candidates.size(); ++c) {
         Plane& pl = result.candidates[c];
         if (pl.up < params.min_up) continue;
         build_hull(pl);
+        hull_of = static_cast<int>(c);
         std::size_t above = 0;
-        for (int g = 0; g < G; ++g) {
-            const std::size_t p = grid.pixel(g);
-            if (!active[p]) continue;
-            const float h = pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-            if (h <= on_band(cloud.z[p]) || h > params.max_object_height_m) continue;
-            if (foot_in_hull(pl, cloud.x[p], cloud.y[p], cloud.z[p], h)) ++above;
+        for (std::size_t p = 0; p < static_cast<std::size_t>(G); ++p) {
+            if (!gp.active[p]) continue;
+            const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
+            if (h <= on_band(gp.z[p]) || h > params.max_object_height_m) continue;
+            if (foot_in_hull(pl, gp.x[p], gp.y[p], gp.z[p], h)) ++above;
         }
         pl.above = above;
         // Points standing on a plane count up to its own extent (a small tilted plane, a box
@@ -353,7 +430,8 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     result.found = true;
     result.support = result.candidates[static_cast<std::size_t>(best)];
     const Plane pl = result.support;
-    build_hull(pl);
+    if (hull_of != best) build_hull(pl);
+    ws.on_band.resize(N);
 
     // 5. Classify every pixel: below or on the plane (and facing like it) is removed; on the
     //    band but facing otherwise is a candidate foot; above and over the support is object.
@@ -363,6 +441,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             std::uint8_t c = kPlaneRemoved;
+            std::uint8_t on_band_removed = 0;
             if (active[p]) {
                 const float x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
                 const float h = pl.height(x, y, z), band = on_band(z);
@@ -374,12 +453,14 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
                            foot_in_hull(pl, x, y, z, h)) {
                     c = kPlaneFoot;
                 }
+                on_band_removed = c == kPlaneRemoved && std::fabs(h) <= band;
             }
             classes[p] = c;
+            ws.on_band[p] = on_band_removed;
             kept += c != kPlaneRemoved;
         }
     }
-    kept += restore_islands(params, cloud, active, pl, on_band, ws, classes);
+    kept += restore_islands(params, cloud, active, pl, ws, classes);
     result.kept = kept;
     return result;
 }

@@ -73,13 +73,30 @@ struct PlaneResult {
 
 /// Scratch of remove_support_plane; allocates nothing after the first frame of a size.
 struct PlaneWorkspace {
+    /// The grid's points gathered once (every grid_stride_px-th pixel), structure of arrays.
+    struct GridPoints {
+        std::vector<float> x, y, z, nx, ny, nz;
+        std::vector<std::uint8_t> active, usable;  ///< usable: active with a normal
+    } grid;
     std::vector<int> region;          ///< grid point -> region id, -1 none
     std::vector<int> stack;
     std::vector<double> sums;         ///< per region: count, sum x, y, z, xx, xy, xz, yy, yz, zz
     std::vector<std::uint8_t> hull;   ///< grid-resolution mask of the support's extent
-    std::vector<int> hull_points;     ///< (gu, gv) pairs of support inliers
-    std::vector<int> island;          ///< per pixel: on-plane component id + 1, 0 none
-    std::vector<int> queue;
+    std::vector<int> hull_points;     ///< (gu, gv) pairs: each grid row's outermost inliers
+    std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
+    /// Runs of on-band pixels, row by row, and their union-find components (islands).
+    struct Run {
+        int row, begin, end;  ///< pixels [begin, end) of the row
+        int parent;           ///< union-find parent (a run index)
+    };
+    std::vector<Run> runs;
+    std::vector<int> row_first_run;     ///< per row + 1: index of its first run
+    /// Per run, then summed into its root run: heights over the plane, pixels (roots only),
+    /// flags 1 = open (image border, or beside removed points off the band), 2 = beside
+    /// object points.
+    std::vector<double> island_height;
+    std::vector<int> island_size;
+    std::vector<std::uint8_t> island_flags;
 };
 
 /// Finds the support plane among the `active` points and classifies every pixel
