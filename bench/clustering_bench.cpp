@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include <omp.h>
 #include <opencv2/core.hpp>
 
 #include "bench_support.hpp"
@@ -37,6 +38,14 @@ cv::Mat kmeans_features(const OrganizedCloud& cloud, const std::vector<std::uint
         features.push_back(cv::Mat(1, 6, CV_32F, const_cast<float*>(row)));
     }
     return features;
+}
+
+// cv::kmeans runs on OpenCV's thread pool (TBB on Debian): give it as many threads as OpenMP
+// gives ours, so that OMP_NUM_THREADS=1 compares one core with one core.
+int match_opencv_threads() {
+    const int threads = omp_get_max_threads();
+    cv::setNumThreads(threads);
+    return threads;
 }
 
 // k-means++ seeding and one iteration, as a per-frame k-means without our state across frames
@@ -84,6 +93,7 @@ static void BM_OpenCvKmeans(benchmark::State& state) {
     const int k = static_cast<int>(state.range(0));
     const cv::Mat features = kmeans_features(pf.pipeline.cloud(), pf.result.active,
                                              params_with_k(k));
+    state.counters["threads"] = match_opencv_threads();
     cv::Mat labels, centres;
     for (auto _ : state) benchmark::DoNotOptimize(opencv_kmeans(features, k, labels, centres));
     state.counters["points"] = features.rows;
@@ -103,6 +113,7 @@ static void BM_ClusterStepVsOpenCvKmeans(benchmark::State& state) {
     std::vector<cv::Mat> features;
     for (const bench::StageInputs& in : inputs)
         features.push_back(kmeans_features(in.cloud, in.active, p));
+    state.counters["threads"] = match_opencv_threads();
     ClusterState cs(p);
     LabelImage labels;
     for (const bench::StageInputs& in : inputs) cs.step(in.cloud, in.normals, in.active, labels);
