@@ -6,6 +6,11 @@
 #
 #   scripts/bench-stages.sh [BUILD_DIR] [REPETITIONS] [extra Google Benchmark flags...]
 #   e.g. scripts/bench-stages.sh build 3 --benchmark_filter=Cluster
+#
+# On a machine that another process keeps busy, OpenMP's barriers wait for a descheduled
+# thread (a scheduler time slice, milliseconds, per parallel region) and the table measures the
+# scheduler: run OMP_NUM_THREADS=1 scripts/bench-stages.sh there (the cv::kmeans peer follows
+# OpenMP's thread count; PCL's normals are single-threaded).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
