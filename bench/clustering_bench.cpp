@@ -58,22 +58,30 @@ double opencv_kmeans(const cv::Mat& features, int k, cv::Mat& labels, cv::Mat& c
 }  // namespace
 
 // One frame of Algorithm 1 (assign, weight update, centre move) after seeding; the counters
-// are FrameStats::ms, each phase's milliseconds averaged over the iterations.
+// are FrameStats::ms, each phase's milliseconds averaged over the iterations. frames:1 steps on
+// the same frame every iteration (winners do not change: the weight update's cheapest case);
+// frames:4 cycles through the four tabletop frames, four different scenes, so most pixels'
+// winners change every frame (the weight update's dearest case).
 static void BM_ClusterStep(benchmark::State& state) {
-    const bench::ProcessedFrame& pf = bench::processed_tabletop();
-    const std::vector<std::uint8_t> active = pf.result.active;
+    const std::vector<bench::StageInputs>& inputs = bench::tabletop_inputs();
+    const std::size_t frames = static_cast<std::size_t>(state.range(1));
     ClusterState cs(params_with_k(static_cast<int>(state.range(0))));
     LabelImage labels;
-    FrameStats stats = cs.step(pf.pipeline.cloud(), pf.pipeline.normals(), active, labels);
+    FrameStats stats;
+    for (std::size_t i = 0; i < frames; ++i)  // seeds on the first
+        stats = cs.step(inputs[i].cloud, inputs[i].normals, inputs[i].active, labels);
     FrameStats::Phases sum;
+    std::size_t frame = 0;
     for (auto _ : state) {
-        stats = cs.step(pf.pipeline.cloud(), pf.pipeline.normals(), active, labels);
+        const bench::StageInputs& in = inputs[frame];
+        stats = cs.step(in.cloud, in.normals, in.active, labels);
         sum.gather += stats.ms.gather;
         sum.seeding += stats.ms.seeding;
         sum.assign += stats.ms.assign;
         sum.weights += stats.ms.weights;
         sum.centres += stats.ms.centres;
         sum.labels += stats.ms.labels;
+        frame = (frame + 1) % frames;
     }
     using benchmark::Counter;
     state.counters["gather_ms"] = Counter(sum.gather, Counter::kAvgIterations);
@@ -84,7 +92,13 @@ static void BM_ClusterStep(benchmark::State& state) {
     state.counters["labels_ms"] = Counter(sum.labels, Counter::kAvgIterations);
     state.counters["points"] = static_cast<double>(stats.points);
 }
-BENCHMARK(BM_ClusterStep)->ArgName("k")->Arg(7)->Arg(10)->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_ClusterStep)
+    ->ArgNames({"k", "frames"})
+    ->Args({7, 1})
+    ->Args({10, 1})
+    ->Args({7, 4})
+    ->Args({10, 4})
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // Peer alone: cv::kmeans on the features of the same frame (built outside the loop).
