@@ -107,62 +107,66 @@ void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scra
     const int W = in.width, H = in.height, r = radius_px;
     const std::size_t N = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
     out.resize(W, H);
-    // Horizontal running sums of (nx, ny, nz) into scratch (3 planes), then vertical ones.
-    scratch.resize(3 * N);
-    float* hx = scratch.data();
-    float* hy = hx + N;
-    float* hz = hy + N;
+    // Vertical window sums of (nx, ny, nz) into scratch (3 planes), then horizontal ones.
+    // A pixel without a normal holds n = 0 (NormalMap's contract), so it adds nothing and
+    // the sums need no branch: whole rows add up contiguously, which vectorizes.
+    scratch.resize(3 * N + static_cast<std::size_t>(W));
+    std::fill(scratch.begin() + static_cast<std::ptrdiff_t>(3 * N), scratch.end(), 0.0f);
+    float* const planes[3] = {scratch.data(), scratch.data() + N, scratch.data() + 2 * N};
+    const float* const src[3] = {in.nx.data(), in.ny.data(), in.nz.data()};
+    // Fixed bands of rows, each starting with a full window: the same sums (hence the same
+    // result) whatever the number of threads.
+    constexpr int kBands = 4;
+    const float* const zeros = scratch.data() + 3 * N;  // a row of zeros
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kBands; ++band) {
+        const int v0 = H * band / kBands, v1 = H * (band + 1) / kBands;
+        for (int c = 0; c < 3; ++c) {
+            float* const dst = planes[c];
+            for (int v = v0; v < v1; ++v) {
+                float* const out_row = dst + static_cast<std::size_t>(v) * W;
+                auto add_row = [&](int k, float sign) {
+                    const float* const in_row = src[c] + static_cast<std::size_t>(k) * W;
+                    for (int u = 0; u < W; ++u) out_row[u] += sign * in_row[u];
+                };
+                if (v == v0) {
+                    std::fill(out_row, out_row + W, 0.0f);
+                    for (int k = std::max(0, v - r); k <= std::min(H - 1, v + r); ++k) add_row(k, 1.0f);
+                } else {
+                    // The window slides one row: previous sum + entering row - leaving row
+                    // (a row of zeros past either edge), in one pass.
+                    const float* const prev = out_row - W;
+                    const float* const enter = v + r < H ? src[c] + static_cast<std::size_t>(v + r) * W : zeros;
+                    const float* const leave = v - r - 1 >= 0 ? src[c] + static_cast<std::size_t>(v - r - 1) * W : zeros;
+                    for (int u = 0; u < W; ++u) out_row[u] = prev[u] + enter[u] - leave[u];
+                }
+            }
+        }
+    }
+    // Horizontal window sums straight into the output, one shifted row at a time (each
+    // pass vectorizes), then renormalized.
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * W;
-        float sx = 0, sy = 0, sz = 0;
-        auto add = [&](int u, float sign) {
-            const std::size_t p = row + u;
-            if (!in.valid[p]) return;
-            sx += sign * in.nx[p];
-            sy += sign * in.ny[p];
-            sz += sign * in.nz[p];
-        };
-        for (int u = 0; u < std::min(r, W); ++u) add(u, 1.0f);
-        for (int u = 0; u < W; ++u) {
-            if (u + r < W) add(u + r, 1.0f);
-            if (u - r - 1 >= 0) add(u - r - 1, -1.0f);
-            hx[row + u] = sx;
-            hy[row + u] = sy;
-            hz[row + u] = sz;
+        float* const dst[3] = {out.nx.data() + row, out.ny.data() + row, out.nz.data() + row};
+        for (int c = 0; c < 3; ++c) {
+            const float* const h = planes[c] + row;
+            float* const o = dst[c];
+            std::fill(o, o + W, 0.0f);
+            for (int k = -r; k <= r; ++k) {
+                const int ua = std::max(0, -k), ub = std::min(W, W - k);  // 0 <= u + k < W
+                for (int u = ua; u < ub; ++u) o[u] += h[u + k];
+            }
         }
-    }
-    // Vertical pass by column blocks, so that each thread walks rows contiguously.
-    constexpr int kBlock = 64;
-    const int blocks = (W + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static)
-    for (int b = 0; b < blocks; ++b) {
-        const int u0 = b * kBlock, u1 = std::min(W, u0 + kBlock);
-        float sx[kBlock] = {}, sy[kBlock] = {}, sz[kBlock] = {};
-        auto add = [&](int v, float sign) {
-            const std::size_t row = static_cast<std::size_t>(v) * W;
-            for (int u = u0; u < u1; ++u) {
-                sx[u - u0] += sign * hx[row + u];
-                sy[u - u0] += sign * hy[row + u];
-                sz[u - u0] += sign * hz[row + u];
-            }
-        };
-        for (int v = 0; v < std::min(r, H); ++v) add(v, 1.0f);
-        for (int v = 0; v < H; ++v) {
-            if (v + r < H) add(v + r, 1.0f);
-            if (v - r - 1 >= 0) add(v - r - 1, -1.0f);
-            const std::size_t row = static_cast<std::size_t>(v) * W;
-            for (int u = u0; u < u1; ++u) {
-                const std::size_t p = row + u;
-                const float x = sx[u - u0], y = sy[u - u0], z = sz[u - u0];
-                const float len = std::sqrt(x * x + y * y + z * z);
-                const bool ok = in.valid[p] && len > 1e-6f;
-                const float s = ok ? 1.0f / len : 0.0f;
-                out.nx[p] = x * s;
-                out.ny[p] = y * s;
-                out.nz[p] = z * s;
-                out.valid[p] = ok;
-            }
+        for (int u = 0; u < W; ++u) {
+            const float x = dst[0][u], y = dst[1][u], z = dst[2][u];
+            const float len = std::sqrt(x * x + y * y + z * z);
+            const bool ok = in.valid[row + u] && len > 1e-6f;
+            const float sc = ok ? 1.0f / len : 0.0f;
+            dst[0][u] = x * sc;
+            dst[1][u] = y * sc;
+            dst[2][u] = z * sc;
+            out.valid[row + u] = ok;
         }
     }
 }

@@ -249,18 +249,39 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     for (std::size_t p = 0; p < N; ++p)
         ws.order[static_cast<std::size_t>(ws.remap[static_cast<std::size_t>(ws.label[p])]++)] = static_cast<int>(p);
     ws.part.assign(N, 0);
-
+    ws.part_in_order.resize(N);
+    ws.split.assign(static_cast<std::size_t>(n) + 1, 0);
+    // Features gathered in segment order, one plane each: every pass below reads contiguous
+    // memory. Scaled by the paper's delta and alpha (eq. 4) so a squared distance is a sum.
+    ws.feature.resize(6 * N);
     ClusterParams cp;
     cp.alpha = prm.color_alpha;
     cp.delta = 1.0f - prm.color_alpha;
-    const float a2 = cp.alpha * cp.alpha, d2 = cp.delta * cp.delta;
+    const int first = ws.offsets[1], last = ws.offsets[static_cast<std::size_t>(n) + 1];
+    float* const f[6] = {ws.feature.data(), ws.feature.data() + N, ws.feature.data() + 2 * N,
+                         ws.feature.data() + 3 * N, ws.feature.data() + 4 * N,
+                         ws.feature.data() + 5 * N};
+#pragma omp parallel for schedule(static)
+    for (int i = first; i < last; ++i) {
+        const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
+        f[0][i] = cp.delta * x.c.x[p];
+        f[1][i] = cp.delta * x.c.y[p];
+        f[2][i] = cp.delta * x.c.z[p];
+        f[3][i] = cp.alpha * x.c.r[p];
+        f[4][i] = cp.alpha * x.c.g[p];
+        f[5][i] = cp.alpha * x.c.b[p];
+    }
     const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
     const int s = prm.crease_step_px;
-    int splits = 0, next = n;
+    // Each segment is tried on its own (in parallel); split ids are given out in segment
+    // order afterwards so the labels do not depend on the threads.
+#pragma omp parallel for schedule(dynamic, 1)
     for (int l = 1; l <= n; ++l) {
-        const int* px = ws.order.data() + ws.offsets[l];
-        const int m = ws.offsets[l + 1] - ws.offsets[l];
+        const int o = ws.offsets[static_cast<std::size_t>(l)];
+        const int* px = ws.order.data() + o;
+        const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
         if (m < 2 * prm.min_points) continue;
+        std::uint8_t* part = ws.part.data();
         // Seeds: the pixel farthest in colour from the mean, then the one farthest from it.
         double mr = 0, mg = 0, mb = 0;
         for (int i = 0; i < m; ++i) {
@@ -268,46 +289,71 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         }
         mr /= m; mg /= m; mb /= m;
         auto farthest = [&](double r, double g, double b) {
-            int best = px[0];
+            int best = 0;
             double bd = -1;
             for (int i = 0; i < m; ++i) {
                 const double dr = x.c.r[px[i]] - r, dg = x.c.g[px[i]] - g, db = x.c.b[px[i]] - b;
                 const double d = dr * dr + dg * dg + db * db;
-                if (d > bd) { bd = d; best = px[i]; }
+                if (d > bd) { bd = d; best = i; }
             }
             return best;
         };
         const int a0 = farthest(mr, mg, mb);
-        const int b0 = farthest(x.c.r[a0], x.c.g[a0], x.c.b[a0]);
-        float cen[2][6] = {{x.c.x[a0], x.c.y[a0], x.c.z[a0], x.c.r[a0], x.c.g[a0], x.c.b[a0]},
-                           {x.c.x[b0], x.c.y[b0], x.c.z[b0], x.c.r[b0], x.c.g[b0], x.c.b[b0]}};
+        const int b0 = farthest(x.c.r[px[a0]], x.c.g[px[a0]], x.c.b[px[a0]]);
+        float cen[2][6];
+        for (int q = 0; q < 6; ++q) {
+            cen[0][q] = f[q][o + a0];
+            cen[1][q] = f[q][o + b0];
+        }
+        // Totals once: part 0's sums are the totals minus part 1's.
+        double total[6] = {};
+        for (int q = 0; q < 6; ++q)
+            for (int i = 0; i < m; ++i) total[q] += f[q][o + i];
+        std::uint8_t* const side = ws.part_in_order.data() + o;
         int count[2] = {0, 0};
         for (int it = 0; it < 6; ++it) {
-            double sum[2][6] = {};
-            count[0] = count[1] = 0;
-            for (int i = 0; i < m; ++i) {
-                const int p = px[i];
-                float f[2];
-                for (int j = 0; j < 2; ++j) {
-                    const float dx = x.c.x[p] - cen[j][0], dy = x.c.y[p] - cen[j][1], dz = x.c.z[p] - cen[j][2];
-                    const float dr = x.c.r[p] - cen[j][3], dg = x.c.g[p] - cen[j][4], db = x.c.b[p] - cen[j][5];
-                    // Paper eq. (4); the normal term of eq. (6) is left out: both parts may
-                    // share a face.
-                    f[j] = std::sqrt(d2 * (dx * dx + dy * dy + dz * dz) + a2 * (dr * dr + dg * dg + db * db));
-                }
-                const int j = f[1] < f[0] ? 1 : 0;
-                ws.part[p] = static_cast<std::uint8_t>(j);
-                ++count[j];
-                sum[j][0] += x.c.x[p]; sum[j][1] += x.c.y[p]; sum[j][2] += x.c.z[p];
-                sum[j][3] += x.c.r[p]; sum[j][4] += x.c.g[p]; sum[j][5] += x.c.b[p];
+            // Nearer centre 1 than centre 0 (eq. 4 squared): |f - c1|^2 < |f - c0|^2, i.e.
+            // 2 f . (c0 - c1) < |c0|^2 - |c1|^2, a linear test per pixel.
+            float w[6], bias = 0;
+            for (int q = 0; q < 6; ++q) {
+                w[q] = 2.0f * (cen[0][q] - cen[1][q]);
+                bias += cen[0][q] * cen[0][q] - cen[1][q] * cen[1][q];
             }
+            double sum1[6] = {};
+            int ones = 0, changed = 0;
+            constexpr int kBlock = 1024;  // float partial sums per block, added up in double
+            for (int i0 = 0; i0 < m; i0 += kBlock) {
+                const int i1 = std::min(m, i0 + kBlock);
+                float block[6] = {};
+                int block_ones = 0, block_changed = 0;
+                for (int i = i0; i < i1; ++i) {
+                    float dot = 0;
+                    for (int q = 0; q < 6; ++q) dot += w[q] * f[q][o + i];
+                    const std::uint8_t j = dot < bias;
+                    block_changed += j != side[i];
+                    side[i] = j;
+                    block_ones += j;
+                    const float mask = j;
+                    for (int q = 0; q < 6; ++q) block[q] += mask * f[q][o + i];
+                }
+                for (int q = 0; q < 6; ++q) sum1[q] += block[q];
+                ones += block_ones;
+                changed += block_changed;
+            }
+            count[1] = ones;
+            count[0] = m - ones;
             if (count[0] == 0 || count[1] == 0) break;
-            for (int j = 0; j < 2; ++j)
-                for (int q = 0; q < 6; ++q) cen[j][q] = static_cast<float>(sum[j][q] / count[j]);
+            for (int q = 0; q < 6; ++q) {
+                cen[1][q] = static_cast<float>(sum1[q] / count[1]);
+                cen[0][q] = static_cast<float>((total[q] - sum1[q]) / count[0]);
+            }
+            if (it > 0 && changed == 0) break;  // converged: further iterations repeat this one
         }
+        for (int i = 0; i < m; ++i) part[px[i]] = side[i];
         const int small = std::min(count[0], count[1]);
         if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m)) continue;
-        const float dr = cen[0][3] - cen[1][3], dg = cen[0][4] - cen[1][4], db = cen[0][5] - cen[1][5];
+        const float dr = (cen[0][3] - cen[1][3]) / cp.alpha, dg = (cen[0][4] - cen[1][4]) / cp.alpha,
+                    db = (cen[0][5] - cen[1][5]) / cp.alpha;
         if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
         // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
         // crease step away on either side tell a smooth surface from a fold.
@@ -316,13 +362,13 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
             const int p = px[i];
             const int u = p % W, v = p / W;
             const int dirs[2][2] = {{1, 0}, {0, 1}};
-            for (const auto& d : dirs) {
-                if (u + d[0] >= W || v + d[1] >= x.H) continue;
-                const int q = p + d[0] + d[1] * W;
-                if (ws.label[q] != l || ws.part[q] == ws.part[p]) continue;
+            for (const auto& dd : dirs) {
+                if (u + dd[0] >= W || v + dd[1] >= x.H) continue;
+                const int q = p + dd[0] + dd[1] * W;
+                if (ws.label[q] != l || part[q] == part[p]) continue;
                 ++boundary;
-                const int pu = u - s * d[0], pv = v - s * d[1];
-                const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
+                const int pu = u - s * dd[0], pv = v - s * dd[1];
+                const int qu = u + dd[0] + s * dd[0], qv = v + dd[1] + s * dd[1];
                 if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) continue;
                 const int a = pv * W + pu, b = qv * W + qu;
                 if (!x.n.valid[a] || !x.n.valid[b]) continue;
@@ -334,9 +380,18 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
         // straddle its edge).
         if (with_normals == 0 || 10 * smooth < 7 * with_normals) continue;
+        ws.split[static_cast<std::size_t>(l)] = 1;
+    }
+    int splits = 0, next = n;
+    for (int l = 1; l <= n; ++l) {
+        if (!ws.split[static_cast<std::size_t>(l)]) continue;
         const int id = ++next;
-        for (int i = 0; i < m; ++i)
-            if (ws.part[px[i]] == 1) ws.label[px[i]] = id;
+        const int o = ws.offsets[static_cast<std::size_t>(l)];
+        const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
+        for (int i = 0; i < m; ++i) {
+            const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(o + i)]);
+            if (ws.part[p] == 1) ws.label[p] = id;
+        }
         ++splits;
     }
     return splits;

@@ -21,7 +21,8 @@ struct NormalParams {
     void validate() const;  ///< throws ParamError
 };
 
-/// Unit normals, structure of arrays, one per pixel; valid = 0 where none could be computed.
+/// Unit normals, structure of arrays, one per pixel; valid = 0 where none could be computed,
+/// and then n = (0, 0, 0) (smooth_normals relies on it).
 struct NormalMap {
     int width = 0;
     int height = 0;
@@ -35,8 +36,9 @@ void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, N
 
 /// Normals averaged over a (2 radius + 1)^2 window of valid normals and renormalized: less
 /// sensor noise for tests that compare normals a few pixels apart (segmentation's crease
-/// cuts). Separable running sums, O(N) whatever the radius; a pixel without a normal stays
-/// without one. `scratch` is resized as needed and reused.
+/// cuts). Separable: vertical running sums, then a direct horizontal sum (O(N r), cheap for
+/// the small radii used); a pixel without a normal stays without one. `scratch` is resized
+/// as needed and reused.
 void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out);
 
 }  // namespace wul3d
