@@ -147,27 +147,40 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         // its weights: they are the history of another surface.
         std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
         const float rgb2 = params_.surface_change_rgb * params_.surface_change_rgb;
-        for (std::size_t p = 0; p < N; ++p) {
-            const float z = cloud.valid[p] ? cloud.z[p] : 0.0f;
-            std::uint8_t* rgb = prev_rgb_.data() + 3 * p;
-            if (z > 0 && prev_z_[p] > 0) {
+        const float change_m = params_.surface_change_m, change_rel = params_.surface_change_rel;
+        // Raw pointers: byte stores would make the compiler reload every vector's data
+        // pointer on each pixel (a char store may alias anything).
+        const std::uint8_t* const valid = cloud.valid.data();
+        const float *const cz = cloud.z.data(), *const cr = cloud.r.data(),
+                    *const cg = cloud.g.data(), *const cb = cloud.b.data();
+        const std::uint8_t* const has_mu = has_mu_.data();
+        float* const prev_z = prev_z_.data();
+        std::uint8_t* const prev_rgb = prev_rgb_.data();
+        std::uint8_t* const changed = changed_.data();
+        const auto Nn = static_cast<std::ptrdiff_t>(N);
+#pragma omp parallel for schedule(static) reduction(+ : both, moved, held, held_moved)
+        for (std::ptrdiff_t i = 0; i < Nn; ++i) {
+            const std::size_t p = static_cast<std::size_t>(i);
+            const float z = valid[p] ? cz[p] : 0.0f;
+            std::uint8_t* rgb = prev_rgb + 3 * p;
+            if (z > 0 && prev_z[p] > 0) {
                 ++both;
-                const float dz = std::fabs(z - prev_z_[p]);
+                const float dz = std::fabs(z - prev_z[p]);
                 moved += dz > 0.05f;
-                const float dr = cloud.r[p] - rgb[0], dg = cloud.g[p] - rgb[1], db = cloud.b[p] - rgb[2];
-                const bool depth_moved = dz > params_.surface_change_m + params_.surface_change_rel * z * z;
-                held += has_mu_[p];
-                held_moved += has_mu_[p] && depth_moved;
+                const float dr = cr[p] - rgb[0], dg = cg[p] - rgb[1], db = cb[p] - rgb[2];
+                const bool depth_moved = dz > change_m + change_rel * z * z;
+                held += has_mu[p];
+                held_moved += has_mu[p] && depth_moved;
                 // Reset after the votes below: the old weights still say which track was
                 // here, evidence of overlap for a moving object.
-                changed_[p] = has_mu_[p] && (depth_moved || dr * dr + dg * dg + db * db > rgb2);
+                changed[p] = has_mu[p] && (depth_moved || dr * dr + dg * dg + db * db > rgb2);
             } else {
-                changed_[p] = 0;
+                changed[p] = 0;
             }
-            prev_z_[p] = z;
-            rgb[0] = static_cast<std::uint8_t>(cloud.r[p]);
-            rgb[1] = static_cast<std::uint8_t>(cloud.g[p]);
-            rgb[2] = static_cast<std::uint8_t>(cloud.b[p]);
+            prev_z[p] = z;
+            rgb[0] = static_cast<std::uint8_t>(cr[p]);
+            rgb[1] = static_cast<std::uint8_t>(cg[p]);
+            rgb[2] = static_cast<std::uint8_t>(cb[p]);
         }
         // Most of the surfaces the objects held moved: the objects were rearranged (a folder
         // of separate scenes), not moved along.
@@ -273,39 +286,49 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
     // 4. The paper's weights on objects: each segment pixel adds psi to its track's weight
     //    (eq. 2, 7, 8, the same update_weights as the clusters); its object is the arg-max.
     //    A pixel with depth outside every object forgets its weights.
+    // Raw pointers: the byte stores below would otherwise make the compiler reload every
+    // vector's data pointer on each pixel (a char store may alias anything).
+    const std::uint16_t* const seg = segments.labels.data();
+    const int* const seg_slot = seg_slot_.data();
+    const std::uint8_t* const taken = slot_taken.data();
+    const std::uint8_t* const valid = cloud.valid.data();
+    std::uint8_t* const changed = changed_.data();
+    std::uint8_t* const has_mu = has_mu_.data();
+    std::uint8_t* const slot_of = slot_of_.data();
+    PixelWeights* const mu = mu_.data();
+    const float psi = params_.psi;
+    const auto Nn = static_cast<std::ptrdiff_t>(N);
 #pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            const int s = segments.labels[p];
-            const int slot = s ? seg_slot_[static_cast<std::size_t>(s)] : -1;
-            if (changed_[p]) {
-                mu_[p] = PixelWeights{};
-                has_mu_[p] = 0;
+    for (std::ptrdiff_t i = 0; i < Nn; ++i) {
+        const std::size_t p = static_cast<std::size_t>(i);
+        const int s = seg[p];
+        const int slot = s ? seg_slot[s] : -1;
+        if (changed[p]) {
+            mu[p] = PixelWeights{};
+            has_mu[p] = 0;
+        }
+        if (slot >= 0) {
+            int label = update_weights(mu[p], slot, psi);
+            // The arg-max runs over the objects seen in this frame: a track with no
+            // segment now must not hold pixels as a ghost fragment of another object.
+            if (!taken[label]) {
+                const PixelWeights& w = mu[p];
+                label = slot;
+                int best = -1;
+                for (int q = 0; q < PixelWeights::kSlots; ++q)
+                    if (w.mu[q] > best && taken[w.cluster[q]]) {
+                        best = w.mu[q];
+                        label = w.cluster[q];
+                    }
             }
-            if (slot >= 0) {
-                int label = update_weights(mu_[p], slot, params_.psi);
-                // The arg-max runs over the objects seen in this frame: a track with no
-                // segment now must not hold pixels as a ghost fragment of another object.
-                if (!slot_taken[static_cast<std::size_t>(label)]) {
-                    const PixelWeights& w = mu_[p];
-                    label = slot;
-                    int best = -1;
-                    for (int q = 0; q < PixelWeights::kSlots; ++q)
-                        if (w.mu[q] > best && slot_taken[w.cluster[q]]) {
-                            best = w.mu[q];
-                            label = w.cluster[q];
-                        }
-                }
-                slot_of_[p] = static_cast<std::uint8_t>(label + 1);
-                has_mu_[p] = 1;
-            } else {
-                if (cloud.valid[p] && has_mu_[p]) {
-                    mu_[p] = PixelWeights{};
-                    has_mu_[p] = 0;
-                }
-                slot_of_[p] = 0;
+            slot_of[p] = static_cast<std::uint8_t>(label + 1);
+            has_mu[p] = 1;
+        } else {
+            if (valid[p] && has_mu[p]) {
+                mu[p] = PixelWeights{};
+                has_mu[p] = 0;
             }
+            slot_of[p] = 0;
         }
     }
 
