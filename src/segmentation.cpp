@@ -253,23 +253,25 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     ws.split.assign(static_cast<std::size_t>(n) + 1, 0);
     // Features gathered in segment order, one plane each: every pass below reads contiguous
     // memory. Scaled by the paper's delta and alpha (eq. 4) so a squared distance is a sum.
-    ws.feature.resize(6 * N);
+    // Only the segments' pixels (order positions first..last) are gathered: plane q holds
+    // position i at f[q][i - first], sized by the object pixels, not the image.
     ClusterParams cp;
     cp.alpha = prm.color_alpha;
     cp.delta = 1.0f - prm.color_alpha;
     const int first = ws.offsets[1], last = ws.offsets[static_cast<std::size_t>(n) + 1];
-    float* const f[6] = {ws.feature.data(), ws.feature.data() + N, ws.feature.data() + 2 * N,
-                         ws.feature.data() + 3 * N, ws.feature.data() + 4 * N,
-                         ws.feature.data() + 5 * N};
+    const std::size_t M = static_cast<std::size_t>(last - first);
+    ws.feature.resize(6 * M);
+    float* f[6];
+    for (int q = 0; q < 6; ++q) f[q] = ws.feature.data() + static_cast<std::size_t>(q) * M;
 #pragma omp parallel for schedule(static)
     for (int i = first; i < last; ++i) {
         const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
-        f[0][i] = cp.delta * x.c.x[p];
-        f[1][i] = cp.delta * x.c.y[p];
-        f[2][i] = cp.delta * x.c.z[p];
-        f[3][i] = cp.alpha * x.c.r[p];
-        f[4][i] = cp.alpha * x.c.g[p];
-        f[5][i] = cp.alpha * x.c.b[p];
+        f[0][i - first] = cp.delta * x.c.x[p];
+        f[1][i - first] = cp.delta * x.c.y[p];
+        f[2][i - first] = cp.delta * x.c.z[p];
+        f[3][i - first] = cp.alpha * x.c.r[p];
+        f[4][i - first] = cp.alpha * x.c.g[p];
+        f[5][i - first] = cp.alpha * x.c.b[p];
     }
     const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
     const int s = prm.crease_step_px;
@@ -281,6 +283,7 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         const int* px = ws.order.data() + o;
         const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
         if (m < 2 * prm.min_points) continue;
+        const int fo = o - first;  // the segment's first position in the feature planes
         std::uint8_t* part = ws.part.data();
         // Seeds: the pixel farthest in colour from the mean, then the one farthest from it.
         double mr = 0, mg = 0, mb = 0;
@@ -302,13 +305,13 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         const int b0 = farthest(x.c.r[px[a0]], x.c.g[px[a0]], x.c.b[px[a0]]);
         float cen[2][6];
         for (int q = 0; q < 6; ++q) {
-            cen[0][q] = f[q][o + a0];
-            cen[1][q] = f[q][o + b0];
+            cen[0][q] = f[q][fo + a0];
+            cen[1][q] = f[q][fo + b0];
         }
         // Totals once: part 0's sums are the totals minus part 1's.
         double total[6] = {};
         for (int q = 0; q < 6; ++q)
-            for (int i = 0; i < m; ++i) total[q] += f[q][o + i];
+            for (int i = 0; i < m; ++i) total[q] += f[q][fo + i];
         std::uint8_t* const side = ws.part_in_order.data() + o;
         int count[2] = {0, 0};
         for (int it = 0; it < 6; ++it) {
@@ -328,13 +331,13 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
                 int block_ones = 0, block_changed = 0;
                 for (int i = i0; i < i1; ++i) {
                     float dot = 0;
-                    for (int q = 0; q < 6; ++q) dot += w[q] * f[q][o + i];
+                    for (int q = 0; q < 6; ++q) dot += w[q] * f[q][fo + i];
                     const std::uint8_t j = dot < bias;
                     block_changed += j != side[i];
                     side[i] = j;
                     block_ones += j;
                     const float mask = j;
-                    for (int q = 0; q < 6; ++q) block[q] += mask * f[q][o + i];
+                    for (int q = 0; q < 6; ++q) block[q] += mask * f[q][fo + i];
                 }
                 for (int q = 0; q < 6; ++q) sum1[q] += block[q];
                 ones += block_ones;

@@ -75,7 +75,7 @@ struct SegmentWorkspace {
     std::vector<int> order;
     std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
-    std::vector<float> feature;        ///< colour cue: 6 planes of N, pixels in `order`
+    std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
     std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
