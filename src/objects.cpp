@@ -286,8 +286,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
     // 4. The paper's weights on objects: each segment pixel adds psi to its track's weight
     //    (eq. 2, 7, 8, the same update_weights as the clusters); its object is the arg-max.
     //    A pixel with depth outside every object forgets its weights.
-    // Raw pointers: the byte stores below would otherwise make the compiler reload every
-    // vector's data pointer on each pixel (a char store may alias anything).
+    // Raw pointers, as in the surface-change pass above.
     const std::uint16_t* const seg = segments.labels.data();
     const int* const seg_slot = seg_slot_.data();
     const std::uint8_t* const taken = slot_taken.data();

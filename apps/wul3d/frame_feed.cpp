@@ -89,4 +89,17 @@ FrameFeed::Status FrameFeed::next(SourceItem& item) {
     }
 }
 
+bool FrameFeed::next_frame(SourceItem& item, std::string& stopped_by, std::exception_ptr& lost) {
+    Status status;
+    try {
+        status = next(item);
+    } catch (const DeviceLost&) {
+        lost = std::current_exception();
+        stopped_by = "device_lost";
+        return false;
+    }
+    if (status == Status::Stopped) stopped_by = "signal";
+    return status == Status::Frame;
+}
+
 }  // namespace wul3d::cli

@@ -5,6 +5,7 @@
 // outputs.
 #include <chrono>
 #include <cstdint>
+#include <exception>
 #include <memory>
 #include <string>
 
@@ -35,6 +36,11 @@ public:
     /// Blocks until the next frame, the end, or a stop request (polled every 100 ms).
     /// Throws DeviceLost when the camera disappears, InputError for a damaged recording.
     Status next(SourceItem& item);
+    /// The loop step `run` and `record` share: next() and what ended the feed. True with a
+    /// frame in `item`; false at the end ("end" stays in `stopped_by`), on SIGINT/SIGTERM
+    /// ("signal") or when the camera is lost ("device_lost", the DeviceLost kept in `lost`
+    /// to be rethrown once the outputs are final).
+    bool next_frame(SourceItem& item, std::string& stopped_by, std::exception_ptr& lost);
     /// Waits at most `timeout` (live: newest frame; recording: reads the next one).
     /// Returns Frame, End, Stopped, or, live only, no frame yet: `false` in `got`.
     Status poll(SourceItem& item, std::chrono::milliseconds timeout, bool& got);

@@ -47,19 +47,7 @@ void record(const RecordOptions& o) {
             stopped_by = "frames";
             break;
         }
-        FrameFeed::Status status;
-        try {
-            status = feed.next(item);
-        } catch (const DeviceLost&) {
-            lost = std::current_exception();
-            stopped_by = "device_lost";
-            break;
-        }
-        if (status == FrameFeed::Status::End) break;
-        if (status == FrameFeed::Status::Stopped) {
-            stopped_by = "signal";
-            break;
-        }
+        if (!feed.next_frame(item, stopped_by, lost)) break;
         const RgbdFrame* frame = &item.frame;
         if (item.is_raw) {  // the same registration as `run` (Pipeline::process)
             register_depth_to_color(*feed.calibration(), item.raw, ws, registered);

@@ -189,19 +189,7 @@ void run(const RunOptions& o) {
             stopped_by = feed.live() || n_total < feed.size() ? "frames" : "end";
             break;
         }
-        FrameFeed::Status status;
-        try {
-            status = feed.next(item);
-        } catch (const DeviceLost&) {
-            lost = std::current_exception();
-            stopped_by = "device_lost";
-            break;
-        }
-        if (status == FrameFeed::Status::End) break;
-        if (status == FrameFeed::Status::Stopped) {
-            stopped_by = "signal";
-            break;
-        }
+        if (!feed.next_frame(item, stopped_by, lost)) break;
         const std::string name = feed.name();
         const FrameResult& r = item.is_raw
                                    ? pipeline.process(item.raw, *feed.calibration(),
