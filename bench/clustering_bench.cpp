@@ -75,7 +75,6 @@ static void BM_ClusterStep(benchmark::State& state) {
     for (auto _ : state) {
         const bench::StageInputs& in = inputs[frame];
         stats = cs.step(in.cloud, in.normals, in.active, labels);
-        sum.gather += stats.ms.gather;
         sum.seeding += stats.ms.seeding;
         sum.assign += stats.ms.assign;
         sum.weights += stats.ms.weights;
@@ -84,7 +83,6 @@ static void BM_ClusterStep(benchmark::State& state) {
         frame = (frame + 1) % frames;
     }
     using benchmark::Counter;
-    state.counters["gather_ms"] = Counter(sum.gather, Counter::kAvgIterations);
     state.counters["seeding_ms"] = Counter(sum.seeding, Counter::kAvgIterations);
     state.counters["assign_ms"] = Counter(sum.assign, Counter::kAvgIterations);
     state.counters["weights_ms"] = Counter(sum.weights, Counter::kAvgIterations);

@@ -117,18 +117,118 @@ int update_weights(PixelWeights& w, int winner, float psi) {
 // ---- ClusterState -----------------------------------------------------------------------
 
 namespace {
-// Points are split into this many fixed blocks for the centre sums; the sums are reduced in
-// block order, so results do not depend on the number of threads.
-constexpr int kBlocks = 64;
+// Grid points are taken in blocks of kAssignBlock, gathered into a small buffer on the stack
+// (the point arrays are read once per pass and nothing grid-sized is copied), and the blocks
+// are split into kChunks fixed ranges for the sums. Sums are reduced in chunk order, so
+// results do not depend on the number of threads.
+constexpr std::size_t kAssignBlock = 256;
+constexpr int kChunks = 64;
 constexpr int kSums = 11;  // x y z r g b nx ny nz, count, f
+constexpr std::uint16_t kNoWinner = 0xffff;  // k <= 65535, so 0-based winners stay below it
+
+/// The active grid points of one block, structure of arrays.
+struct PointBlock {
+    std::size_t m = 0;  ///< points gathered
+    std::uint32_t grid[kAssignBlock];
+    float x[kAssignBlock], y[kAssignBlock], z[kAssignBlock];
+    float r[kAssignBlock], g[kAssignBlock], b[kAssignBlock];
+    float nx[kAssignBlock], ny[kAssignBlock], nz[kAssignBlock];
+    float gamma[kAssignBlock];  ///< gamma where the point has a normal, else 0 (eq. 6 needs both)
+};
+
+/// What the assignment kernel compares the points with: centres, structure of arrays.
+struct CentreView {
+    const float *x, *y, *z, *r, *g, *b, *nx, *ny, *nz;
+    const float* has_normal;  ///< 1 or 0 per centre
+    int k;
+    float d2, a2;             ///< delta^2, alpha^2 (0 without colour)
+};
+
+/// Winner and f of each point of the block. Points in the inner loop, centres in the outer
+/// (as FAISS does): the inner loop runs over contiguous points and vectorizes whatever k
+/// is. Built twice, for AVX2 and for baseline x86-64, picked at load time: baseline SSE2 has
+/// no blend, so GCC keeps the arg-min scalar there.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void assign_block(const CentreView& c, const PointBlock& pb, int* winner, float* fmin) {
+    const std::size_t m = pb.m;
+    for (std::size_t q = 0; q < m; ++q) {
+        fmin[q] = INFINITY;
+        winner[q] = 0;
+    }
+    for (int j = 0; j < c.k; ++j) {
+        const float qx = c.x[j], qy = c.y[j], qz = c.z[j];
+        const float qr = c.r[j], qg = c.g[j], qb = c.b[j];
+        const float qnx = c.nx[j], qny = c.ny[j], qnz = c.nz[j];
+        const float qn = c.has_normal[j];
+        for (std::size_t q = 0; q < m; ++q) {
+            const float dx = pb.x[q] - qx, dy = pb.y[q] - qy, dz = pb.z[q] - qz;
+            const float dr = pb.r[q] - qr, dg = pb.g[q] - qg, db = pb.b[q] - qb;
+            // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
+            // arg-min of f is not the arg-min of the squared distance.
+            const float dist = std::sqrt(c.d2 * (dx * dx + dy * dy + dz * dz) +
+                                         c.a2 * (dr * dr + dg * dg + db * db));
+            const float cos_theta = pb.nx[q] * qnx + pb.ny[q] * qny + pb.nz[q] * qnz;
+            const float f = dist + pb.gamma[q] * qn * (1.0f - cos_theta);  // eq. (6)
+            const bool better = f < fmin[q];
+            fmin[q] = better ? f : fmin[q];
+            winner[q] = better ? j : winner[q];
+        }
+    }
+}
 }  // namespace
 
-void ClusterState::Points::resize(std::size_t n) {
-    grid.resize(n);
-    for (auto* a : {&x, &y, &z, &r, &g, &b, &nx, &ny, &nz, &f}) a->resize(n);
-    has_normal.resize(n);
-    winner.resize(n);
-}
+/// The frame as the clustering sees it: the sampled grid over the cloud, normals and mask.
+struct ClusterState::Grid {
+    const OrganizedCloud& cloud;
+    const NormalMap& normals;
+    const std::uint8_t* active;
+    float gamma;
+    int stride, w, h;
+
+    std::size_t size() const { return static_cast<std::size_t>(w) * h; }
+    std::size_t blocks() const { return (size() + kAssignBlock - 1) / kAssignBlock; }
+    /// Full-resolution pixel of grid point g.
+    std::size_t pixel(std::size_t g) const {
+        const std::size_t gv = g / static_cast<std::size_t>(w), gu = g % static_cast<std::size_t>(w);
+        return (gv * static_cast<std::size_t>(cloud.width) + gu) * static_cast<std::size_t>(stride);
+    }
+    /// Grid points of the blocks of chunk c: [first, last).
+    std::pair<std::size_t, std::size_t> chunk(int c) const {
+        const std::size_t n = blocks();
+        return {std::min(size(), n * c / kChunks * kAssignBlock),
+                std::min(size(), n * (c + 1) / kChunks * kAssignBlock)};
+    }
+    /// The active points among grid points [g0, g1), g1 - g0 <= kAssignBlock, into pb.
+    void gather(std::size_t g0, std::size_t g1, PointBlock& pb) const {
+        std::size_t m = 0;
+        const std::size_t W = static_cast<std::size_t>(cloud.width), s = static_cast<std::size_t>(stride);
+        std::size_t gv = g0 / static_cast<std::size_t>(w), gu = g0 % static_cast<std::size_t>(w);
+        for (std::size_t g = g0; g < g1; ++g) {
+            const std::size_t p = (gv * W + gu) * s;
+            if (active[p]) {
+                pb.grid[m] = static_cast<std::uint32_t>(g);
+                pb.x[m] = cloud.x[p];
+                pb.y[m] = cloud.y[p];
+                pb.z[m] = cloud.z[p];
+                pb.r[m] = cloud.r[p];
+                pb.g[m] = cloud.g[p];
+                pb.b[m] = cloud.b[p];
+                pb.nx[m] = normals.nx[p];  // 0 where there is no normal (normals.hpp)
+                pb.ny[m] = normals.ny[p];
+                pb.nz[m] = normals.nz[p];
+                pb.gamma[m] = normals.valid[p] ? gamma : 0.0f;
+                ++m;
+            }
+            if (++gu == static_cast<std::size_t>(w)) {
+                gu = 0;
+                ++gv;
+            }
+        }
+        pb.m = m;
+    }
+};
 
 ClusterState::ClusterState(const ClusterParams& params) : params_(params) {
     params_.validate();
@@ -153,260 +253,209 @@ void ClusterState::allocate(int width, int height) {
     const std::size_t grid = static_cast<std::size_t>(grid_w_) * grid_h_;
     mu_.assign(grid, PixelWeights{});
     grid_label_.assign(grid, 0);
-    row_count_.assign(grid_h_ + 1, 0);
-    pts_.resize(grid);
-    cumulative_.resize(grid);
-    candidate_f_.resize(grid);
-    best_candidate_f_.resize(grid);
-    block_sums_.assign(static_cast<std::size_t>(kBlocks) * params_.k * kSums, 0.0);
+    winner_.assign(grid, kNoWinner);
+    f_.assign(grid, 0.0f);
+    chunk_sums_.assign(static_cast<std::size_t>(kChunks) * params_.k * kSums, 0.0);
     reset();
 }
 
-void ClusterState::gather(const OrganizedCloud& cloud, const NormalMap& normals,
-                          const std::vector<std::uint8_t>& active) {
-    const int s = params_.stride, W = cloud.width;
-    // Two passes over grid rows (count, then fill at prefix offsets) keep the packed order
-    // the raster order whatever the thread count.
-#pragma omp parallel for schedule(static)
-    for (int gv = 0; gv < grid_h_; ++gv) {
-        const std::size_t row = static_cast<std::size_t>(gv) * s * W;
-        int c = 0;
-        for (int gu = 0; gu < grid_w_; ++gu) c += active[row + static_cast<std::size_t>(gu) * s];
-        row_count_[gv + 1] = c;
+std::size_t ClusterState::count_active(const Grid& grid) const {
+    std::size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+    for (int gv = 0; gv < grid.h; ++gv) {
+        const std::uint8_t* row = grid.active + grid.pixel(static_cast<std::size_t>(gv) * grid.w);
+        for (int gu = 0; gu < grid.w; ++gu) n += row[static_cast<std::size_t>(gu) * grid.stride];
     }
-    row_count_[0] = 0;
-    for (int gv = 0; gv < grid_h_; ++gv) row_count_[gv + 1] += row_count_[gv];
-    n_ = static_cast<std::size_t>(row_count_[grid_h_]);
-
-#pragma omp parallel for schedule(static)
-    for (int gv = 0; gv < grid_h_; ++gv) {
-        std::size_t i = static_cast<std::size_t>(row_count_[gv]);
-        const std::size_t row = static_cast<std::size_t>(gv) * s * W;
-        for (int gu = 0; gu < grid_w_; ++gu) {
-            const std::size_t p = row + static_cast<std::size_t>(gu) * s;
-            if (!active[p]) continue;
-            pts_.grid[i] = gv * grid_w_ + gu;
-            pts_.x[i] = cloud.x[p];
-            pts_.y[i] = cloud.y[p];
-            pts_.z[i] = cloud.z[p];
-            pts_.r[i] = cloud.r[p];
-            pts_.g[i] = cloud.g[p];
-            pts_.b[i] = cloud.b[p];
-            pts_.nx[i] = normals.nx[p];
-            pts_.ny[i] = normals.ny[p];
-            pts_.nz[i] = normals.nz[p];
-            pts_.has_normal[i] = normals.valid[p];
-            ++i;
-        }
-    }
+    return n;
 }
 
-namespace {
-
-/// What the assignment kernel reads: packed points and centres, structure of arrays.
-struct AssignInputs {
-    const float *x, *y, *z, *r, *g, *b, *nx, *ny, *nz;
-    const std::uint8_t* has_normal;
-    const float *cx, *cy, *cz, *cr, *cg, *cb, *cnx, *cny, *cnz;
-    const float* centre_has_normal;  ///< 1 or 0 per centre
-    int k;
-    float d2, a2, gamma;             ///< delta^2, alpha^2 (0 without colour), gamma
-};
-
-constexpr std::size_t kAssignBlock = 256;
-
-/// Winner (unless null) and f of points [i0, i0 + m), m <= kAssignBlock. Points in a block, centres in
-/// the outer loop (as FAISS does): the inner loop runs over contiguous points and
-/// vectorizes whatever k is. Built twice, for AVX2 and for baseline x86-64, picked at load
-/// time: baseline SSE2 has no blend, so GCC keeps the arg-min scalar there.
-#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void assign_block(const AssignInputs& in, std::size_t i0, std::size_t m, int* winner,
-                  float* fmin) {
-    float best_f[kAssignBlock], gp[kAssignBlock];
-    int best[kAssignBlock];
-    for (std::size_t q = 0; q < m; ++q) {
-        best_f[q] = INFINITY;
-        best[q] = 0;
-        gp[q] = in.has_normal[i0 + q] ? in.gamma : 0.0f;
+std::size_t ClusterState::nth_active(const Grid& grid, std::size_t r) const {
+    for (std::size_t g = 0, gv = 0; gv < static_cast<std::size_t>(grid.h); ++gv) {
+        const std::uint8_t* row = grid.active + grid.pixel(gv * grid.w);
+        for (int gu = 0; gu < grid.w; ++gu, ++g)
+            if (row[static_cast<std::size_t>(gu) * grid.stride] && r-- == 0) return g;
     }
-    const float *X = in.x + i0, *Y = in.y + i0, *Z = in.z + i0;
-    const float *R = in.r + i0, *G = in.g + i0, *B = in.b + i0;
-    const float *NX = in.nx + i0, *NY = in.ny + i0, *NZ = in.nz + i0;
-    for (int j = 0; j < in.k; ++j) {
-        const float qx = in.cx[j], qy = in.cy[j], qz = in.cz[j];
-        const float qr = in.cr[j], qg = in.cg[j], qb = in.cb[j];
-        const float qnx = in.cnx[j], qny = in.cny[j], qnz = in.cnz[j];
-        const float qn = in.centre_has_normal[j];
-        for (std::size_t q = 0; q < m; ++q) {
-            const float dx = X[q] - qx, dy = Y[q] - qy, dz = Z[q] - qz;
-            const float dr = R[q] - qr, dg = G[q] - qg, db = B[q] - qb;
-            // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
-            // arg-min of f is not the arg-min of the squared distance.
-            const float dist = std::sqrt(in.d2 * (dx * dx + dy * dy + dz * dz) +
-                                         in.a2 * (dr * dr + dg * dg + db * db));
-            const float cos_theta = NX[q] * qnx + NY[q] * qny + NZ[q] * qnz;
-            const float f = dist + gp[q] * qn * (1.0f - cos_theta);  // eq. (6)
-            const bool better = f < best_f[q];
-            best_f[q] = better ? f : best_f[q];
-            best[q] = better ? j : best[q];
-        }
-    }
-    for (std::size_t q = 0; q < m; ++q) fmin[i0 + q] = best_f[q];
-    if (winner)
-        for (std::size_t q = 0; q < m; ++q) winner[i0 + q] = best[q];
+    return 0;  // not reached: r < n_
 }
 
-}  // namespace
-
-void ClusterState::set_centre(int j, std::size_t i) {
-    centres_.x[j] = pts_.x[i];
-    centres_.y[j] = pts_.y[i];
-    centres_.z[j] = pts_.z[i];
-    centres_.r[j] = pts_.r[i];
-    centres_.g[j] = pts_.g[i];
-    centres_.b[j] = pts_.b[i];
-    centres_.nx[j] = pts_.nx[i];
-    centres_.ny[j] = pts_.ny[i];
-    centres_.nz[j] = pts_.nz[i];
+void ClusterState::set_centre(int j, const Grid& grid, std::size_t g) {
+    const std::size_t p = grid.pixel(g);
+    centres_.x[j] = grid.cloud.x[p];
+    centres_.y[j] = grid.cloud.y[p];
+    centres_.z[j] = grid.cloud.z[p];
+    centres_.r[j] = grid.cloud.r[p];
+    centres_.g[j] = grid.cloud.g[p];
+    centres_.b[j] = grid.cloud.b[p];
+    centres_.nx[j] = grid.normals.nx[p];
+    centres_.ny[j] = grid.normals.ny[p];
+    centres_.nz[j] = grid.normals.nz[p];
     centres_.count[j] = 0;
 }
 
-void ClusterState::f_to_point(std::size_t c, std::vector<float>& out) const {
+double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
     // Point c as the one centre of the assignment kernel.
-    const float one = pts_.has_normal[c] ? 1.0f : 0.0f;
-    const AssignInputs in{pts_.x.data(), pts_.y.data(), pts_.z.data(), pts_.r.data(),
-                          pts_.g.data(), pts_.b.data(), pts_.nx.data(), pts_.ny.data(),
-                          pts_.nz.data(), pts_.has_normal.data(),
-                          &pts_.x[c], &pts_.y[c], &pts_.z[c], &pts_.r[c], &pts_.g[c], &pts_.b[c],
-                          &pts_.nx[c], &pts_.ny[c], &pts_.nz[c], &one, 1,
+    const std::size_t pc = grid.pixel(c);
+    const float x = grid.cloud.x[pc], y = grid.cloud.y[pc], z = grid.cloud.z[pc];
+    const float r = grid.cloud.r[pc], g = grid.cloud.g[pc], b = grid.cloud.b[pc];
+    const float nx = grid.normals.nx[pc], ny = grid.normals.ny[pc], nz = grid.normals.nz[pc];
+    const float has_normal = grid.normals.valid[pc] ? 1.0f : 0.0f;
+    const CentreView view{&x, &y, &z, &r, &g, &b, &nx, &ny, &nz, &has_normal, 1,
                           params_.delta * params_.delta,
-                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
-    const std::size_t n = n_;
-    const auto blocks = static_cast<std::ptrdiff_t>((n + kAssignBlock - 1) / kAssignBlock);
+                          use_color_ ? params_.alpha * params_.alpha : 0.0f};
+    double chunk_potential[kChunks] = {};
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t blk = 0; blk < blocks; ++blk) {
-        const std::size_t i0 = static_cast<std::size_t>(blk) * kAssignBlock;
-        assign_block(in, i0, std::min(kAssignBlock, n - i0), nullptr, out.data());
+    for (int ch = 0; ch < kChunks; ++ch) {
+        PointBlock pb;
+        int winner[kAssignBlock];
+        float f[kAssignBlock];
+        double potential = 0;
+        const auto [first, last] = grid.chunk(ch);
+        for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
+            const std::size_t g1 = std::min(last, g0 + kAssignBlock);
+            grid.gather(g0, g1, pb);
+            assign_block(view, pb, winner, f);
+            if (use == FToPoint::Set) {
+                std::fill(f_.begin() + static_cast<std::ptrdiff_t>(g0),
+                          f_.begin() + static_cast<std::ptrdiff_t>(g1), 0.0f);
+                for (std::size_t q = 0; q < pb.m; ++q) f_[pb.grid[q]] = f[q];
+            } else if (use == FToPoint::Lower) {
+                for (std::size_t q = 0; q < pb.m; ++q)
+                    f_[pb.grid[q]] = std::min(f_[pb.grid[q]], f[q]);
+            } else {
+                for (std::size_t q = 0; q < pb.m; ++q) {
+                    const double d = std::min(f_[pb.grid[q]], f[q]);
+                    potential += d * d;
+                }
+            }
+        }
+        chunk_potential[ch] = potential;
     }
+    double total = 0;
+    for (double p : chunk_potential) total += p;
+    return total;
 }
 
-std::size_t ClusterState::sample_by_f_squared() {
+std::size_t ClusterState::sample_by_f_squared(const Grid& grid) {
     // Greedy k-means++ (Arthur & Vassilvitskii 2007, section 6): draw a few candidates with
     // probability proportional to f^2, f being the distance to the nearest centre chosen so
-    // far, and keep the one that lowers the total f^2 most. Its distances are left in
-    // best_candidate_f_. Sums run serially or in fixed blocks, in order, so the choice does
-    // not depend on the thread count.
-    double total = 0;
-    for (std::size_t i = 0; i < n_; ++i) {
-        total += static_cast<double>(pts_.f[i]) * pts_.f[i];
-        cumulative_[i] = total;
+    // far, and keep the one that lowers the total f^2 most. Sums run in fixed chunks, in
+    // order, so the choice does not depend on the thread count.
+    double chunk_total[kChunks];
+#pragma omp parallel for schedule(static)
+    for (int ch = 0; ch < kChunks; ++ch) {
+        const auto [first, last] = grid.chunk(ch);
+        double sum = 0;
+        for (std::size_t g = first; g < last; ++g) sum += static_cast<double>(f_[g]) * f_[g];
+        chunk_total[ch] = sum;
     }
+    double total = 0;
+    for (double t : chunk_total) total += t;
     const int trials = 2 + static_cast<int>(std::log(static_cast<double>(params_.k)));
     std::size_t best = 0;
     double best_potential = INFINITY;
     for (int t = 0; t < trials; ++t) {
-        std::size_t c;
+        std::size_t c = 0;
         if (total > 0) {
+            // The first point whose running sum of f^2 passes the target: find its chunk,
+            // then walk the chunk. Points outside the mask have f = 0 and are never drawn.
             const double target = std::uniform_real_distribution<double>(0.0, total)(rng_);
-            c = static_cast<std::size_t>(
-                std::upper_bound(cumulative_.begin(), cumulative_.begin() + n_, target) -
-                cumulative_.begin());
-            c = std::min(c, n_ - 1);
-        } else {  // every point sits on a centre: any point will do
-            c = std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_);
-        }
-        f_to_point(c, candidate_f_);
-        double block_potential[kBlocks];
-#pragma omp parallel for schedule(static)
-        for (int blk = 0; blk < kBlocks; ++blk) {
-            double sum = 0;
-            for (std::size_t i = n_ * blk / kBlocks; i < n_ * (blk + 1) / kBlocks; ++i) {
-                const double f = std::min(pts_.f[i], candidate_f_[i]);
-                sum += f * f;
+            double acc = 0;
+            int ch = 0;
+            while (ch + 1 < kChunks && acc + chunk_total[ch] <= target) acc += chunk_total[ch++];
+            const auto [first, last] = grid.chunk(ch);
+            c = last;
+            std::size_t last_drawable = first;
+            for (std::size_t g = first; g < last; ++g) {
+                if (f_[g] == 0) continue;
+                last_drawable = g;
+                acc += static_cast<double>(f_[g]) * f_[g];
+                if (acc > target) {
+                    c = g;
+                    break;
+                }
             }
-            block_potential[blk] = sum;
+            if (c == last) c = last_drawable;  // rounding put the target past the chunk's end
+        } else {  // every point sits on a centre: any point will do
+            c = nth_active(grid, std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_));
         }
-        double potential = 0;
-        for (double p : block_potential) potential += p;
+        const double potential = f_to_point(grid, c, FToPoint::Potential);
         if (potential < best_potential) {
             best_potential = potential;
             best = c;
-            candidate_f_.swap(best_candidate_f_);
         }
     }
     return best;
 }
 
-void ClusterState::add_centre(int j) {
-    set_centre(j, sample_by_f_squared());
-    const auto n = static_cast<std::ptrdiff_t>(n_);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) pts_.f[i] = std::min(pts_.f[i], best_candidate_f_[i]);
+void ClusterState::add_centre(int j, const Grid& grid) {
+    const std::size_t c = sample_by_f_squared(grid);
+    set_centre(j, grid, c);
+    f_to_point(grid, c, FToPoint::Lower);
 }
 
-void ClusterState::seed_kmeanspp() {
-    const std::size_t first = std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_);
-    set_centre(0, first);
-    f_to_point(first, pts_.f);
-    for (int j = 1; j < params_.k; ++j) add_centre(j);
+void ClusterState::seed_kmeanspp(const Grid& grid) {
+    const std::size_t first =
+        nth_active(grid, std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_));
+    set_centre(0, grid, first);
+    f_to_point(grid, first, FToPoint::Set);
+    for (int j = 1; j < params_.k; ++j) add_centre(j, grid);
 }
 
-void ClusterState::assign() {
+void ClusterState::assign(const Grid& grid) {
     const int k = params_.k;
     // 1 where the centre has a normal, so that the normal term drops out for it (eq. 6
     // needs both normals).
     for (int j = 0; j < k; ++j) centre_normal_[j] = centre_has_normal(j) ? 1.0f : 0.0f;
-    const AssignInputs in{pts_.x.data(),  pts_.y.data(),  pts_.z.data(),  pts_.r.data(),
-                          pts_.g.data(),  pts_.b.data(),  pts_.nx.data(), pts_.ny.data(),
-                          pts_.nz.data(), pts_.has_normal.data(),
-                          centres_.x.data(), centres_.y.data(), centres_.z.data(),
-                          centres_.r.data(), centres_.g.data(), centres_.b.data(),
+    const CentreView view{centres_.x.data(),  centres_.y.data(),  centres_.z.data(),
+                          centres_.r.data(),  centres_.g.data(),  centres_.b.data(),
                           centres_.nx.data(), centres_.ny.data(), centres_.nz.data(),
                           centre_normal_.data(), k, params_.delta * params_.delta,
-                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
-    int* winner = pts_.winner.data();
-    float* fmin = pts_.f.data();
-    const std::size_t n = n_;
-    const auto blocks = static_cast<std::ptrdiff_t>((n + kAssignBlock - 1) / kAssignBlock);
+                          use_color_ ? params_.alpha * params_.alpha : 0.0f};
+    std::fill(chunk_sums_.begin(), chunk_sums_.end(), 0.0);
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t blk = 0; blk < blocks; ++blk) {
-        const std::size_t i0 = static_cast<std::size_t>(blk) * kAssignBlock;
-        assign_block(in, i0, std::min(kAssignBlock, n - i0), winner, fmin);
+    for (int ch = 0; ch < kChunks; ++ch) {
+        PointBlock pb;
+        int winner[kAssignBlock];
+        float f[kAssignBlock];
+        double* sums = chunk_sums_.data() + static_cast<std::size_t>(ch) * k * kSums;
+        const auto [first, last] = grid.chunk(ch);
+        for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
+            const std::size_t g1 = std::min(last, g0 + kAssignBlock);
+            grid.gather(g0, g1, pb);
+            assign_block(view, pb, winner, f);
+            std::fill(winner_.begin() + static_cast<std::ptrdiff_t>(g0),
+                      winner_.begin() + static_cast<std::ptrdiff_t>(g1), kNoWinner);
+            std::fill(f_.begin() + static_cast<std::ptrdiff_t>(g0),
+                      f_.begin() + static_cast<std::ptrdiff_t>(g1), 0.0f);
+            // The centre sums of move_centres, while the block is in cache. A point without
+            // a normal has a zero normal (normals.hpp), so it adds nothing to the normal sums.
+            for (std::size_t q = 0; q < pb.m; ++q) {
+                winner_[pb.grid[q]] = static_cast<std::uint16_t>(winner[q]);
+                f_[pb.grid[q]] = f[q];
+                double* sj = sums + static_cast<std::size_t>(winner[q]) * kSums;
+                sj[0] += pb.x[q];
+                sj[1] += pb.y[q];
+                sj[2] += pb.z[q];
+                sj[3] += pb.r[q];
+                sj[4] += pb.g[q];
+                sj[5] += pb.b[q];
+                sj[6] += pb.nx[q];
+                sj[7] += pb.ny[q];
+                sj[8] += pb.nz[q];
+                sj[9] += 1.0;
+                sj[10] += f[q];
+            }
+        }
     }
 }
 
 double ClusterState::move_centres() {
     const int k = params_.k;
-    std::fill(block_sums_.begin(), block_sums_.end(), 0.0);
-    const std::size_t n = n_;
-#pragma omp parallel for schedule(static)
-    for (int blk = 0; blk < kBlocks; ++blk) {
-        double* s = block_sums_.data() + static_cast<std::size_t>(blk) * k * kSums;
-        const std::size_t i0 = n * blk / kBlocks, i1 = n * (blk + 1) / kBlocks;
-        for (std::size_t i = i0; i < i1; ++i) {
-            double* sj = s + static_cast<std::size_t>(pts_.winner[i]) * kSums;
-            sj[0] += pts_.x[i];
-            sj[1] += pts_.y[i];
-            sj[2] += pts_.z[i];
-            sj[3] += pts_.r[i];
-            sj[4] += pts_.g[i];
-            sj[5] += pts_.b[i];
-            if (pts_.has_normal[i]) {
-                sj[6] += pts_.nx[i];
-                sj[7] += pts_.ny[i];
-                sj[8] += pts_.nz[i];
-            }
-            sj[9] += 1.0;
-            sj[10] += pts_.f[i];
-        }
-    }
     double total_f = 0;
     for (int j = 0; j < k; ++j) {
         double t[kSums] = {};
-        for (int blk = 0; blk < kBlocks; ++blk) {
-            const double* sj = block_sums_.data() + (static_cast<std::size_t>(blk) * k + j) * kSums;
+        for (int ch = 0; ch < kChunks; ++ch) {
+            const double* sj = chunk_sums_.data() + (static_cast<std::size_t>(ch) * k + j) * kSums;
             for (int q = 0; q < kSums; ++q) t[q] += sj[q];
         }
         total_f += t[10];
@@ -428,14 +477,14 @@ double ClusterState::move_centres() {
     return n_ ? total_f / static_cast<double>(n_) : 0.0;
 }
 
-int ClusterState::reseed_empty() {
+int ClusterState::reseed_empty(const Grid& grid) {
     // A centre that lost all its points moves to a point far from every centre, drawn with
     // k-means++'s D^2 rule, so that a new object entering the scene can take it
     // (ALGORITHM.md, "The loop"; paper Figure 5(b)).
     int reseeded = 0;
     for (int j = 0; j < params_.k; ++j) {
         if (centres_.count[j] != 0 || n_ == 0) continue;
-        add_centre(j);
+        add_centre(j, grid);
         ++reseeded;
     }
     return reseeded;
@@ -443,19 +492,20 @@ int ClusterState::reseed_empty() {
 
 void ClusterState::update_weights_and_labels() {
     const float psi = params_.psi;
-    std::fill(grid_label_.begin(), grid_label_.end(), 0);
-    const auto n = static_cast<std::ptrdiff_t>(n_);
+    const auto size = static_cast<std::ptrdiff_t>(winner_.size());
 #pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < n; ++i) {
-        const std::size_t g = static_cast<std::size_t>(pts_.grid[i]);
-        const int label = update_weights(mu_[g], pts_.winner[i], psi);
-        grid_label_[g] = static_cast<std::uint16_t>(label + 1);
+    for (std::ptrdiff_t g = 0; g < size; ++g) {
+        const std::uint16_t w = winner_[g];
+        grid_label_[g] = w == kNoWinner
+                             ? std::uint16_t{0}
+                             : static_cast<std::uint16_t>(update_weights(mu_[g], w, psi) + 1);
     }
 }
 
 void ClusterState::last_winners(std::vector<int>& per_grid_point) const {
-    per_grid_point.assign(static_cast<std::size_t>(grid_w_) * grid_h_, -1);
-    for (std::size_t i = 0; i < n_; ++i) per_grid_point[pts_.grid[i]] = pts_.winner[i];
+    per_grid_point.resize(winner_.size());
+    for (std::size_t g = 0; g < winner_.size(); ++g)
+        per_grid_point[g] = winner_[g] == kNoWinner ? -1 : winner_[g];
 }
 
 FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& normals,
@@ -463,6 +513,7 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
     if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
     centre_normal_.resize(params_.k);
     use_color_ = cloud.has_color;
+    const Grid grid{cloud, normals, active.data(), params_.gamma, params_.stride, grid_w_, grid_h_};
     using Clock = std::chrono::steady_clock;
     auto ms_since = [](Clock::time_point& t) {
         const auto now = Clock::now();
@@ -472,9 +523,7 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
     };
     FrameStats stats;
     auto t = Clock::now();
-    gather(cloud, normals, active);
-    stats.ms.gather = ms_since(t);
-
+    n_ = count_active(grid);
     stats.points = n_;
     if (!seeded_) {
         if (n_ < static_cast<std::size_t>(params_.k)) {
@@ -483,25 +532,25 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
                 << " valid points in the depth range of the first frame";
             throw InputError(msg.str());
         }
-        seed_kmeanspp();
+        seed_kmeanspp(grid);
         seeded_ = true;
         stats.seeded = true;
-        stats.ms.seeding = ms_since(t);
     }
+    stats.ms.seeding = ms_since(t);  // with the count of active points
 
-    if (n_ > 0) {
-        for (int it = 0; it < params_.iters; ++it) {
-            assign();
-            stats.ms.assign += ms_since(t);
-            if (it + 1 == params_.iters) {
-                update_weights_and_labels();
-                stats.ms.weights = ms_since(t);
-            }
-            stats.mean_f = move_centres();
-            stats.reseeded += reseed_empty();
-            stats.ms.centres += ms_since(t);
+    for (int it = 0; it < params_.iters && n_ > 0; ++it) {
+        assign(grid);
+        stats.ms.assign += ms_since(t);
+        if (it + 1 == params_.iters) {
+            update_weights_and_labels();
+            stats.ms.weights = ms_since(t);
         }
-    } else {
+        stats.mean_f = move_centres();
+        stats.reseeded += reseed_empty(grid);
+        stats.ms.centres += ms_since(t);
+    }
+    if (n_ == 0) {  // nothing to cluster: weights and centres stay as they were
+        std::fill(winner_.begin(), winner_.end(), kNoWinner);
         std::fill(grid_label_.begin(), grid_label_.end(), 0);
     }
     ++tau_;

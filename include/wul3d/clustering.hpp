@@ -56,11 +56,12 @@ struct FrameStats {
     bool seeded = false;             ///< k-means++ ran on this frame
     int reseeded = 0;                ///< empty clusters re-seeded on this frame
     double mean_f = 0;               ///< mean distance f (eq. 6) of the points to their winner
-    /// Milliseconds in each phase of step(): packing the active points, k-means++ seeding,
-    /// distances and arg-min (eq. 6, every iteration), weight update and labels (eq. 2, 7, 8),
-    /// centre update and re-seeding, full-resolution labels. For the profile in bench/.
+    /// Milliseconds in each phase of step(): counting the active points and k-means++
+    /// seeding, distances and arg-min with the centre sums (eq. 6, every iteration), weight
+    /// update and labels (eq. 2, 7, 8), centre update and re-seeding, full-resolution labels.
+    /// For the profile in bench/.
     struct Phases {
-        double gather = 0, seeding = 0, assign = 0, weights = 0, centres = 0, labels = 0;
+        double seeding = 0, assign = 0, weights = 0, centres = 0, labels = 0;
     } ms;
 };
 
@@ -145,19 +146,25 @@ public:
     void last_winners(std::vector<int>& per_grid_point) const;
 
 private:
+    struct Grid;  ///< this frame's cloud, normals and mask on the sampled grid (clustering.cpp)
+    enum class FToPoint { Set, Lower, Potential };
+
     void allocate(int width, int height);
-    void gather(const OrganizedCloud& cloud, const NormalMap& normals,
-                const std::vector<std::uint8_t>& active);
-    void seed_kmeanspp();
-    void assign();
-    double move_centres();  ///< returns the mean f of the assignment
-    int reseed_empty();
+    std::size_t count_active(const Grid& grid) const;
+    std::size_t nth_active(const Grid& grid, std::size_t r) const;  ///< grid index of the r-th
+    void seed_kmeanspp(const Grid& grid);
+    /// Eq. (6) arg-min of every active point into winner_ and f_, with the centre sums.
+    void assign(const Grid& grid);
+    double move_centres();  ///< centres from assign's sums; returns the mean f
+    int reseed_empty(const Grid& grid);
     void update_weights_and_labels();
     // helpers of seeding and re-seeding
-    void set_centre(int j, std::size_t i);
-    void f_to_point(std::size_t c, std::vector<float>& out) const;  ///< f of every point to point c
-    std::size_t sample_by_f_squared();
-    void add_centre(int j);  ///< centre j by the greedy D^2 rule; lowers every point's f
+    void set_centre(int j, const Grid& grid, std::size_t g);
+    /// f of every active point to grid point c: Set stores it in f_, Lower keeps the
+    /// smaller of it and f_, Potential returns the sum of min(f_, f)^2 and stores nothing.
+    double f_to_point(const Grid& grid, std::size_t c, FToPoint use);
+    std::size_t sample_by_f_squared(const Grid& grid);
+    void add_centre(int j, const Grid& grid);  ///< centre j by the greedy D^2 rule; lowers f_
     bool centre_has_normal(int j) const {
         return centres_.nx[j] != 0.0f || centres_.ny[j] != 0.0f || centres_.nz[j] != 0.0f;
     }
@@ -170,22 +177,14 @@ private:
     int width_ = 0, height_ = 0, grid_w_ = 0, grid_h_ = 0;
     std::mt19937_64 rng_;
 
-    // Scratch, sized once per resolution: the active grid points of this frame, packed.
-    struct Points {
-        std::vector<int> grid;  ///< grid index of each packed point
-        std::vector<float> x, y, z, r, g, b, nx, ny, nz;
-        std::vector<std::uint8_t> has_normal;
-        std::vector<int> winner;  ///< centre with the smallest f
-        std::vector<float> f;     ///< that smallest f
-        void resize(std::size_t n);
-    } pts_;
-    std::vector<std::uint16_t> grid_label_;  ///< arg-max weight + 1 per grid point, 0 = none
-    std::vector<int> row_count_;              ///< gather's prefix sums per grid row
-    std::vector<double> block_sums_;          ///< move_centres' per-block sums
-    std::vector<float> centre_normal_;        ///< 1 where centre j has a normal
-    std::vector<double> cumulative_;          ///< seeding's running sum of f^2
-    std::vector<float> candidate_f_, best_candidate_f_;  ///< seeding: f to a candidate
-    std::size_t n_ = 0;       ///< packed points this frame
+    // Per grid point, sized once per resolution (the points themselves are read from the
+    // cloud block by block, never copied whole: 8 bytes a point besides the weights).
+    std::vector<std::uint16_t> winner_;      ///< 0-based winner of the last assignment, 0xffff: inactive
+    std::vector<float> f_;                   ///< f to that winner (while seeding: to the nearest centre); 0: inactive
+    std::vector<std::uint16_t> grid_label_;  ///< arg-max weight + 1, 0 = none
+    std::vector<double> chunk_sums_;         ///< assign's centre sums per fixed chunk of points
+    std::vector<float> centre_normal_;       ///< 1 where centre j has a normal
+    std::size_t n_ = 0;       ///< active grid points this frame
     bool use_color_ = true;   ///< false for depth-only frames: the colour term drops out
 };
 
