@@ -72,6 +72,15 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
     t = Clock::now();
     render_weight_colors(state_, r.labels, frame, r.colors);
     r.times.colors = ms_since(t);
+    if (!params_.detect_objects) {
+        r.plane = PlaneResult{};
+        r.plane_classes.clear();
+        r.segments = LabelImage{};
+        r.segment_stats = SegmentStats{};
+        r.objects = LabelImage{};
+        r.object_list.clear();
+        return r;
+    }
 
     // Objects: the support plane goes (part of the paper's background step, done after the
     // clustering so that labels.png keeps the paper's clusters), the rest is segmented and

@@ -3,6 +3,7 @@
 // Figure 7. Parsing, timing and reporting only; the pipeline is the library's.
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,6 +32,9 @@ struct BenchOptions {
     std::string csv;
     std::size_t frames = 5;  // distinct frames loaded
     int passes = 4;          // times the frames are run through the pipeline
+    std::string pipeline = "objects";  // objects: the default object pipeline; paper: its steps only
+    std::string segmenter;             // empty: the default
+    int threads = 0;                   // 0: all cores
     int single_k = 0;        // internal: measure this k in this process and print one row
 };
 
@@ -97,6 +101,9 @@ void measure_one(const BenchOptions& o) {
     }
     PipelineParams params;
     params.cluster.k = o.single_k;
+    params.detect_objects = o.pipeline == "objects";
+    if (!o.segmenter.empty()) params.segmentation.segmenter = parse_segmenter(o.segmenter);
+    if (o.threads > 0) omp_set_num_threads(o.threads);
     Pipeline pipeline(params);
     pipeline.process(frames.front());  // seeding is a one-off: not timed
     std::vector<double> ms;
@@ -129,7 +136,9 @@ std::string run_child(const BenchOptions& o, int k) {
         std::vector<std::string> args = {"wul3d", "bench", o.input, "--single-k", std::to_string(k),
                                          "--resolution", o.resolution, "--frames",
                                          std::to_string(o.frames), "--passes",
-                                         std::to_string(o.passes)};
+                                         std::to_string(o.passes), "--pipeline", o.pipeline,
+                                         "--threads", std::to_string(o.threads)};
+        if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
         argv.push_back(nullptr);
@@ -157,6 +166,9 @@ void run(const BenchOptions& o) {
     }
     int w = 0, h = 0;
     parse_resolution(o.resolution, w, h);  // fail before forking
+    if (o.pipeline != "objects" && o.pipeline != "paper")
+        throw ParamError("--pipeline '" + o.pipeline + "': expected objects or paper");
+    if (!o.segmenter.empty()) parse_segmenter(o.segmenter);
     std::vector<int> ks;
     {
         std::stringstream ss(o.ks);
@@ -206,6 +218,13 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--passes", opts->passes, "Passes over the frames")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
+    cmd->add_option("--pipeline", opts->pipeline,
+                    "objects: the default object pipeline; paper: the paper's steps only "
+                    "(back-projection to eq. 9 colours)")
+        ->capture_default_str();
+    cmd->add_option("--segmenter", opts->segmenter, "geometric|kmeans|hybrid (default: hybrid)");
+    cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
+        ->check(CLI::Range(0, 1 << 16));
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");
     cmd->callback([opts]() { run(*opts); });

@@ -23,6 +23,9 @@ struct PipelineParams {
     NormalParams normals;
     DepthRange range;
     ClusterParams cluster;
+    /// false: stop after the paper's steps (eq. 9 colours): no support plane, segments or
+    /// tracks, and none of their buffers (`wul3d bench --pipeline paper`).
+    bool detect_objects = true;
     bool remove_plane = true;  ///< false: --no-plane, the paper's background (depth range only)
     PlaneParams plane;
     SegmentParams segmentation;
@@ -55,6 +58,7 @@ struct FrameResult {
     LabelImage segments;                       ///< this frame's segments, 0 = background
     SegmentStats segment_stats;
     LabelImage objects;                        ///< 0 = background, else track id (objects.png)
+                                               ///< (the four above empty without detect_objects)
     std::vector<DetectedObject> object_list;   ///< one per object in `objects`
     StageTimes times;
 };
