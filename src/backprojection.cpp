@@ -10,7 +10,8 @@ void OrganizedCloud::resize(int w, int h) {
     width = w;
     height = h;
     const std::size_t n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-    for (auto* a : {&x, &y, &z, &r, &g, &b}) a->resize(n);
+    for (auto* a : {&x, &y, &z}) a->resize(n);
+    for (auto* a : {&r, &g, &b}) a->resize(n);
     valid.resize(n);
 }
 
@@ -49,7 +50,7 @@ std::size_t back_project(const RgbdFrame& frame, OrganizedCloud& cloud) {
                 cloud.g[p] = rgb[3 * p + 1];
                 cloud.b[p] = rgb[3 * p + 2];
             } else {
-                cloud.r[p] = cloud.g[p] = cloud.b[p] = 0.0f;
+                cloud.r[p] = cloud.g[p] = cloud.b[p] = 0;
             }
         }
     }

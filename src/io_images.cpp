@@ -492,9 +492,6 @@ void write_ply(const std::string& path, const OrganizedCloud& cloud, const Label
     char* out = buf.data() + header.size();
     static_assert(std::endian::native == std::endian::little,
                   "write_ply writes the host's floats as little-endian");
-    auto to_u8 = [](float c) {
-        return static_cast<std::uint8_t>(std::clamp(std::lround(c), 0L, 255L));
-    };
     for (std::size_t p = 0; p < n; ++p) {
         if (labels.labels[p] == 0 || !cloud.valid[p]) continue;
         const float xyz[3] = {cloud.x[p], cloud.y[p], cloud.z[p]};
@@ -502,7 +499,7 @@ void write_ply(const std::string& path, const OrganizedCloud& cloud, const Label
         if (own_colors) {
             std::memcpy(rgb, &colors.rgb[3 * p], 3);
         } else if (cloud_colors) {
-            rgb[0] = to_u8(cloud.r[p]), rgb[1] = to_u8(cloud.g[p]), rgb[2] = to_u8(cloud.b[p]);
+            rgb[0] = cloud.r[p], rgb[1] = cloud.g[p], rgb[2] = cloud.b[p];
         }
         const std::uint16_t label = labels.labels[p];
         std::memcpy(out, xyz, 12);

@@ -151,8 +151,9 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         // Raw pointers: byte stores would make the compiler reload every vector's data
         // pointer on each pixel (a char store may alias anything).
         const std::uint8_t* const valid = cloud.valid.data();
-        const float *const cz = cloud.z.data(), *const cr = cloud.r.data(),
-                    *const cg = cloud.g.data(), *const cb = cloud.b.data();
+        const float* const cz = cloud.z.data();
+        const std::uint8_t *const cr = cloud.r.data(), *const cg = cloud.g.data(),
+                           *const cb = cloud.b.data();
         const std::uint8_t* const has_mu = has_mu_.data();
         float* const prev_z = prev_z_.data();
         std::uint8_t* const prev_rgb = prev_rgb_.data();
@@ -167,20 +168,20 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
                 ++both;
                 const float dz = std::fabs(z - prev_z[p]);
                 moved += dz > 0.05f;
-                const float dr = cr[p] - rgb[0], dg = cg[p] - rgb[1], db = cb[p] - rgb[2];
+                const int dr = cr[p] - rgb[0], dg = cg[p] - rgb[1], db = cb[p] - rgb[2];
                 const bool depth_moved = dz > change_m + change_rel * z * z;
                 held += has_mu[p];
                 held_moved += has_mu[p] && depth_moved;
                 // Reset after the votes below: the old weights still say which track was
                 // here, evidence of overlap for a moving object.
-                changed[p] = has_mu[p] && (depth_moved || dr * dr + dg * dg + db * db > rgb2);
+                changed[p] = has_mu[p] && (depth_moved || static_cast<float>(dr * dr + dg * dg + db * db) > rgb2);
             } else {
                 changed[p] = 0;
             }
             prev_z[p] = z;
-            rgb[0] = static_cast<std::uint8_t>(cr[p]);
-            rgb[1] = static_cast<std::uint8_t>(cg[p]);
-            rgb[2] = static_cast<std::uint8_t>(cb[p]);
+            rgb[0] = cr[p];
+            rgb[1] = cg[p];
+            rgb[2] = cb[p];
         }
         // Most of the surfaces the objects held moved: the objects were rearranged (a folder
         // of separate scenes), not moved along.

@@ -138,7 +138,7 @@ TEST(IoImages, PlyHeaderAndVertices) {
     cloud.x = {0.f, 1.f, 2.f, 3.f, 4.f, 5.f};
     cloud.y = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
     cloud.z = {1.f, 1.25f, 1.5f, 1.75f, 2.f, 2.25f};
-    cloud.r = cloud.g = cloud.b = std::vector<float>(6, 0.f);
+    cloud.r = cloud.g = cloud.b = std::vector<std::uint8_t>(6, 0);
     cloud.valid = {1, 1, 0, 1, 1, 1};
     wul3d::LabelImage labels;
     labels.width = 3;

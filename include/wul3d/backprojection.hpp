@@ -15,8 +15,8 @@ struct OrganizedCloud {
     int width = 0;
     int height = 0;
     bool has_color = false;      ///< false for depth-only frames: r, g, b are all 0
-    std::vector<float> x, y, z;  ///< metres, camera frame (x right, y down, z forward)
-    std::vector<float> r, g, b;  ///< 0-255
+    std::vector<float> x, y, z;         ///< metres, camera frame (x right, y down, z forward)
+    std::vector<std::uint8_t> r, g, b;  ///< the frame's 8-bit colour (memory: 3 bytes, not 12)
     std::vector<std::uint8_t> valid;
 
     std::size_t size() const { return valid.size(); }
