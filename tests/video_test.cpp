@@ -1,10 +1,13 @@
 // `wul3d run --video`: the side-by-side video (colour | clusters | selected object) is read
-// back with OpenCV's VideoCapture: one video frame per input frame, three panels wide.
+// back with OpenCV's VideoCapture: one video frame per input frame, three panels wide. The
+// video is written by the plugin libwul3d_video.so, which wul3d loads from its own folder:
+// a copy of wul3d in a folder without it must fail at once and leave nothing behind.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/videoio.hpp>
 #include <string>
@@ -14,7 +17,10 @@
 namespace {
 
 namespace fs = std::filesystem;
+using wul3d::test::cli_path;
+using wul3d::test::list_files;
 using wul3d::test::run_cli;
+using wul3d::test::run_command;
 using wul3d::test::sample_dir;
 using wul3d::test::TempDir;
 
@@ -57,6 +63,62 @@ TEST(RunVideo, FolderThatCannotBeCreated_OneLineAndNoFrames) {
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("v.mp4"), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+// A copy of the wul3d executable in tmp/bin, with the plugin beside it when `with_plugin`.
+fs::path copy_cli(const TempDir& tmp, bool with_plugin) {
+    const fs::path bin = tmp / "bin";
+    fs::create_directories(bin);
+    fs::copy_file(cli_path(), bin / cli_path().filename());
+    if (with_plugin) fs::copy_file(WUL3D_VIDEO_PLUGIN, bin / fs::path(WUL3D_VIDEO_PLUGIN).filename());
+    return bin / cli_path().filename();
+}
+
+TEST(RunVideo, PluginMissing_OneLineNamingItAndNothingWritten) {
+    TempDir tmp;
+    const fs::path cli = copy_cli(tmp, false);
+    const fs::path video = tmp / "clips" / "v.mp4";
+    const auto r = run_command({cli.string(), "run", (sample_dir() / "uois_tabletop").string(),
+                                "--out", (tmp / "out").string(), "--video", video.string(), "-q"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    const std::string plugin = fs::path(WUL3D_VIDEO_PLUGIN).filename().string();
+    EXPECT_NE(r.err.find(plugin + " not found next to wul3d"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("v.mp4"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    // Checked before the first frame: no video, no partial file, no frame outputs.
+    EXPECT_FALSE(fs::exists(video.parent_path())) << "video folder created";
+    EXPECT_TRUE(list_files(tmp / "out").empty()) << list_files(tmp / "out").front();
+}
+
+TEST(RunVideo, PluginThatIsNotOne_OneLineSayingItCannotBeLoaded) {
+    TempDir tmp;
+    const fs::path cli = copy_cli(tmp, false);
+    const std::string plugin = fs::path(WUL3D_VIDEO_PLUGIN).filename().string();
+    std::ofstream(cli.parent_path() / plugin) << "not a shared object\n";
+    const fs::path video = tmp / "v.mp4";
+    const auto r = run_command({cli.string(), "run",
+                                (sample_dir() / "uois_tabletop" / "image_0000").string(), "--out",
+                                (tmp / "out").string(), "--video", video.string(), "-q"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find(plugin + " cannot be loaded"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(fs::exists(video));
+}
+
+TEST(RunVideo, PluginIsLookedUpBesideTheExecutable) {
+    // The copy finds the copied plugin: wul3d looks in its own folder, not the build's.
+    TempDir tmp;
+    const fs::path cli = copy_cli(tmp, true);
+    const fs::path video = tmp / "v.mp4";
+    const auto r = run_command({cli.string(), "run",
+                                (sample_dir() / "uois_tabletop" / "image_0000").string(), "--out",
+                                (tmp / "out").string(), "--video", video.string(), "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    cv::VideoCapture capture(video.string(), cv::CAP_FFMPEG);
+    ASSERT_TRUE(capture.isOpened());
+    cv::Mat image;
+    EXPECT_TRUE(capture.read(image));
+    EXPECT_EQ(image.cols, 3 * 640);
 }
 
 }  // namespace

@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
+#include <dlfcn.h>
+
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include <string>
 #include <system_error>
 #include <utility>
 
+#include "video_plugin.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d::cli {
@@ -116,13 +118,63 @@ void highlight_mask(const ColorImage& base, const std::vector<std::uint8_t>& mas
 
 // ---- RunVideo ---------------------------------------------------------------------------
 
+namespace {
+
+/// The plugin's table, or why there is none (one line). Loaded once per process.
+struct LoadedPlugin {
+    const Wul3dVideoApi* api = nullptr;
+    std::string error;
+};
+
+LoadedPlugin load_plugin() {
+    LoadedPlugin r;
+    const std::string name = WUL3D_VIDEO_PLUGIN_FILE;
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) {
+        r.error = "plugin " + name + " not found: no /proc/self/exe: " + ec.message();
+        return r;
+    }
+    const fs::path file = exe.parent_path() / name;
+    dlerror();
+    void* lib = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        const char* why = dlerror();
+        r.error = "plugin " + name +
+                  (fs::exists(file, ec) ? " cannot be loaded: " : " not found next to wul3d: ") +
+                  (why ? why : file.string());
+        return r;
+    }
+    const auto entry = reinterpret_cast<Wul3dVideoApiEntry>(dlsym(lib, WUL3D_VIDEO_API_SYMBOL));
+    r.api = entry ? entry(WUL3D_VIDEO_API_VERSION) : nullptr;
+    if (!r.api || r.api->version != WUL3D_VIDEO_API_VERSION) {
+        r.api = nullptr;
+        r.error = "plugin " + file.string() + " is not wul3d's video plugin of interface version " +
+                  std::to_string(WUL3D_VIDEO_API_VERSION) + " (rebuild wul3d and its plugin together)";
+        dlclose(lib);
+    }
+    // Kept loaded to the end of the process: FFmpeg may hold threads and atexit handlers.
+    return r;
+}
+
+const Wul3dVideoApi& video_plugin(const fs::path& video) {
+    static const LoadedPlugin plugin = load_plugin();
+    if (!plugin.api) throw IoError(video.string() + ": cannot write the video (" + plugin.error + ")");
+    return *plugin.api;
+}
+
+}  // namespace
+
 struct RunVideo::Impl {
-    cv::VideoWriter writer;
-    cv::Size panel;   // every panel's size: the first frame's
-    cv::Mat canvas;   // BGR, 3 panels side by side
+    const Wul3dVideoApi* api = nullptr;
+    void* writer = nullptr;  // the plugin's, null until the first frame
+    cv::Size panel;          // every panel's size: the first frame's
+    cv::Mat canvas;          // BGR, 3 panels side by side
 };
 
 RunVideo::RunVideo(fs::path path) : path_(std::move(path)), impl_(std::make_unique<Impl>()) {
+    // First the plugin: without it nothing is created.
+    impl_->api = &video_plugin(path_);
     const fs::path dir = path_.has_parent_path() ? path_.parent_path() : fs::path(".");
     std::error_code ec;
     fs::create_directories(dir, ec);
@@ -137,9 +189,9 @@ RunVideo::RunVideo(fs::path path) : path_(std::move(path)), impl_(std::make_uniq
 }
 
 RunVideo::~RunVideo() {
-    if (impl_->writer.isOpened()) impl_->writer.release();
+    if (impl_->writer) impl_->api->close(impl_->writer);
     std::error_code ec;
-    fs::remove(tmp_path_, ec);
+    if (!tmp_path_.empty()) fs::remove(tmp_path_, ec);
 }
 
 namespace {
@@ -183,16 +235,17 @@ void caption(cv::Mat& canvas, int x0, const std::vector<std::string>& lines) {
 void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
                      const std::vector<std::uint8_t>* selected, std::size_t index,
                      std::size_t total, double fps) {
-    if (!impl_->writer.isOpened()) {
+    const Wul3dVideoApi& api = *impl_->api;
+    if (!impl_->writer) {
         // Even sizes: H.264 in yuv420p needs them.
         impl_->panel = cv::Size(result.colors.width & ~1, result.colors.height & ~1);
         const cv::Size size(3 * impl_->panel.width, impl_->panel.height);
         for (const char* codec : {"avc1", "mp4v"}) {
-            const int fourcc = cv::VideoWriter::fourcc(codec[0], codec[1], codec[2], codec[3]);
-            if (impl_->writer.open(tmp_path_.string(), cv::CAP_FFMPEG, fourcc, kVideoFps, size))
-                break;
+            impl_->writer =
+                api.open(tmp_path_.c_str(), codec, kVideoFps, size.width, size.height);
+            if (impl_->writer) break;
         }
-        if (!impl_->writer.isOpened())
+        if (!impl_->writer)
             throw IoError(path_.string() +
                           ": cannot open a video writer (OpenCV's FFmpeg backend has neither "
                           "H.264 nor MPEG-4 for this container; try a .mp4 name)");
@@ -219,13 +272,16 @@ void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
     caption(impl_->canvas, panel.width, {"clusters (eq. 9)"});
     caption(impl_->canvas, 2 * panel.width,
             {selected ? "selected object" : "no object selected (--select U,V)"});
-    impl_->writer.write(impl_->canvas);
+    if (api.write(impl_->writer, impl_->canvas.data, impl_->canvas.step[0]) != 0)
+        throw IoError(path_.string() + ": cannot write the video: " + api.last_error());
 }
 
 void RunVideo::close() {
-    if (!impl_->writer.isOpened())
-        throw IoError(path_.string() + ": no frame was written to the video");
-    impl_->writer.release();
+    if (!impl_->writer) throw IoError(path_.string() + ": no frame was written to the video");
+    const int status = impl_->api->close(impl_->writer);
+    impl_->writer = nullptr;
+    if (status != 0)
+        throw IoError(path_.string() + ": cannot finish the video: " + impl_->api->last_error());
     std::error_code ec;
     fs::rename(tmp_path_, path_, ec);
     if (ec) throw IoError(path_.string() + ": cannot write the video: " + ec.message());

@@ -1,8 +1,9 @@
 #pragma once
 // `wul3d run --video FILE`: a side-by-side video of the run (colour | clusters | selected
 // object) with the frame number and the pipeline's FPS burned in, written through OpenCV's
-// FFmpeg-backed VideoWriter. Also the panel pictures the viewer (`wul3d view`) shows, so
-// the video and the window look alike.
+// FFmpeg-backed VideoWriter in the plugin libwul3d_video.so (video_plugin.hpp), loaded only
+// here. Also the panel pictures the viewer (`wul3d view`) shows, so the video and the window
+// look alike.
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -45,8 +46,10 @@ class RunVideo {
 public:
     static constexpr double kVideoFps = 30.0;
 
-    /// Creates the folder of `path`, opens nothing yet (the size comes with the first
-    /// frame). Throws IoError if the folder cannot be created.
+    /// Loads the video plugin (once per process, from wul3d's own folder) and creates the
+    /// folder of `path`; opens nothing yet (the size comes with the first frame). Throws
+    /// IoError (one line, naming the file) if the plugin is missing or cannot be loaded, or
+    /// the folder cannot be created.
     explicit RunVideo(std::filesystem::path path);
     ~RunVideo();
     RunVideo(const RunVideo&) = delete;
