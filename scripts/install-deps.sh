@@ -5,8 +5,10 @@
 #
 #   build-essential ninja-build cmake pkg-config   compiler (GCC 12, with OpenMP), build tools
 #   git                                            source control
-#   libopencv-dev                                  PNG/JPEG reading and writing (core, imgproc,
-#                                                  imgcodecs); the only package with OpenCVConfig.cmake
+#   libopencv-dev                                  pixel containers and image processing (core,
+#                                                  imgproc); the only package with OpenCVConfig.cmake
+#   libpng-dev libjpeg-dev                         PNG reading and writing, JPEG reading (libpng,
+#                                                  libjpeg-turbo; not OpenCV's imgcodecs)
 #   libeigen3-dev libtbb-dev                       linear algebra; parallel loops (STYLE.md: TBB or OpenMP)
 #   libcli11-dev nlohmann-json3-dev                command line, JSON (header-only)
 #   libgtest-dev libgmock-dev                      the test suite (tests/)
@@ -29,6 +31,8 @@ packages=(
   pkg-config
   git
   libopencv-dev
+  libpng-dev
+  libjpeg-dev
   libeigen3-dev
   libcli11-dev
   nlohmann-json3-dev

@@ -1,7 +1,6 @@
 #pragma once
 // Private to src/io_*.cpp: image readers that reuse the caller's buffers, so that a
 // FrameSource allocates nothing per frame once the first frame has been read.
-#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -10,11 +9,13 @@
 
 namespace wul3d::detail {
 
-/// Scratch of the image readers: the file's bytes and the decoded image.
+/// Scratch of the image readers. The pixels are decoded straight into the image read, so
+/// no decoded copy of the image is kept here.
 struct ImageScratch {
     std::vector<unsigned char> bytes;
     std::vector<unsigned char> cleaned;  ///< PNG without ancillary chunks, when it had any
-    cv::Mat decoded;
+    std::vector<unsigned char*> rows;    ///< where each image row goes, for libpng / libjpeg
+    std::vector<unsigned char> pixels;   ///< 8-bit labels before widening; a CMYK JPEG row
 };
 
 /// As read_depth_png / read_color_image / read_label_png, into `out` (buffers reused).

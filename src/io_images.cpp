@@ -1,6 +1,11 @@
 // Single-file readers and the atomic writers of io.hpp.
 #include <fcntl.h>
+#include <png.h>
 #include <unistd.h>
+#include <zlib.h>
+
+#include <cstdio>  // before jpeglib.h, which needs FILE and size_t
+#include <jpeglib.h>
 
 #include <algorithm>
 #include <array>
@@ -8,12 +13,13 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <csetjmp>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <stdexcept>
 
 #include "io_detail.hpp"
 #include "wul3d/error.hpp"
@@ -47,11 +53,10 @@ void read_file(const std::string& path, std::vector<unsigned char>& bytes) {
 }
 
 // ---- PNG integrity --------------------------------------------------------------------
-// libpng reports a damaged file on stderr ("libpng error: IDAT: CRC error") before OpenCV
-// gives up, and warns about harmless ancillary chunks ("iCCP: known incorrect sRGB
-// profile"). So the chunk structure and every CRC are checked here first, and ancillary
-// chunks (which OpenCV ignores anyway) are stripped: a bad file gives one InputError and
-// nothing else on stderr.
+// The chunk structure and every CRC are checked here first, so that a damaged file is
+// reported with where it is damaged, and ancillary chunks (which the readers ignore) are
+// stripped: libpng then never parses a text or colour profile chunk. libpng is told not to
+// compute the CRCs again.
 
 constexpr std::array<unsigned char, 8> kPngSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 
@@ -143,34 +148,349 @@ void check_jpeg(const std::string& path, const std::vector<unsigned char>& bytes
     throw InputError(path + ": cannot decode JPEG (truncated: no end-of-image marker)");
 }
 
-std::string describe(const cv::Mat& m) {
-    const int depth = m.depth();
-    const char* bits = depth == CV_8U || depth == CV_8S     ? "8-bit"
-                       : depth == CV_16U || depth == CV_16S ? "16-bit"
-                                                            : "32-bit or wider";
-    return std::string(bits) + " " + std::to_string(m.channels()) + "-channel";
+// ---- decoding: libpng and libjpeg-turbo -------------------------------------------------
+// Both libraries report an error through a callback that must not return. Here it keeps the
+// message and longjmps back to the setjmp of png_guarded / jpeg_guarded, which then return
+// false and the caller throws one InputError naming the file. The frames a longjmp skips
+// (the library's, the callback's, the step's lambda) hold no object with a destructor.
+// Warnings are dropped, so nothing reaches stderr.
+//
+// The readers accept what OpenCV's imdecode(IMREAD_UNCHANGED) gave them before, and give
+// the same pixels: see PixelFormat.
+
+constexpr std::size_t kMessageSize = 256;
+
+/// The sample depth and channel count of a file as the readers see it (OpenCV's
+/// IMREAD_UNCHANGED rules): PNG: 16-bit if the file is, otherwise 8-bit (1, 2 and 4-bit grey
+/// scaled to 8 bits); 1 channel for grey (with or without tRNS), 4 for grey + alpha, RGBA,
+/// and RGB or palette with tRNS, otherwise 3. JPEG: 8-bit, 1 channel for grey, otherwise 3.
+struct PixelFormat {
+    int bits = 8;
+    int channels = 1;
+};
+
+std::string describe(PixelFormat f) {
+    return std::to_string(f.bits) + "-bit " + std::to_string(f.channels) + "-channel";
 }
 
-/// Reads, checks and decodes `path` into scratch.decoded. PNG only unless allow_jpeg.
-void decode(const std::string& path, ImageScratch& s, bool allow_jpeg) {
-    read_file(path, s.bytes);
-    const std::vector<unsigned char>* buf = &s.bytes;
-    if (is_png(s.bytes)) {
-        buf = &check_png(path, s.bytes, s.cleaned);
-    } else if (allow_jpeg && is_jpeg(s.bytes)) {
-        check_jpeg(path, s.bytes);
-    } else {
-        throw InputError(path + (allow_jpeg ? ": cannot decode (not a PNG or JPEG file)"
-                                            : ": cannot decode (not a PNG file)"));
+/// What a reader asks a decoder for: row after row, `width` pixels each, no padding.
+enum class Layout {
+    Gray8,   ///< 8-bit grey (files of 8 or fewer bits, 1 channel)
+    Gray16,  ///< 16-bit grey in the host's byte order (16-bit files, 1 channel)
+    Rgb8,    ///< 8-bit R, G, B (8-bit files, any channels: grey is copied, alpha dropped)
+};
+
+std::size_t bytes_per_pixel(Layout layout) {
+    return layout == Layout::Gray8 ? 1 : layout == Layout::Gray16 ? 2 : 3;
+}
+
+/// Points s.rows at the rows of `out`, an image of `width` x `height` in `layout`.
+void point_rows(ImageScratch& s, unsigned char* out, std::size_t width, std::size_t height,
+                Layout layout) {
+    const std::size_t stride = width * bytes_per_pixel(layout);
+    s.rows.resize(height);
+    for (std::size_t y = 0; y < height; ++y) s.rows[y] = out + y * stride;
+}
+
+// -- libpng
+
+/// libpng's error callback: keeps the message (its error pointer is the message buffer)
+/// and jumps back to png_guarded.
+void png_error_jump(png_structp png, png_const_charp message) {
+    std::snprintf(static_cast<char*>(png_get_error_ptr(png)), kMessageSize, "%s", message);
+    png_longjmp(png, 1);
+}
+
+void png_warning_drop(png_structp, png_const_charp) {}
+
+/// Runs `step`, which calls libpng; false if libpng reported an error.
+template <class Step>
+bool png_guarded(png_structp png, Step&& step) {
+    if (setjmp(png_jmpbuf(png)) != 0) return false;
+    step();
+    return true;
+}
+
+/// The PNG in memory that libpng reads.
+struct PngInput {
+    const unsigned char* data = nullptr;
+    std::size_t size = 0;
+    std::size_t pos = 0;
+};
+
+void png_read_memory(png_structp png, png_bytep out, std::size_t n) {
+    auto* in = static_cast<PngInput*>(png_get_io_ptr(png));
+    // check_png saw every chunk up to IEND, where libpng stops: this should never be true,
+    // and if it is, an error rather than a read past the buffer.
+    if (n > in->size - in->pos) png_error(png, "read past the end of the file");
+    std::memcpy(out, in->data + in->pos, n);
+    in->pos += n;
+}
+
+/// A PNG from memory: its header read on construction, its pixels by read().
+class PngDecoder {
+public:
+    /// `bytes` passed check_png; InputError if the header cannot be read.
+    PngDecoder(const std::string& path, const std::vector<unsigned char>& bytes) : path_(path) {
+        input_.data = bytes.data();
+        input_.size = bytes.size();
+        h_.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, message_, png_error_jump,
+                                        png_warning_drop);
+        if (h_.png != nullptr) h_.info = png_create_info_struct(h_.png);
+        if (h_.png == nullptr || h_.info == nullptr) fail("cannot start libpng");
+        png_structp png = h_.png;
+        png_infop info = h_.info;
+        const bool ok = png_guarded(png, [&] {
+            png_set_read_fn(png, &input_, png_read_memory);
+            // check_png has checked every CRC: libpng need not compute them again.
+            png_set_crc_action(png, PNG_CRC_QUIET_USE, PNG_CRC_QUIET_USE);
+            png_read_info(png, info);
+            png_get_IHDR(png, info, &width_, &height_, &bit_depth_, &color_type_, nullptr,
+                         nullptr, nullptr);
+            png_bytep trans = nullptr;
+            png_color_16p trans_color = nullptr;
+            if (png_get_tRNS(png, info, &trans, &num_trans_, &trans_color) == 0) num_trans_ = 0;
+        });
+        if (!ok) fail();
     }
+    PngDecoder(const PngDecoder&) = delete;
+    PngDecoder& operator=(const PngDecoder&) = delete;
+
+    std::size_t width() const { return width_; }
+    std::size_t height() const { return height_; }
+
+    PixelFormat format() const {
+        PixelFormat f;
+        f.bits = bit_depth_ == 16 ? 16 : 8;
+        switch (color_type_) {
+            case PNG_COLOR_TYPE_RGB:
+            case PNG_COLOR_TYPE_PALETTE: f.channels = num_trans_ > 0 ? 4 : 3; break;
+            case PNG_COLOR_TYPE_GRAY_ALPHA:
+            case PNG_COLOR_TYPE_RGB_ALPHA: f.channels = 4; break;
+            default: f.channels = 1;
+        }
+        return f;
+    }
+
+    /// Decodes into `out` (width() x height() in `layout`, which fits format(): Gray16 for
+    /// 16 bits and 1 channel, Gray8 for 8 bits and 1 channel, Rgb8 for 8 bits).
+    void read(Layout layout, unsigned char* out, ImageScratch& s) {
+        point_rows(s, out, width_, height_, layout);
+        const bool gray = (color_type_ & PNG_COLOR_MASK_COLOR) == 0;
+        const std::size_t row_bytes = width_ * bytes_per_pixel(layout);
+        png_structp png = h_.png;
+        png_infop info = h_.info;
+        const bool ok = png_guarded(png, [&] {
+            if (color_type_ == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+            if (gray && bit_depth_ < 8) png_set_expand_gray_1_2_4_to_8(png);
+            if (gray && layout == Layout::Rgb8) png_set_gray_to_rgb(png);
+            png_set_strip_alpha(png);  // also the alpha that palette expansion makes of tRNS
+            if (bit_depth_ == 16 && std::endian::native == std::endian::little) png_set_swap(png);
+            png_set_interlace_handling(png);
+            png_read_update_info(png, info);
+            if (png_get_rowbytes(png, info) != row_bytes) {
+                png_error(png, "unexpected row size after conversion");  // a bug, not a file
+            }
+            png_read_image(png, s.rows.data());
+            png_read_end(png, nullptr);
+        });
+        if (!ok) fail();
+    }
+
+private:
+    [[noreturn]] void fail(const char* why = nullptr) const {
+        throw InputError(path_ + ": cannot decode PNG (" + (why ? why : message_) + ")");
+    }
+
+    struct Handles {
+        png_structp png = nullptr;
+        png_infop info = nullptr;
+        ~Handles() { png_destroy_read_struct(&png, &info, nullptr); }
+    };
+
+    const std::string& path_;
+    PngInput input_;
+    char message_[kMessageSize] = "";
+    Handles h_;
+    png_uint_32 width_ = 0, height_ = 0;
+    int bit_depth_ = 0, color_type_ = 0, num_trans_ = 0;
+};
+
+// -- libjpeg-turbo
+
+/// libjpeg's error manager with where to jump back to and the message.
+struct JpegErrors {
+    jpeg_error_mgr mgr;  // first: libjpeg hands &mgr to the callbacks
+    std::jmp_buf jump;
+    char message[JMSG_LENGTH_MAX];
+};
+
+void jpeg_error_jump(j_common_ptr cinfo) {
+    auto* errors = reinterpret_cast<JpegErrors*>(cinfo->err);
+    (*cinfo->err->format_message)(cinfo, errors->message);
+    std::longjmp(errors->jump, 1);
+}
+
+void jpeg_message_drop(j_common_ptr) {}
+
+/// Runs `step`, which calls libjpeg; false if libjpeg reported an error.
+template <class Step>
+bool jpeg_guarded(JpegErrors& errors, Step&& step) {
+    if (setjmp(errors.jump) != 0) return false;
+    step();
+    return true;
+}
+
+/// CMYK as libjpeg gives it (Adobe's inverted CMYK, as Photoshop writes it) to RGB, with
+/// the arithmetic OpenCV used: R = K - (255 - C) K / 256, G from M, B from Y likewise.
+void cmyk_to_rgb(const unsigned char* cmyk, unsigned char* rgb, std::size_t width) {
+    for (std::size_t x = 0; x < width; ++x, cmyk += 4, rgb += 3) {
+        const int k = cmyk[3];
+        for (int c = 0; c < 3; ++c) rgb[c] = static_cast<unsigned char>(k - (((255 - cmyk[c]) * k) >> 8));
+    }
+}
+
+/// A JPEG from memory: its header read on construction, its pixels by read_rgb().
+class JpegDecoder {
+public:
+    /// `bytes` passed check_jpeg; InputError if the header cannot be read.
+    JpegDecoder(const std::string& path, const std::vector<unsigned char>& bytes) : path_(path) {
+        jpeg_decompress_struct& cinfo = h_.cinfo;
+        cinfo.err = jpeg_std_error(&h_.errors.mgr);
+        h_.errors.mgr.error_exit = jpeg_error_jump;
+        h_.errors.mgr.output_message = jpeg_message_drop;
+        const bool ok = jpeg_guarded(h_.errors, [&] {
+            jpeg_create_decompress(&cinfo);
+            jpeg_mem_src(&cinfo, bytes.data(), static_cast<unsigned long>(bytes.size()));
+            jpeg_read_header(&cinfo, TRUE);
+        });
+        if (!ok) fail(h_.errors.message);
+    }
+    JpegDecoder(const JpegDecoder&) = delete;
+    JpegDecoder& operator=(const JpegDecoder&) = delete;
+
+    std::size_t width() const { return h_.cinfo.image_width; }
+    std::size_t height() const { return h_.cinfo.image_height; }
+    PixelFormat format() const { return {8, h_.cinfo.num_components > 1 ? 3 : 1}; }
+
+    /// Decodes into `out`, width() x height() RGB: grey copied to the three channels, CMYK
+    /// converted.
+    void read_rgb(unsigned char* out, ImageScratch& s) {
+        jpeg_decompress_struct& cinfo = h_.cinfo;
+        const bool cmyk = cinfo.num_components == 4;
+        const std::size_t w = width(), h = height();
+        point_rows(s, out, w, h, Layout::Rgb8);
+        if (cmyk) s.pixels.resize(4 * w);
+        unsigned char* const cmyk_row = s.pixels.data();
+        const char* why = nullptr;
+        const bool ok = jpeg_guarded(h_.errors, [&] {
+            cinfo.out_color_space = cmyk ? JCS_CMYK : JCS_RGB;
+            jpeg_start_decompress(&cinfo);
+            if (cinfo.output_width != w || cinfo.output_height != h ||
+                cinfo.output_components != (cmyk ? 4 : 3)) {
+                why = "unexpected output size";  // a bug, not a file
+                return;
+            }
+            while (cinfo.output_scanline < h) {
+                const std::size_t y = cinfo.output_scanline;
+                JDIMENSION got;
+                if (cmyk) {
+                    JSAMPROW row = cmyk_row;
+                    got = jpeg_read_scanlines(&cinfo, &row, 1);
+                    if (got == 1) cmyk_to_rgb(cmyk_row, s.rows[y], w);
+                } else {
+                    got = jpeg_read_scanlines(&cinfo, s.rows.data() + y, static_cast<JDIMENSION>(h - y));
+                }
+                if (got == 0) {
+                    why = "no progress in the image data";  // only a suspending source stops
+                    return;
+                }
+            }
+        });
+        if (!ok) fail(h_.errors.message);
+        if (why != nullptr) fail(why);
+        // What follows the last row (up to the end-of-image marker) does not change the
+        // pixels: an error there is ignored, as OpenCV did.
+        jpeg_guarded(h_.errors, [&] { jpeg_finish_decompress(&cinfo); });
+    }
+
+private:
+    [[noreturn]] void fail(const char* why) const {
+        throw InputError(path_ + ": cannot decode JPEG (" + why + ")");
+    }
+
+    struct Handles {
+        jpeg_decompress_struct cinfo{};
+        JpegErrors errors{};
+        ~Handles() { jpeg_destroy_decompress(&cinfo); }
+    };
+
+    const std::string& path_;
+    Handles h_;
+};
+
+// -- the file
+
+/// OpenCV's limits on a decoded image, kept: 2^20 pixels a side, 2^30 in all.
+void check_size(const std::string& path, std::size_t w, std::size_t h) {
+    if (w == 0 || h == 0 || w > (1u << 20) || h > (1u << 20) || w * h > (std::size_t{1} << 30)) {
+        throw InputError(path + ": cannot decode (an image of " + std::to_string(w) + "x" +
+                         std::to_string(h) + " pixels is empty or too large)");
+    }
+}
+
+/// A PNG or JPEG file read and checked, its header decoded; its pixels by read().
+class ImageFile {
+public:
+    /// PNG only unless allow_jpeg. InputError if missing, not a PNG (or JPEG), damaged.
+    ImageFile(const std::string& path, ImageScratch& s, bool allow_jpeg) : path_(path), s_(s) {
+        read_file(path, s.bytes);
+        if (is_png(s.bytes)) {
+            png_.emplace(path, check_png(path, s.bytes, s.cleaned));
+        } else if (allow_jpeg && is_jpeg(s.bytes)) {
+            check_jpeg(path, s.bytes);
+            jpeg_.emplace(path, s.bytes);
+        } else {
+            throw InputError(path + (allow_jpeg ? ": cannot decode (not a PNG or JPEG file)"
+                                                : ": cannot decode (not a PNG file)"));
+        }
+        check_size(path, width(), height());
+    }
+
+    std::size_t width() const { return png_ ? png_->width() : jpeg_->width(); }
+    std::size_t height() const { return png_ ? png_->height() : jpeg_->height(); }
+    std::size_t pixels() const { return width() * height(); }
+    PixelFormat format() const { return png_ ? png_->format() : jpeg_->format(); }
+
+    /// Decodes into `out` (pixels() in `layout`, which must fit format(); a JPEG gives Rgb8).
+    void read(Layout layout, unsigned char* out) {
+        if (png_) {
+            png_->read(layout, out, s_);
+        } else if (layout == Layout::Rgb8) {
+            jpeg_->read_rgb(out, s_);
+        } else {
+            throw std::logic_error(path_ + ": a JPEG is decoded to RGB only");
+        }
+    }
+
+private:
+    const std::string& path_;
+    ImageScratch& s_;
+    std::optional<PngDecoder> png_;
+    std::optional<JpegDecoder> jpeg_;
+};
+
+/// Runs `decode`, which fills `data`; if it throws, the image is left empty (rather than
+/// half of the new frame under the old size) and the error goes on.
+template <class Image, class Data, class Decode>
+void decode_or_clear(Image& image, Data& data, Decode&& decode) {
     try {
-        const cv::Mat raw(1, static_cast<int>(buf->size()), CV_8U,
-                          const_cast<unsigned char*>(buf->data()));
-        cv::imdecode(raw, cv::IMREAD_UNCHANGED, &s.decoded);
-    } catch (const cv::Exception& e) {
-        throw InputError(path + ": cannot decode (" + e.err + ")");
+        decode();
+    } catch (...) {
+        image.width = image.height = 0;
+        data.clear();
+        throw;
     }
-    if (s.decoded.empty()) throw InputError(path + ": cannot decode (damaged image data)");
 }
 
 // ---- writing ------------------------------------------------------------------------
@@ -204,15 +524,69 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
     if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno_text());
 }
 
-void write_png(const std::string& path, const cv::Mat& image) {
-    if (image.empty()) throw IoError(path + ": cannot write an empty image");
-    std::vector<unsigned char> buf;
+/// libpng's output: a growing buffer, and whether growing it failed.
+struct PngOutput {
+    std::vector<unsigned char>* bytes = nullptr;
+    bool failed = false;
+};
+
+void png_write_memory(png_structp png, png_bytep data, std::size_t n) {
+    auto* out = static_cast<PngOutput*>(png_get_io_ptr(png));
     try {
-        if (!cv::imencode(".png", image, buf)) throw IoError(path + ": cannot encode PNG");
-    } catch (const cv::Exception& e) {
-        throw IoError(path + ": cannot encode PNG (" + e.err + ")");
+        out->bytes->insert(out->bytes->end(), data, data + n);
+    } catch (const std::exception&) {
+        out->failed = true;  // no exception through libpng's frames: png_error below
     }
-    write_file_atomic(path, buf.data(), buf.size());
+    if (out->failed) png_error(png, "out of memory");
+}
+
+void png_flush_none(png_structp) {}
+
+/// Encodes `height` rows of `width` pixels at `pixels`, each 8-bit grey, 8-bit RGB
+/// (channels 3) or 16-bit grey in the host's byte order (bits 16), to PNG, and writes `path`
+/// atomically. IoError names the path.
+void write_png(const std::string& path, int width, int height, int bits, int channels,
+               const void* pixels) {
+    const std::size_t stride = static_cast<std::size_t>(width) * channels * (bits / 8);
+    std::vector<unsigned char*> rows(static_cast<std::size_t>(height));
+    // libpng copies each row before it converts it: the pixels are not written to.
+    auto* first = static_cast<unsigned char*>(const_cast<void*>(pixels));
+    for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = first + y * stride;
+    std::vector<unsigned char> encoded;
+    encoded.reserve(stride * rows.size() / 4 + 1024);
+    PngOutput output{&encoded};
+
+    struct Handles {
+        png_structp png = nullptr;
+        png_infop info = nullptr;
+        ~Handles() { png_destroy_write_struct(&png, &info); }
+    } h;
+    char message[kMessageSize] = "";
+    h.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, message, png_error_jump,
+                                    png_warning_drop);
+    if (h.png != nullptr) h.info = png_create_info_struct(h.png);
+    if (h.png == nullptr || h.info == nullptr) {
+        throw IoError(path + ": cannot encode PNG (cannot start libpng)");
+    }
+    png_structp png = h.png;
+    png_infop info = h.info;
+    const bool ok = png_guarded(png, [&] {
+        png_set_write_fn(png, &output, png_write_memory, png_flush_none);
+        // OpenCV's settings, for the same sizes and speed as before: the Sub filter on every
+        // row, zlib's fastest level, run-length matches only.
+        png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+        png_set_compression_level(png, Z_BEST_SPEED);
+        png_set_compression_strategy(png, Z_RLE);
+        png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
+                     bits, channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
+                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+        png_write_info(png, info);
+        if (bits == 16 && std::endian::native == std::endian::little) png_set_swap(png);
+        png_write_image(png, rows.data());
+        png_write_end(png, nullptr);
+    });
+    if (!ok) throw IoError(path + ": cannot encode PNG (" + message + ")");
+    write_file_atomic(path, encoded.data(), encoded.size());
 }
 
 void check_buffer(const std::string& path, const char* what, int w, int h, std::size_t have,
@@ -310,47 +684,52 @@ namespace detail {
 
 void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageScratch& s,
                          DepthImage& out) {
-    decode(path, s, false);
-    const cv::Mat& m = s.decoded;
-    if (m.depth() != CV_16U || m.channels() != 1) {
-        throw InputError(path + ": depth must be 16-bit single-channel PNG, got " + describe(m) +
+    ImageFile file(path, s, false);
+    const PixelFormat f = file.format();
+    if (f.bits != 16 || f.channels != 1) {
+        throw InputError(path + ": depth must be 16-bit single-channel PNG, got " + describe(f) +
                          " (8-bit depth has no known units)");
     }
-    out.width = m.cols;
-    out.height = m.rows;
+    out.data.resize(file.pixels());
+    decode_or_clear(out, out.data, [&] {
+        file.read(Layout::Gray16, reinterpret_cast<unsigned char*>(out.data.data()));
+    });
+    out.width = static_cast<int>(file.width());
+    out.height = static_cast<int>(file.height());
     out.scale_m_per_unit = scale_m_per_unit;
-    out.data.resize(static_cast<std::size_t>(m.cols) * m.rows);
-    cv::Mat dst(m.rows, m.cols, CV_16UC1, out.data.data());
-    m.copyTo(dst);
 }
 
 void read_color_image_into(const std::string& path, ImageScratch& s, ColorImage& out) {
-    decode(path, s, true);
-    const cv::Mat& m = s.decoded;
-    const int ch = m.channels();
-    if (m.depth() != CV_8U || (ch != 1 && ch != 3 && ch != 4)) {
-        throw InputError(path + ": colour must be 8-bit grey, RGB or RGBA, got " + describe(m));
+    ImageFile file(path, s, true);
+    const PixelFormat f = file.format();
+    if (f.bits != 8 || (f.channels != 1 && f.channels != 3 && f.channels != 4)) {
+        throw InputError(path + ": colour must be 8-bit grey, RGB or RGBA, got " + describe(f));
     }
-    out.width = m.cols;
-    out.height = m.rows;
-    out.rgb.resize(3 * static_cast<std::size_t>(m.cols) * m.rows);
-    cv::Mat dst(m.rows, m.cols, CV_8UC3, out.rgb.data());
-    const int code = ch == 1 ? cv::COLOR_GRAY2RGB : ch == 3 ? cv::COLOR_BGR2RGB : cv::COLOR_BGRA2RGB;
-    cv::cvtColor(m, dst, code);
+    out.rgb.resize(3 * file.pixels());
+    decode_or_clear(out, out.rgb, [&] { file.read(Layout::Rgb8, out.rgb.data()); });
+    out.width = static_cast<int>(file.width());
+    out.height = static_cast<int>(file.height());
 }
 
 void read_label_png_into(const std::string& path, ImageScratch& s, LabelImage& out) {
-    decode(path, s, false);
-    const cv::Mat& m = s.decoded;
+    ImageFile file(path, s, false);
+    const PixelFormat f = file.format();
     // 8-bit labels are accepted too: ids, unlike depth, have no units to get wrong.
-    if ((m.depth() != CV_16U && m.depth() != CV_8U) || m.channels() != 1) {
-        throw InputError(path + ": labels must be 16-bit single-channel PNG, got " + describe(m));
+    if ((f.bits != 16 && f.bits != 8) || f.channels != 1) {
+        throw InputError(path + ": labels must be 16-bit single-channel PNG, got " + describe(f));
     }
-    out.width = m.cols;
-    out.height = m.rows;
-    out.labels.resize(static_cast<std::size_t>(m.cols) * m.rows);
-    cv::Mat dst(m.rows, m.cols, CV_16UC1, out.labels.data());
-    m.convertTo(dst, CV_16U);
+    out.labels.resize(file.pixels());
+    decode_or_clear(out, out.labels, [&] {
+        if (f.bits == 16) {
+            file.read(Layout::Gray16, reinterpret_cast<unsigned char*>(out.labels.data()));
+        } else {
+            s.pixels.resize(file.pixels());
+            file.read(Layout::Gray8, s.pixels.data());
+            std::copy(s.pixels.begin(), s.pixels.end(), out.labels.begin());
+        }
+    });
+    out.width = static_cast<int>(file.width());
+    out.height = static_cast<int>(file.height());
 }
 
 }  // namespace detail
@@ -429,38 +808,27 @@ void write_calibration_json(const std::string& path, const StereoCalibration& ca
 
 void write_label_png(const std::string& path, const LabelImage& labels) {
     check_buffer(path, "labels", labels.width, labels.height, labels.labels.size(), 1);
-    const cv::Mat m(labels.height, labels.width, CV_16UC1,
-                    const_cast<std::uint16_t*>(labels.labels.data()));
-    write_png(path, m);
+    write_png(path, labels.width, labels.height, 16, 1, labels.labels.data());
 }
 
 void write_color_png(const std::string& path, const ColorImage& image) {
     check_buffer(path, "a colour image", image.width, image.height, image.rgb.size(), 3);
-    const cv::Mat rgb(image.height, image.width, CV_8UC3,
-                      const_cast<std::uint8_t*>(image.rgb.data()));
-    cv::Mat bgr;
-    cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-    write_png(path, bgr);
+    write_png(path, image.width, image.height, 8, 3, image.rgb.data());
 }
 
 void write_mask_png(const std::string& path, int width, int height,
                     const std::vector<std::uint8_t>& mask) {
     check_buffer(path, "a mask", width, height, mask.size(), 1);
     // Any non-zero entry is written as 255, so the mask is visible in an image viewer.
-    cv::Mat m(height, width, CV_8UC1);
-    for (int v = 0; v < height; ++v) {
-        std::uint8_t* row = m.ptr<std::uint8_t>(v);
-        const std::uint8_t* src = mask.data() + static_cast<std::size_t>(v) * width;
-        for (int u = 0; u < width; ++u) row[u] = src[u] ? 255 : 0;
-    }
-    write_png(path, m);
+    std::vector<std::uint8_t> visible(mask.size());
+    std::transform(mask.begin(), mask.end(), visible.begin(),
+                   [](std::uint8_t m) { return static_cast<std::uint8_t>(m ? 255 : 0); });
+    write_png(path, width, height, 8, 1, visible.data());
 }
 
 void write_depth_png(const std::string& path, const DepthImage& depth) {
     check_buffer(path, "a depth image", depth.width, depth.height, depth.data.size(), 1);
-    const cv::Mat m(depth.height, depth.width, CV_16UC1,
-                    const_cast<std::uint16_t*>(depth.data.data()));
-    write_png(path, m);
+    write_png(path, depth.width, depth.height, 16, 1, depth.data.data());
 }
 
 void write_ply(const std::string& path, const OrganizedCloud& cloud, const LabelImage& labels,

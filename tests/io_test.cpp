@@ -1,8 +1,15 @@
-// Readers, writers and frame sources of io.hpp: round trips, every reader error, atomic
-// writes, and open_source on the shipped samples and on small sequences written here.
+// Readers, writers and frame sources of io.hpp: round trips, PNGs of every kind made byte by
+// byte and JPEGs made with libjpeg, every reader error, atomic writes, and open_source on the
+// shipped samples and on small sequences written here.
 #include <gtest/gtest.h>
 
+#include <cstdio>  // before jpeglib.h, which needs FILE and size_t
+#include <jpeglib.h>
+
+#include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -38,7 +45,7 @@ bool contains(const std::string& s, const std::string& part) {
 }
 
 /// Runs `f`, expects an InputError whose message holds every one of `parts`, and nothing
-/// printed on stderr (libpng and OpenCV must stay quiet: the CLI prints one line).
+/// printed on stderr (libpng and libjpeg must stay quiet: the CLI prints one line).
 template <class F>
 void expect_input_error(F&& f, const std::vector<std::string>& parts) {
     testing::internal::CaptureStderr();
@@ -305,6 +312,338 @@ TEST(IoImages, ReaderErrors_WrongBitDepth) {
     wul3d::write_depth_png(depth.string(), ramp_depth(4, 4));
     expect_input_error([&] { wul3d::read_color_image(depth.string()); },
                        {depth.string(), "8-bit", "got 16-bit"});
+}
+
+// ---- PNG and JPEG made here, byte by byte or with libjpeg ---------------------------------
+
+/// Adler-32, the checksum that ends a zlib stream.
+std::uint32_t adler32(const std::string& bytes) {
+    std::uint32_t a = 1, b = 0;
+    for (unsigned char c : bytes) {
+        a = (a + c) % 65521u;
+        b = (b + a) % 65521u;
+    }
+    return (b << 16) | a;
+}
+
+/// A zlib stream holding `raw` uncompressed (stored deflate blocks), as a PNG's IDAT data.
+std::string zlib_stored(const std::string& raw) {
+    std::string z = "\x78\x01";
+    std::size_t pos = 0;
+    do {
+        const std::size_t n = std::min<std::size_t>(65535, raw.size() - pos);
+        const bool last = pos + n == raw.size();
+        const auto len = static_cast<std::uint16_t>(n), nlen = static_cast<std::uint16_t>(~n);
+        z += static_cast<char>(last ? 1 : 0);
+        z += {static_cast<char>(len & 0xff), static_cast<char>(len >> 8),
+              static_cast<char>(nlen & 0xff), static_cast<char>(nlen >> 8)};
+        z += raw.substr(pos, n);
+        pos += n;
+    } while (pos < raw.size());
+    return z + be32(adler32(raw));
+}
+
+std::string png_chunk(const std::string& type, const std::string& data) {
+    return be32(static_cast<std::uint32_t>(data.size())) + type + data + be32(crc32(type + data));
+}
+
+/// A PNG file: the IHDR of the arguments, `chunks` (PLTE, tRNS), and an IDAT holding the
+/// zlib stream `idat`.
+std::string png_file(std::uint32_t w, std::uint32_t h, int bit_depth, int color_type,
+                     const std::string& idat, const std::string& chunks = "", bool interlaced = false) {
+    const std::string ihdr = be32(w) + be32(h) +
+                             std::string{static_cast<char>(bit_depth), static_cast<char>(color_type),
+                                         0, 0, static_cast<char>(interlaced ? 1 : 0)};
+    return std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + chunks +
+           png_chunk("IDAT", idat) + png_chunk("IEND", "");
+}
+
+/// Scanlines with filter type 0 (None): each of `rows` prefixed by a zero byte.
+std::string unfiltered(const std::vector<std::string>& rows) {
+    std::string raw;
+    for (const auto& r : rows) raw += '\0' + r;
+    return raw;
+}
+
+std::string be16(std::uint16_t v) { return {static_cast<char>(v >> 8), static_cast<char>(v & 0xff)}; }
+
+TEST(IoImages, Png16BitSamplesAreBigEndianInTheFile) {
+    TempDir tmp;
+    // 3x2 16-bit grey, samples chosen so that a byte swap shows.
+    const std::vector<std::uint16_t> v = {0x0102, 0xff00, 0x00ff, 0xabcd, 1, 65535};
+    std::vector<std::string> rows(2);
+    for (std::size_t p = 0; p < v.size(); ++p) rows[p / 3] += be16(v[p]);
+    const fs::path path = tmp / "depth.png";
+    spit(path, png_file(3, 2, 16, 0, zlib_stored(unfiltered(rows))));
+    EXPECT_EQ(wul3d::read_depth_png(path.string(), 0.001f).data, v);
+    EXPECT_EQ(wul3d::read_label_png(path.string()).labels, v);
+}
+
+TEST(IoImages, WrittenPngs_HeaderAndExactRoundTrip) {
+    TempDir tmp;
+    // Bit depth and colour type of IHDR (bytes 24, 25), no interlace (byte 28).
+    auto header = [&](const fs::path& p) {
+        const std::string b = slurp(p);
+        EXPECT_EQ(b.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+        EXPECT_EQ(b.substr(12, 4), "IHDR");
+        EXPECT_EQ(b[28], 0) << p;
+        return std::pair<int, int>{b[24], b[25]};
+    };
+    const int w = 67, h = 45;  // odd sizes: no row is a multiple of 4 bytes
+    const wul3d::DepthImage depth = ramp_depth(w, h);
+    wul3d::write_depth_png((tmp / "depth.png").string(), depth);
+    EXPECT_EQ(header(tmp / "depth.png"), (std::pair<int, int>{16, 0}));
+    EXPECT_EQ(wul3d::read_depth_png((tmp / "depth.png").string(), 0.001f).data, depth.data);
+
+    wul3d::LabelImage labels;
+    labels.width = w;
+    labels.height = h;
+    labels.labels.assign(depth.data.rbegin(), depth.data.rend());
+    wul3d::write_label_png((tmp / "labels.png").string(), labels);
+    EXPECT_EQ(header(tmp / "labels.png"), (std::pair<int, int>{16, 0}));
+    EXPECT_EQ(wul3d::read_label_png((tmp / "labels.png").string()).labels, labels.labels);
+
+    wul3d::ColorImage color = solid_color(w, h, 0, 0, 0);
+    for (std::size_t i = 0; i < color.rgb.size(); ++i) color.rgb[i] = static_cast<std::uint8_t>(i * 31 % 251);
+    wul3d::write_color_png((tmp / "color.png").string(), color);
+    EXPECT_EQ(header(tmp / "color.png"), (std::pair<int, int>{8, 2}));
+    const wul3d::ColorImage back = wul3d::read_color_image((tmp / "color.png").string());
+    EXPECT_EQ(back.width, w);
+    EXPECT_EQ(back.height, h);
+    EXPECT_EQ(back.rgb, color.rgb);
+
+    wul3d::write_mask_png((tmp / "mask.png").string(), 3, 1, {0, 1, 0});
+    EXPECT_EQ(header(tmp / "mask.png"), (std::pair<int, int>{8, 0}));
+}
+
+TEST(IoImages, PalettePngs_AreColourWithAlphaDropped) {
+    TempDir tmp;
+    // 2-bit palette, 4 pixels: entries 3, 0, 1, 2 packed into one byte.
+    const std::string plte = png_chunk("PLTE", std::string("\x0a\x14\x1e\x28\x32\x3c\x46\x50\x5a\xc8\x64\x00", 12));
+    const std::string idat = zlib_stored(unfiltered({"\xc6"}));
+    const std::vector<std::uint8_t> expect = {200, 100, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90};
+    const fs::path opaque = tmp / "palette.png";
+    spit(opaque, png_file(4, 1, 2, 3, idat, plte));
+    const wul3d::ColorImage c = wul3d::read_color_image(opaque.string());
+    EXPECT_EQ(c.width, 4);
+    EXPECT_EQ(c.rgb, expect);
+    expect_input_error([&] { wul3d::read_label_png(opaque.string()); }, {opaque.string(), "got 8-bit 3-channel"});
+
+    // With tRNS (alpha for the first two entries): four channels, the alpha is dropped.
+    const fs::path transparent = tmp / "palette_trns.png";
+    spit(transparent, png_file(4, 1, 2, 3, idat, plte + png_chunk("tRNS", std::string("\x00\x80", 2))));
+    EXPECT_EQ(wul3d::read_color_image(transparent.string()).rgb, expect);
+    expect_input_error([&] { wul3d::read_depth_png(transparent.string(), 0.001f); },
+                       {transparent.string(), "got 8-bit 4-channel"});
+}
+
+TEST(IoImages, GreyAlphaLowBitAndInterlacedPngs) {
+    TempDir tmp;
+    // Grey + alpha, 8-bit: colour is the grey three times; not labels (4 channels, as OpenCV had it).
+    const fs::path ga = tmp / "grey_alpha.png";
+    spit(ga, png_file(2, 1, 8, 4, zlib_stored(unfiltered({std::string("\x10\xff\xe0\x00", 4)}))));
+    EXPECT_EQ(wul3d::read_color_image(ga.string()).rgb, (std::vector<std::uint8_t>{16, 16, 16, 224, 224, 224}));
+    expect_input_error([&] { wul3d::read_label_png(ga.string()); }, {ga.string(), "got 8-bit 4-channel"});
+    const fs::path ga16 = tmp / "grey_alpha16.png";
+    spit(ga16, png_file(1, 1, 16, 4, zlib_stored(unfiltered({be16(1000) + be16(65535)}))));
+    expect_input_error([&] { wul3d::read_depth_png(ga16.string(), 0.001f); },
+                       {ga16.string(), "got 16-bit 4-channel"});
+
+    // 1-bit and 4-bit grey are scaled to 8 bits: as labels, as colour.
+    const fs::path g1 = tmp / "grey1.png";
+    spit(g1, png_file(8, 1, 1, 0, zlib_stored(unfiltered({"\xb1"}))));
+    EXPECT_EQ(wul3d::read_label_png(g1.string()).labels,
+              (std::vector<std::uint16_t>{255, 0, 255, 255, 0, 0, 0, 255}));
+    const fs::path g4 = tmp / "grey4.png";
+    spit(g4, png_file(3, 1, 4, 0, zlib_stored(unfiltered({"\x1f\x70"}))));
+    EXPECT_EQ(wul3d::read_label_png(g4.string()).labels, (std::vector<std::uint16_t>{17, 255, 119}));
+    EXPECT_EQ(wul3d::read_color_image(g4.string()).rgb,
+              (std::vector<std::uint8_t>{17, 17, 17, 255, 255, 255, 119, 119, 119}));
+
+    // RGB with a tRNS colour: four channels, read as its RGB.
+    const fs::path rgbt = tmp / "rgb_trns.png";
+    spit(rgbt, png_file(1, 1, 8, 2, zlib_stored(unfiltered({"\x01\x02\x03"})),
+                        png_chunk("tRNS", be16(1) + be16(2) + be16(3))));
+    EXPECT_EQ(wul3d::read_color_image(rgbt.string()).rgb, (std::vector<std::uint8_t>{1, 2, 3}));
+    expect_input_error([&] { wul3d::read_label_png(rgbt.string()); }, {rgbt.string(), "got 8-bit 4-channel"});
+
+    // Adam7 interlaced 16-bit depth, 5x4: the passes hold the pixels in their own order.
+    const int w = 5, h = 4;
+    auto value = [](int x, int y) { return static_cast<std::uint16_t>(1000 * y + 10 * x + 1); };
+    const int pass[7][4] = {{0, 0, 8, 8}, {4, 0, 8, 8}, {0, 4, 4, 8}, {2, 0, 4, 4},
+                            {0, 2, 2, 4}, {1, 0, 2, 2}, {0, 1, 1, 2}};  // x0, y0, dx, dy
+    std::vector<std::string> rows;
+    for (const auto& p : pass) {
+        if (p[0] >= w || p[1] >= h) continue;  // an empty pass has no rows
+        for (int y = p[1]; y < h; y += p[3]) {
+            std::string row;
+            for (int x = p[0]; x < w; x += p[2]) row += be16(value(x, y));
+            rows.push_back(row);
+        }
+    }
+    const fs::path interlaced = tmp / "interlaced.png";
+    spit(interlaced, png_file(w, h, 16, 0, zlib_stored(unfiltered(rows)), "", true));
+    const wul3d::DepthImage d = wul3d::read_depth_png(interlaced.string(), 0.001f);
+    ASSERT_EQ(d.data.size(), static_cast<std::size_t>(w * h));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) EXPECT_EQ(d.data[y * w + x], value(x, y)) << x << "," << y;
+}
+
+TEST(IoImages, DamagedImageDataWithValidCrc_OneQuietInputError) {
+    TempDir tmp;
+    // A written depth PNG whose IDAT data is garbage after the zlib header, CRC recomputed:
+    // check_png passes it, zlib fails inside libpng.
+    const fs::path good = tmp / "good.png";
+    wul3d::write_depth_png(good.string(), ramp_depth(64, 48));
+    std::string bytes = slurp(good);
+    const std::size_t idat = bytes.find("IDAT");
+    ASSERT_NE(idat, std::string::npos);
+    const std::uint32_t len = (std::uint32_t{static_cast<unsigned char>(bytes[idat - 4])} << 24) |
+                              (std::uint32_t{static_cast<unsigned char>(bytes[idat - 3])} << 16) |
+                              (std::uint32_t{static_cast<unsigned char>(bytes[idat - 2])} << 8) |
+                              static_cast<unsigned char>(bytes[idat - 1]);
+    ASSERT_GT(len, 100u);
+    for (std::uint32_t i = 2; i < len; ++i) bytes[idat + 4 + i] = static_cast<char>(0xff - i * 7 % 256);
+    bytes.replace(idat + 4 + len, 4, be32(crc32(bytes.substr(idat, 4 + len))));
+    const fs::path garbage = tmp / "garbage.png";
+    spit(garbage, bytes);
+    expect_input_error([&] { wul3d::read_depth_png(garbage.string(), 0.001f); },
+                       {garbage.string(), "cannot decode PNG ("});
+    expect_input_error([&] { wul3d::read_label_png(garbage.string()); }, {garbage.string(), "cannot decode PNG ("});
+
+    // Too little image data: an error. Too much: libpng warns and reads the image; quietly.
+    const std::string row = be16(7) + be16(8);
+    const fs::path short_data = tmp / "short.png";
+    spit(short_data, png_file(2, 3, 16, 0, zlib_stored(unfiltered({row, row}))));
+    expect_input_error([&] { wul3d::read_depth_png(short_data.string(), 0.001f); },
+                       {short_data.string(), "cannot decode PNG (Not enough image data)"});
+    const fs::path long_data = tmp / "long.png";
+    spit(long_data, png_file(2, 1, 16, 0, zlib_stored(unfiltered({row, row, row}))));
+    testing::internal::CaptureStderr();
+    const wul3d::DepthImage d = wul3d::read_depth_png(long_data.string(), 0.001f);
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+    EXPECT_EQ(d.data, (std::vector<std::uint16_t>{7, 8}));
+}
+
+TEST(OpenSource, DamagedFrame_LeavesItsImageEmpty) {
+    TempDir tmp;
+    for (const char* name : {"f0", "f1"}) {
+        fs::create_directories(tmp / name);
+        wul3d::write_depth_png((tmp / name / "depth.png").string(), ramp_depth(8, 6));
+        wul3d::write_text_file((tmp / name / "intrinsics.json").string(),
+                               R"({"fx": 5, "fy": 5, "cx": 4, "cy": 3, "width": 8, "height": 6})");
+    }
+    // f1's image data stops after two of its six rows.
+    spit(tmp / "f1" / "depth.png", png_file(8, 6, 16, 0, zlib_stored(unfiltered({std::string(16, 'a'), std::string(16, 'b')}))));
+    auto src = wul3d::open_source(tmp.path().string(), {});
+    wul3d::SourceItem item;
+    src->read(0, item);
+    EXPECT_EQ(item.frame.depth.width, 8);
+    expect_input_error([&] { src->read(1, item); }, {"f1", "cannot decode PNG"});
+    // Not f0's size over half of f1's pixels.
+    EXPECT_EQ(item.frame.depth.width, 0);
+    EXPECT_EQ(item.frame.depth.height, 0);
+    EXPECT_TRUE(item.frame.depth.data.empty());
+}
+
+/// Writes a JPEG with libjpeg: `components` 1 (grey), 3 (RGB) or 4 (CMYK) per pixel,
+/// quality 100 without chroma subsampling, so that the pixels come back within a step or two.
+void write_jpeg(const fs::path& path, int w, int h, int components, const std::vector<std::uint8_t>& pixels) {
+    jpeg_compress_struct c{};
+    jpeg_error_mgr err{};
+    c.err = jpeg_std_error(&err);
+    jpeg_create_compress(&c);
+    unsigned char* buf = nullptr;
+    unsigned long size = 0;
+    jpeg_mem_dest(&c, &buf, &size);
+    c.image_width = static_cast<JDIMENSION>(w);
+    c.image_height = static_cast<JDIMENSION>(h);
+    c.input_components = components;
+    c.in_color_space = components == 1 ? JCS_GRAYSCALE : components == 3 ? JCS_RGB : JCS_CMYK;
+    jpeg_set_defaults(&c);
+    jpeg_set_quality(&c, 100, TRUE);
+    for (int i = 0; i < c.num_components; ++i) c.comp_info[i].h_samp_factor = c.comp_info[i].v_samp_factor = 1;
+    jpeg_start_compress(&c, TRUE);
+    while (c.next_scanline < c.image_height) {
+        JSAMPROW row = const_cast<std::uint8_t*>(pixels.data()) + std::size_t{c.next_scanline} * w * components;
+        jpeg_write_scanlines(&c, &row, 1);
+    }
+    jpeg_finish_compress(&c);
+    spit(path, std::string(reinterpret_cast<const char*>(buf), size));
+    jpeg_destroy_compress(&c);
+    std::free(buf);
+}
+
+/// Every channel of every pixel within `tol` of `rgb`.
+void expect_near_rgb(const wul3d::ColorImage& c, const std::array<int, 3>& rgb, int tol) {
+    ASSERT_FALSE(c.rgb.empty());
+    for (std::size_t i = 0; i < c.rgb.size(); ++i) {
+        ASSERT_NEAR(c.rgb[i], rgb[i % 3], tol) << "pixel " << i / 3 << " channel " << i % 3;
+    }
+}
+
+TEST(IoImages, JpegRgbGreyAndCmyk) {
+    TempDir tmp;
+    const int w = 24, h = 17;  // not whole 8x8 blocks
+    const auto n = static_cast<std::size_t>(w * h);
+    std::vector<std::uint8_t> rgb(3 * n);
+    for (std::size_t p = 0; p < n; ++p) rgb[3 * p] = 200, rgb[3 * p + 1] = 50, rgb[3 * p + 2] = 10;
+    write_jpeg(tmp / "rgb.jpg", w, h, 3, rgb);
+    const wul3d::ColorImage c = wul3d::read_color_image((tmp / "rgb.jpg").string());
+    EXPECT_EQ(c.width, w);
+    EXPECT_EQ(c.height, h);
+    expect_near_rgb(c, {200, 50, 10}, 2);  // RGB, not BGR
+
+    write_jpeg(tmp / "grey.jpg", w, h, 1, std::vector<std::uint8_t>(n, 77));
+    const wul3d::ColorImage g = wul3d::read_color_image((tmp / "grey.jpg").string());
+    expect_near_rgb(g, {77, 77, 77}, 1);
+    for (std::size_t p = 0; p < n; ++p) {
+        ASSERT_EQ(g.rgb[3 * p], g.rgb[3 * p + 1]);
+        ASSERT_EQ(g.rgb[3 * p], g.rgb[3 * p + 2]);
+    }
+
+    // CMYK as OpenCV converted it: R = K - (255 - C) K / 256, G from M, B from Y.
+    std::vector<std::uint8_t> cmyk(4 * n);
+    for (std::size_t p = 0; p < n; ++p) cmyk[4 * p] = 200, cmyk[4 * p + 1] = 100, cmyk[4 * p + 2] = 0, cmyk[4 * p + 3] = 220;
+    write_jpeg(tmp / "cmyk.jpg", w, h, 4, cmyk);
+    expect_near_rgb(wul3d::read_color_image((tmp / "cmyk.jpg").string()),
+                    {220 - 55 * 220 / 256, 220 - 155 * 220 / 256, 220 - 255 * 220 / 256}, 2);
+
+    // Depth and labels are PNG only.
+    expect_input_error([&] { wul3d::read_depth_png((tmp / "rgb.jpg").string(), 0.001f); },
+                       {"rgb.jpg", "not a PNG file"});
+}
+
+TEST(IoImages, DamagedJpeg_OneQuietInputErrorOrQuietPixels) {
+    TempDir tmp;
+    std::vector<std::uint8_t> rgb(3 * 32 * 32);
+    for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<std::uint8_t>(i * 13 % 256);
+    write_jpeg(tmp / "good.jpg", 32, 32, 3, rgb);
+    const std::string good = slurp(tmp / "good.jpg");
+
+    // No end-of-image marker: the check before libjpeg.
+    spit(tmp / "cut.jpg", good.substr(0, good.size() / 2));
+    expect_input_error([&] { wul3d::read_color_image((tmp / "cut.jpg").string()); },
+                       {"cut.jpg", "cannot decode JPEG (truncated"});
+    // A frame header of 0 x 0 pixels: libjpeg's error, on one line.
+    std::string bad = good;
+    const std::size_t sof = bad.find("\xff\xc0");
+    ASSERT_NE(sof, std::string::npos);
+    bad.replace(sof + 5, 4, std::string(4, '\0'));
+    spit(tmp / "sof.jpg", bad);
+    expect_input_error([&] { wul3d::read_color_image((tmp / "sof.jpg").string()); },
+                       {"sof.jpg", "cannot decode JPEG ("});
+    // Damaged scan data: libjpeg warns and decodes what it can, as before; quietly.
+    bad = good;
+    const std::size_t sos = bad.find("\xff\xda");
+    ASSERT_NE(sos, std::string::npos);
+    const std::size_t mid = sos + (bad.size() - sos) / 2;
+    for (std::size_t i = mid; i < mid + 40; ++i) bad[i] = static_cast<char>(0x5a);
+    spit(tmp / "scan.jpg", bad);
+    testing::internal::CaptureStderr();
+    const wul3d::ColorImage c = wul3d::read_color_image((tmp / "scan.jpg").string());
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+    EXPECT_EQ(c.width, 32);
 }
 
 TEST(IoImages, ReaderErrors_BadJsonAndMissingKeys) {
