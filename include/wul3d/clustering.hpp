@@ -82,12 +82,14 @@ int update_weights(float* mu, int k, int winner, float psi);
 /// The weights of one pixel that matter: its kSlots largest weights mu (eq. 7, 8), with their
 /// 0-based cluster ids, in 16-bit fixed point (1 = kOne); an unused slot has weight 0, and
 /// all-zero means "never seen". Keeping these instead of all k bounds memory independently
-/// of k: 32 bytes a pixel, where dense float weights at 1920x1080 and k = 100 would take
-/// 830 MB. A weight is dropped only when a ninth cluster wins while eight are kept; it is
-/// then the smallest (with psi = 1 at most 1/256 after eight other winners). Labels and
-/// eq. (9) colours match dense float weights on real sequences (tests/clustering_test.cpp).
+/// of k: 24 bytes a pixel, where dense float weights at 1920x1080 and k = 100 would take
+/// 830 MB. A weight is dropped only when a seventh cluster wins while six are kept; it is
+/// then the smallest (with psi = 1 at most 1/64 after six other winners). Labels and eq. (9)
+/// colours match dense float weights on real sequences (tests/clustering_test.cpp). Six
+/// slots, not eight, is what brings 1920x1080 under the speed issue's 160 MB floor; labels
+/// on osd_mosd and osd_moving came out identical to eight.
 struct PixelWeights {
-    static constexpr int kSlots = 8;
+    static constexpr int kSlots = 6;
     static constexpr float kOne = 65535.0f;
     std::uint16_t cluster[kSlots] = {};
     std::uint16_t mu[kSlots] = {};

@@ -19,8 +19,8 @@ namespace wul3d {
 struct ObjectParams {
     float psi = 0.5f;          ///< weight increment of eq. (2) for object tracks; (0, 1]. Below 1
                                ///< a pixel changes object only after two frames of evidence
-    int max_tracks = 32;       ///< tracks held at once; [2, 255]. Each pixel keeps its 8 largest
-                               ///< track weights (PixelWeights, 32 bytes), whatever this is
+    int max_tracks = 32;       ///< tracks held at once; [2, 255]. Each pixel keeps its 6 largest
+                               ///< track weights (PixelWeights, 24 bytes), whatever this is
     float min_overlap = 0.2f;  ///< a segment continues a track when its weight mass on the track
                                ///< is at least this share of the smaller of the two; (0, 1]
     float max_jump_m = 0.15f;  ///< else a lost track within this distance (centroids) is taken
