@@ -51,9 +51,27 @@ TEST(CliBench, ResamplesToTheRequestedResolution) {
     EXPECT_NE(r.out.find("\n2,320,240,"), std::string::npos) << r.out;
 }
 
+TEST(CliBench, PaperPipelineStopsAfterTheColoursAndHoldsLessMemory) {
+    // The paper's steps alone keep no plane, segment or track buffers: at 640x480 that is
+    // tens of MB (the tracker's weights alone are 24 bytes a pixel), far above noise.
+    auto row = [](const std::string& pipeline) {
+        const auto r = run_cli({"bench", (sample_dir() / "uois_tabletop").string(), "--k", "5",
+                                "--frames", "1", "--passes", "1", "--pipeline", pipeline});
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        const auto lines = split(r.out, '\n');
+        return lines.size() == 2 ? split(lines[1], ',') : std::vector<std::string>{};
+    };
+    const auto paper = row("paper"), objects = row("objects");
+    ASSERT_EQ(paper.size(), 7u);
+    ASSERT_EQ(objects.size(), 7u);
+    EXPECT_EQ(paper[3], objects[3]);  // the same points clustered
+    EXPECT_LT(std::stod(paper[6]) + 10.0, std::stod(objects[6]));
+}
+
 TEST(CliBench, BadArgumentsAreOneLineErrors) {
     for (const auto& args : std::vector<std::vector<std::string>>{
-             {"--k", "2,x"}, {"--k", "0"}, {"--resolution", "big"}}) {
+             {"--k", "2,x"}, {"--k", "0"}, {"--resolution", "big"}, {"--pipeline", "fast"},
+             {"--segmenter", "magic"}}) {
         std::vector<std::string> all = {"bench", (sample_dir() / "uois_tabletop").string()};
         all.insert(all.end(), args.begin(), args.end());
         const auto r = run_cli(all);
