@@ -126,14 +126,26 @@ constexpr int kChunks = 64;
 constexpr int kSums = 11;  // x y z r g b nx ny nz, count, f
 constexpr std::uint16_t kNoWinner = 0xffff;  // k <= 65535, so 0-based winners stay below it
 
-/// The active grid points of one block, structure of arrays.
+/// The active grid points of one block gathered, structure of arrays (on the stack).
 struct PointBlock {
-    std::size_t m = 0;  ///< points gathered
     std::uint32_t grid[kAssignBlock];
     float x[kAssignBlock], y[kAssignBlock], z[kAssignBlock];
-    float r[kAssignBlock], g[kAssignBlock], b[kAssignBlock];
+    std::uint8_t r[kAssignBlock], g[kAssignBlock], b[kAssignBlock];
     float nx[kAssignBlock], ny[kAssignBlock], nz[kAssignBlock];
-    float gamma[kAssignBlock];  ///< gamma where the point has a normal, else 0 (eq. 6 needs both)
+    std::uint8_t has_normal[kAssignBlock];
+};
+
+/// The points of one block as the kernel reads them: m points, either gathered into a
+/// PointBlock (grid = their grid indices) or, for a block of the full-resolution grid whose
+/// pixels are all active, the cloud's own arrays from pixel g0 on (grid = null).
+struct PointView {
+    const float *x, *y, *z;
+    const std::uint8_t *r, *g, *b;
+    const float *nx, *ny, *nz;
+    const std::uint8_t* has_normal;
+    const std::uint32_t* grid;
+    std::size_t g0, m;
+    std::size_t index(std::size_t q) const { return grid ? grid[q] : g0 + q; }
 };
 
 /// What the assignment kernel compares the points with: centres, structure of arrays.
@@ -141,7 +153,7 @@ struct CentreView {
     const float *x, *y, *z, *r, *g, *b, *nx, *ny, *nz;
     const float* has_normal;  ///< 1 or 0 per centre
     int k;
-    float d2, a2;             ///< delta^2, alpha^2 (0 without colour)
+    float d2, a2, gamma;      ///< delta^2, alpha^2 (0 without colour), gamma
 };
 
 /// Winner and f of each point of the block. Points in the inner loop, centres in the outer
@@ -151,9 +163,17 @@ struct CentreView {
 #if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void assign_block(const CentreView& c, const PointBlock& pb, int* winner, float* fmin) {
+void assign_block(const CentreView& c, const PointView& pb, int* winner, float* fmin) {
     const std::size_t m = pb.m;
+    // Colours and the normal flag as floats first: with 8-bit loads in it, GCC does not
+    // vectorize the loop over the centres.
+    float R[kAssignBlock], G[kAssignBlock], B[kAssignBlock];
+    float gamma[kAssignBlock];  // gamma where the point has a normal, else 0 (eq. 6 needs both)
     for (std::size_t q = 0; q < m; ++q) {
+        R[q] = pb.r[q];
+        G[q] = pb.g[q];
+        B[q] = pb.b[q];
+        gamma[q] = static_cast<float>(pb.has_normal[q] != 0) * c.gamma;
         fmin[q] = INFINITY;
         winner[q] = 0;
     }
@@ -164,13 +184,13 @@ void assign_block(const CentreView& c, const PointBlock& pb, int* winner, float*
         const float qn = c.has_normal[j];
         for (std::size_t q = 0; q < m; ++q) {
             const float dx = pb.x[q] - qx, dy = pb.y[q] - qy, dz = pb.z[q] - qz;
-            const float dr = pb.r[q] - qr, dg = pb.g[q] - qg, db = pb.b[q] - qb;
+            const float dr = R[q] - qr, dg = G[q] - qg, db = B[q] - qb;
             // Eq. (4); the square root stays: with eq. (6)'s additive normal term the
             // arg-min of f is not the arg-min of the squared distance.
             const float dist = std::sqrt(c.d2 * (dx * dx + dy * dy + dz * dz) +
                                          c.a2 * (dr * dr + dg * dg + db * db));
             const float cos_theta = pb.nx[q] * qnx + pb.ny[q] * qny + pb.nz[q] * qnz;
-            const float f = dist + pb.gamma[q] * qn * (1.0f - cos_theta);  // eq. (6)
+            const float f = dist + gamma[q] * qn * (1.0f - cos_theta);  // eq. (6)
             const bool better = f < fmin[q];
             fmin[q] = better ? f : fmin[q];
             winner[q] = better ? j : winner[q];
@@ -184,7 +204,6 @@ struct ClusterState::Grid {
     const OrganizedCloud& cloud;
     const NormalMap& normals;
     const std::uint8_t* active;
-    float gamma;
     int stride, w, h;
 
     std::size_t size() const { return static_cast<std::size_t>(w) * h; }
@@ -200,8 +219,28 @@ struct ClusterState::Grid {
         return {std::min(size(), n * c / kChunks * kAssignBlock),
                 std::min(size(), n * (c + 1) / kChunks * kAssignBlock)};
     }
-    /// The active points among grid points [g0, g1), g1 - g0 <= kAssignBlock, into pb.
-    void gather(std::size_t g0, std::size_t g1, PointBlock& pb) const {
+    /// The active points among grid points [g0, g1), g1 - g0 <= kAssignBlock: the cloud's
+    /// own arrays when the grid is the full resolution and all of them are active (most
+    /// blocks), else gathered into pb. With `or_all`, a full-resolution block comes whole,
+    /// inactive points included, for a caller that masks them itself (no gather at all).
+    PointView points(std::size_t g0, std::size_t g1, PointBlock& pb, bool or_all = false) const {
+        if (stride == 1) {
+            std::size_t n_active = 0;
+            if (!or_all)
+                for (std::size_t g = g0; g < g1; ++g) n_active += active[g];
+            if (or_all || n_active == g1 - g0)
+                return {cloud.x.data() + g0,   cloud.y.data() + g0,   cloud.z.data() + g0,
+                        cloud.r.data() + g0,   cloud.g.data() + g0,   cloud.b.data() + g0,
+                        normals.nx.data() + g0, normals.ny.data() + g0, normals.nz.data() + g0,
+                        normals.valid.data() + g0, nullptr, g0, g1 - g0};
+        }
+        // Raw pointers: the byte stores below may alias anything, so through the vectors
+        // the compiler would reload every data pointer on each point.
+        const float *const X = cloud.x.data(), *const Y = cloud.y.data(), *const Z = cloud.z.data();
+        const std::uint8_t *const R = cloud.r.data(), *const G = cloud.g.data(),
+                           *const B = cloud.b.data(), *const valid = normals.valid.data();
+        const float *const NX = normals.nx.data(), *const NY = normals.ny.data(),
+                    *const NZ = normals.nz.data();
         std::size_t m = 0;
         const std::size_t W = static_cast<std::size_t>(cloud.width), s = static_cast<std::size_t>(stride);
         std::size_t gv = g0 / static_cast<std::size_t>(w), gu = g0 % static_cast<std::size_t>(w);
@@ -209,16 +248,16 @@ struct ClusterState::Grid {
             const std::size_t p = (gv * W + gu) * s;
             if (active[p]) {
                 pb.grid[m] = static_cast<std::uint32_t>(g);
-                pb.x[m] = cloud.x[p];
-                pb.y[m] = cloud.y[p];
-                pb.z[m] = cloud.z[p];
-                pb.r[m] = cloud.r[p];
-                pb.g[m] = cloud.g[p];
-                pb.b[m] = cloud.b[p];
-                pb.nx[m] = normals.nx[p];  // 0 where there is no normal (normals.hpp)
-                pb.ny[m] = normals.ny[p];
-                pb.nz[m] = normals.nz[p];
-                pb.gamma[m] = normals.valid[p] ? gamma : 0.0f;
+                pb.x[m] = X[p];
+                pb.y[m] = Y[p];
+                pb.z[m] = Z[p];
+                pb.r[m] = R[p];
+                pb.g[m] = G[p];
+                pb.b[m] = B[p];
+                pb.nx[m] = NX[p];  // 0 where there is no normal (normals.hpp)
+                pb.ny[m] = NY[p];
+                pb.nz[m] = NZ[p];
+                pb.has_normal[m] = valid[p];
                 ++m;
             }
             if (++gu == static_cast<std::size_t>(w)) {
@@ -226,7 +265,7 @@ struct ClusterState::Grid {
                 ++gv;
             }
         }
-        pb.m = m;
+        return {pb.x, pb.y, pb.z, pb.r, pb.g, pb.b, pb.nx, pb.ny, pb.nz, pb.has_normal, pb.grid, g0, m};
     }
 };
 
@@ -296,12 +335,12 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
     // Point c as the one centre of the assignment kernel.
     const std::size_t pc = grid.pixel(c);
     const float x = grid.cloud.x[pc], y = grid.cloud.y[pc], z = grid.cloud.z[pc];
-    const float r = grid.cloud.r[pc], g = grid.cloud.g[pc], b = grid.cloud.b[pc];
+    const float r = grid.cloud.r[pc], g = grid.cloud.g[pc], b = grid.cloud.b[pc];  // 0-255
     const float nx = grid.normals.nx[pc], ny = grid.normals.ny[pc], nz = grid.normals.nz[pc];
     const float has_normal = grid.normals.valid[pc] ? 1.0f : 0.0f;
     const CentreView view{&x, &y, &z, &r, &g, &b, &nx, &ny, &nz, &has_normal, 1,
                           params_.delta * params_.delta,
-                          use_color_ ? params_.alpha * params_.alpha : 0.0f};
+                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
     double chunk_potential[kChunks] = {};
 #pragma omp parallel for schedule(static)
     for (int ch = 0; ch < kChunks; ++ch) {
@@ -312,18 +351,21 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
-            grid.gather(g0, g1, pb);
-            assign_block(view, pb, winner, f);
+            // Inactive points may come along: f_ is 0 there, which Lower and Potential
+            // keep (f >= 0) and Set writes.
+            const PointView pts = grid.points(g0, g1, pb, /*or_all=*/true);
+            assign_block(view, pts, winner, f);
             if (use == FToPoint::Set) {
                 std::fill(f_.begin() + static_cast<std::ptrdiff_t>(g0),
                           f_.begin() + static_cast<std::ptrdiff_t>(g1), 0.0f);
-                for (std::size_t q = 0; q < pb.m; ++q) f_[pb.grid[q]] = f[q];
+                for (std::size_t q = 0; q < pts.m; ++q)
+                    if (grid.active[grid.pixel(pts.index(q))]) f_[pts.index(q)] = f[q];
             } else if (use == FToPoint::Lower) {
-                for (std::size_t q = 0; q < pb.m; ++q)
-                    f_[pb.grid[q]] = std::min(f_[pb.grid[q]], f[q]);
+                for (std::size_t q = 0; q < pts.m; ++q)
+                    f_[pts.index(q)] = std::min(f_[pts.index(q)], f[q]);
             } else {
-                for (std::size_t q = 0; q < pb.m; ++q) {
-                    const double d = std::min(f_[pb.grid[q]], f[q]);
+                for (std::size_t q = 0; q < pts.m; ++q) {
+                    const double d = std::min(f_[pts.index(q)], f[q]);
                     potential += d * d;
                 }
             }
@@ -410,7 +452,7 @@ void ClusterState::assign(const Grid& grid) {
                           centres_.r.data(),  centres_.g.data(),  centres_.b.data(),
                           centres_.nx.data(), centres_.ny.data(), centres_.nz.data(),
                           centre_normal_.data(), k, params_.delta * params_.delta,
-                          use_color_ ? params_.alpha * params_.alpha : 0.0f};
+                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
     std::fill(chunk_sums_.begin(), chunk_sums_.end(), 0.0);
 #pragma omp parallel for schedule(static)
     for (int ch = 0; ch < kChunks; ++ch) {
@@ -421,27 +463,27 @@ void ClusterState::assign(const Grid& grid) {
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
-            grid.gather(g0, g1, pb);
-            assign_block(view, pb, winner, f);
+            const PointView pts = grid.points(g0, g1, pb);
+            assign_block(view, pts, winner, f);
             std::fill(winner_.begin() + static_cast<std::ptrdiff_t>(g0),
                       winner_.begin() + static_cast<std::ptrdiff_t>(g1), kNoWinner);
             std::fill(f_.begin() + static_cast<std::ptrdiff_t>(g0),
                       f_.begin() + static_cast<std::ptrdiff_t>(g1), 0.0f);
             // The centre sums of move_centres, while the block is in cache. A point without
             // a normal has a zero normal (normals.hpp), so it adds nothing to the normal sums.
-            for (std::size_t q = 0; q < pb.m; ++q) {
-                winner_[pb.grid[q]] = static_cast<std::uint16_t>(winner[q]);
-                f_[pb.grid[q]] = f[q];
+            for (std::size_t q = 0; q < pts.m; ++q) {
+                winner_[pts.index(q)] = static_cast<std::uint16_t>(winner[q]);
+                f_[pts.index(q)] = f[q];
                 double* sj = sums + static_cast<std::size_t>(winner[q]) * kSums;
-                sj[0] += pb.x[q];
-                sj[1] += pb.y[q];
-                sj[2] += pb.z[q];
-                sj[3] += pb.r[q];
-                sj[4] += pb.g[q];
-                sj[5] += pb.b[q];
-                sj[6] += pb.nx[q];
-                sj[7] += pb.ny[q];
-                sj[8] += pb.nz[q];
+                sj[0] += pts.x[q];
+                sj[1] += pts.y[q];
+                sj[2] += pts.z[q];
+                sj[3] += pts.r[q];
+                sj[4] += pts.g[q];
+                sj[5] += pts.b[q];
+                sj[6] += pts.nx[q];
+                sj[7] += pts.ny[q];
+                sj[8] += pts.nz[q];
                 sj[9] += 1.0;
                 sj[10] += f[q];
             }
@@ -513,7 +555,7 @@ FrameStats ClusterState::step(const OrganizedCloud& cloud, const NormalMap& norm
     if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
     centre_normal_.resize(params_.k);
     use_color_ = cloud.has_color;
-    const Grid grid{cloud, normals, active.data(), params_.gamma, params_.stride, grid_w_, grid_h_};
+    const Grid grid{cloud, normals, active.data(), params_.stride, grid_w_, grid_h_};
     using Clock = std::chrono::steady_clock;
     auto ms_since = [](Clock::time_point& t) {
         const auto now = Clock::now();
