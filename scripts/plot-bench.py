@@ -4,7 +4,8 @@
 Usage: scripts/plot-bench.py OUT.png CSV [CSV ...]   (needs Debian's python3-matplotlib)
 
 Each CSV (k,width,height,points,fps_median,ms_median,peak_rss_mb) is one line per panel,
-labelled by its resolution.
+labelled by its resolution and, from its file name, the pipeline: a name containing "paper"
+is `wul3d bench --pipeline paper` (the paper's steps alone), any other the object pipeline.
 """
 import csv
 import sys
@@ -28,7 +29,8 @@ def main():
         if not rows:
             sys.exit(f"plot-bench.py: {path} has no rows")
         k = [int(r["k"]) for r in rows]
-        label = f"{rows[0]['width']}x{rows[0]['height']}"
+        pipeline = "paper's steps" if "paper" in path.rsplit("/", 1)[-1] else "objects"
+        label = f"{rows[0]['width']}x{rows[0]['height']}, {pipeline}"
         ax_fps.plot(k, [float(r["fps_median"]) for r in rows], "o-", label=label)
         ax_mem.plot(k, [float(r["peak_rss_mb"]) for r in rows], "o-", label=label)
     ax_fps.set(xlabel="k (clusters)", ylabel="frames per second (median)", title="Speed")
@@ -36,7 +38,7 @@ def main():
     for ax in (ax_fps, ax_mem):
         ax.grid(True, alpha=0.3)
         ax.legend()
-    fig.suptitle("wul3d bench, whole pipeline (objects included), 2-core AMD EPYC")
+    fig.suptitle("wul3d bench, 2-core AMD EPYC, 2 threads")
     fig.tight_layout()
     fig.savefig(out, dpi=100)
 
