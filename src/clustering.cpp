@@ -117,9 +117,9 @@ int update_weights(PixelWeights& w, int winner, float psi) {
 // ---- ClusterState -----------------------------------------------------------------------
 
 namespace {
-// Grid points are taken in blocks of kAssignBlock, gathered into a small buffer on the stack
-// (the point arrays are read once per pass and nothing grid-sized is copied), and the blocks
-// are split into kChunks fixed ranges for the sums. Sums are reduced in chunk order, so
+// Grid points are taken in blocks of kAssignBlock, read in place from the cloud or gathered
+// into a small buffer on the stack (nothing grid-sized is copied), and the blocks are split
+// into kChunks fixed ranges for the sums. Sums are reduced in chunk order, so
 // results do not depend on the number of threads.
 constexpr std::size_t kAssignBlock = 256;
 constexpr int kChunks = 64;
@@ -136,8 +136,8 @@ struct PointBlock {
 };
 
 /// The points of one block as the kernel reads them: m points, either gathered into a
-/// PointBlock (grid = their grid indices) or, for a block of the full-resolution grid whose
-/// pixels are all active, the cloud's own arrays from pixel g0 on (grid = null).
+/// PointBlock (grid = their grid indices) or, for a block of the full-resolution grid, the
+/// cloud's own arrays from pixel g0 on (grid = null; see Grid::points).
 struct PointView {
     const float *x, *y, *z;
     const std::uint8_t *r, *g, *b;
