@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <future>
 #include <thread>
 
 #include "wul3d/error.hpp"
@@ -81,7 +81,10 @@ TEST(LiveSource, SlowProcessing_NewestWins_AndDropsAreCounted) {
         EXPECT_GT(item.frame.depth.data[0], last);  // never an older frame
         last = item.frame.depth.data[0];
         ++taken;
-        std::this_thread::sleep_for(15ms);
+        // Slower than the camera by construction, not by a timed sleep: let it grab two more
+        // frames before the next read, so at least one is replaced unread.
+        const std::uint64_t until = std::min<std::uint64_t>(live.captured() + 2, 40);
+        while (live.captured() < until) std::this_thread::yield();
     }
     EXPECT_EQ(live.captured(), 40u);
     EXPECT_GT(live.dropped(), 0u);
@@ -124,16 +127,15 @@ TEST(LiveSource, Stop_EndsPromptly_EvenWhenTheConsumerIsGone) {
     auto live = std::make_unique<LiveSource>(std::make_unique<ScriptedCamera>(-1, 1ms), o);
     SourceItem item;
     ASSERT_EQ(live->next(item, 2000ms), LiveSource::Next::Frame);
-    std::this_thread::sleep_for(20ms);
-    // Stop and join on another thread: a stop that waited for the gone consumer would never
-    // finish (the generous bound only keeps a broken build from hanging the suite).
-    auto stopped = std::async(std::launch::async, [&] {
-        live->stop();
-        while (live->next(item, 500ms) == LiveSource::Next::Frame) {
-        }
-        live.reset();  // joins
-    });
-    EXPECT_EQ(stopped.wait_for(30s), std::future_status::ready);
+    while (live->captured() < 2) std::this_thread::yield();  // the next frame waits on the slot
+    // A stop that waited for the gone consumer would never return: the test would then hang
+    // until ctest's per-test TIMEOUT (tests/CMakeLists.txt) fails it.
+    live->stop();
+    LiveSource::Next r = LiveSource::Next::Frame;
+    while ((r = live->next(item, 500ms)) == LiveSource::Next::Frame) {
+    }
+    EXPECT_EQ(r, LiveSource::Next::End);  // next() after stop(): what is left, then End
+    live.reset();                          // joins
 }
 
 TEST(CameraSpec, ParsesBackendAndArgument) {
