@@ -14,11 +14,12 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     const LabelImage clusters = pf.result.labels;
     SegmentWorkspace ws;
     LabelImage out;
+    const Plane* support = pf.result.plane.found ? &pf.result.plane.support : nullptr;
     SegmentStats stats = segment_objects(params, pf.pipeline.cloud(), pf.pipeline.normals(),
-                                         classes, clusters, ws, out);
+                                         classes, support, clusters, ws, out);
     for (auto _ : state) {
         stats = segment_objects(params, pf.pipeline.cloud(), pf.pipeline.normals(), classes,
-                                clusters, ws, out);
+                                support, clusters, ws, out);
         benchmark::DoNotOptimize(out.labels.data());
     }
     state.counters["segments"] = stats.segments;

@@ -100,7 +100,8 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
 
     t = Clock::now();
     r.segment_stats = segment_objects(params_.segmentation, cloud_, normals_, r.plane_classes,
-                                      r.labels, segment_ws_, r.segments);
+                                      r.plane.found ? &r.plane.support : nullptr, r.labels,
+                                      segment_ws_, r.segments);
     r.times.segmentation = ms_since(t);
 
     t = Clock::now();

@@ -1,6 +1,8 @@
 #include "wul3d/segmentation.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -55,6 +57,11 @@ void SegmentParams::validate() const {
     require(color_min_share > 0 && color_min_share <= 0.5f, "color_min_share", color_min_share, "in (0, 0.5]");
     require(color_max_boundary > 0, "color_max_boundary", color_max_boundary, "> 0");
     require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
+    require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");
+    require(rim_max_residual_m > 0, "rim_max_residual_m", rim_max_residual_m, "> 0");
+    require(rim_min_arc > 0 && rim_min_arc <= 1, "rim_min_arc", rim_min_arc, "in (0, 1]");
+    require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
+    require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
 }
 
 namespace {
@@ -233,6 +240,180 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
     return merges;
 }
 
+/// The container rule (SegmentParams, "Containers"): a segment seen over another's circular,
+/// level edge across a depth step, lying inside that circle and reaching up to it, is the
+/// other's inside (a bowl's or a cup's) and joins it. Returns the joins.
+int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    if (prm.rim_min_boundary <= 0 || n < 2) return 0;
+    const int W = x.W, H = x.H;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    const auto& label = ws.label;
+    // Boundary pairs of two segments, keyed (lo, hi, step, lo is nearer), segments < 2^30.
+    auto key = [](int lo, int hi) { return (static_cast<std::uint64_t>(lo) << 34) | (static_cast<std::uint64_t>(hi) << 4); };
+    auto for_each_pair = [&](auto&& visit) {
+        for (int v = 0; v < H; ++v)
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                const int a = label[p];
+                if (a == 0) continue;
+                const std::size_t qs[2] = {u + 1 < W ? p + 1 : p, v + 1 < H ? p + static_cast<std::size_t>(W) : p};
+                for (std::size_t q : qs) {
+                    const int b = label[q];
+                    if (b == 0 || b == a) continue;
+                    visit(p, q, a, b);
+                }
+            }
+    };
+    ws.steps.clear();
+    for_each_pair([&](std::size_t p, std::size_t q, int a, int b) {
+        const bool step = !x.connected(p, q);
+        const std::size_t lo_px = a < b ? p : q, hi_px = a < b ? q : p;
+        const bool lo_nearer = x.c.z[lo_px] < x.c.z[hi_px];
+        ws.steps.push_back(key(std::min(a, b), std::max(a, b)) | (std::uint64_t{step} << 1) | std::uint64_t{lo_nearer});
+    });
+    std::sort(ws.steps.begin(), ws.steps.end());
+    // Candidates: pairs that meet (almost) only across depth steps; the front is the segment
+    // nearer along them. cand_keys holds their keys (sorted), rim_pairs (front, back).
+    ws.rim_pairs.clear();
+    std::vector<std::uint64_t> cand_keys;
+    for (std::size_t i = 0; i < ws.steps.size();) {
+        const std::uint64_t k = ws.steps[i] & ~std::uint64_t{15};
+        int pairs = 0, steps = 0, lo_nearer = 0;
+        for (; i < ws.steps.size() && (ws.steps[i] & ~std::uint64_t{15}) == k; ++i) {
+            ++pairs;
+            if (!((ws.steps[i] >> 1) & 1)) continue;
+            ++steps;
+            lo_nearer += static_cast<int>(ws.steps[i] & 1);
+        }
+        if (steps < prm.rim_min_boundary || 5 * steps < 4 * pairs) continue;
+        const int lo = static_cast<int>(k >> 34), hi = static_cast<int>((k >> 4) & ((1u << 30) - 1));
+        const bool lo_front = 2 * lo_nearer > steps;
+        cand_keys.push_back(k);
+        ws.rim_pairs.push_back(lo_front ? lo : hi);
+        ws.rim_pairs.push_back(lo_front ? hi : lo);
+    }
+    const int C = static_cast<int>(cand_keys.size());
+    if (C == 0) return 0;
+    // Coordinates on the support plane: e1, e2 orthogonal to its normal (a foot's position
+    // is the point's).
+    const Eigen::Vector3d nrm(pl.nx, pl.ny, pl.nz);
+    int least = 0;  // the axis least aligned with the normal: a well-conditioned cross product
+    nrm.cwiseAbs().minCoeff(&least);
+    const Eigen::Vector3d axis = Eigen::Vector3d::Unit(least);
+    const Eigen::Vector3d e1 = nrm.cross(axis).normalized(), e2 = nrm.cross(e1);
+    auto plane_xy = [&](std::size_t p, double& a, double& b) {
+        const Eigen::Vector3d X(x.c.x[p], x.c.y[p], x.c.z[p]);
+        a = X.dot(e1);
+        b = X.dot(e2);
+    };
+    // The front's edge pixels along the steps, per candidate.
+    ws.rim_points.clear();
+    for_each_pair([&](std::size_t p, std::size_t q, int a, int b) {
+        const std::uint64_t k = key(std::min(a, b), std::max(a, b));
+        const auto it = std::lower_bound(cand_keys.begin(), cand_keys.end(), k);
+        if (it == cand_keys.end() || *it != k || x.connected(p, q)) return;
+        const int c = static_cast<int>(it - cand_keys.begin());
+        const std::size_t near = x.c.z[p] < x.c.z[q] ? p : q;
+        if (label[near] != ws.rim_pairs[static_cast<std::size_t>(2 * c)]) return;
+        double u, v;
+        plane_xy(near, u, v);
+        ws.rim_points.insert(ws.rim_points.end(),
+                             {static_cast<double>(c), u, v, static_cast<double>(pl.height(x.c.x[near], x.c.y[near], x.c.z[near]))});
+    });
+    // Per candidate: a circle fitted to the edge (algebraic least squares, Kasa), kept when
+    // the edge lies on it and spans enough of it. circle: (cx, cy, R, rim height).
+    std::vector<std::array<double, 4>> circle(static_cast<std::size_t>(C), {0, 0, -1, 0});
+    const std::size_t P = ws.rim_points.size() / 4;
+    for (int c = 0; c < C; ++c) {
+        // Centred on the edge's mean for conditioning.
+        double m = 0, mu = 0, mv = 0, mh = 0;
+        for (std::size_t i = 0; i < P; ++i) {
+            const double* r = ws.rim_points.data() + 4 * i;
+            if (static_cast<int>(r[0]) != c) continue;
+            ++m; mu += r[1]; mv += r[2]; mh += r[3];
+        }
+        if (m < 3) continue;
+        mu /= m; mv /= m; mh /= m;
+        Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+        for (std::size_t i = 0; i < P; ++i) {
+            const double* r = ws.rim_points.data() + 4 * i;
+            if (static_cast<int>(r[0]) != c) continue;
+            const Eigen::Vector3d row(r[1] - mu, r[2] - mv, 1.0);
+            A += row * row.transpose();
+            rhs -= row * (row.x() * row.x() + row.y() * row.y());
+        }
+        const Eigen::Vector3d sol = A.ldlt().solve(rhs);
+        const double cu = -sol.x() / 2, cv = -sol.y() / 2, R2 = cu * cu + cv * cv - sol.z();
+        if (!(R2 > 0) || !std::isfinite(R2)) continue;
+        const double R = std::sqrt(R2);
+        // Geometric residual, and the edge's widest chord (farthest point from the mean, then
+        // the farthest from that one).
+        double res = 0, far_d = -1, chord = 0;
+        const double* far = nullptr;
+        for (std::size_t i = 0; i < P; ++i) {
+            const double* r = ws.rim_points.data() + 4 * i;
+            if (static_cast<int>(r[0]) != c) continue;
+            const double d = std::hypot(r[1] - mu - cu, r[2] - mv - cv) - R;
+            res += d * d;
+            const double dm = std::hypot(r[1] - mu, r[2] - mv);
+            if (dm > far_d) { far_d = dm; far = r; }
+        }
+        for (std::size_t i = 0; i < P; ++i) {
+            const double* r = ws.rim_points.data() + 4 * i;
+            if (static_cast<int>(r[0]) == c) chord = std::max(chord, std::hypot(r[1] - far[1], r[2] - far[2]));
+        }
+        if (std::sqrt(res / m) > prm.rim_max_residual_m || chord < prm.rim_min_arc * 2 * R) continue;
+        circle[static_cast<std::size_t>(c)] = {cu + mu, cv + mv, R, mh};
+    }
+    // The back segments' feet: the share inside the circle, and their top. A back segment may
+    // sit behind several fronts: rim_next links its candidates.
+    ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
+    ws.rim_next.assign(static_cast<std::size_t>(C), -1);
+    for (int c = C - 1; c >= 0; --c) {
+        if (circle[static_cast<std::size_t>(c)][2] < 0) continue;
+        int& head = ws.remap[static_cast<std::size_t>(ws.rim_pairs[static_cast<std::size_t>(2 * c + 1)])];
+        ws.rim_next[static_cast<std::size_t>(c)] = head;
+        head = c;
+    }
+    std::vector<std::array<double, 3>> back(static_cast<std::size_t>(C), {0, 0, -1e9});  // pixels, inside, top
+    for (std::size_t p = 0; p < N; ++p) {
+        const int l = label[p];
+        if (l == 0) continue;
+        int c = ws.remap[static_cast<std::size_t>(l)];
+        if (c < 0) continue;
+        double u, v;
+        plane_xy(p, u, v);
+        const double h = pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+        for (; c >= 0; c = ws.rim_next[static_cast<std::size_t>(c)]) {
+            const auto& ci = circle[static_cast<std::size_t>(c)];
+            auto& b = back[static_cast<std::size_t>(c)];
+            b[0] += 1;
+            b[1] += std::hypot(u - ci[0], v - ci[1]) <= 1.1 * ci[2] + 0.01;
+            b[2] = std::max(b[2], h);
+        }
+    }
+    ws.parent.resize(static_cast<std::size_t>(n) + 1);
+    for (int l = 0; l <= n; ++l) ws.parent[static_cast<std::size_t>(l)] = l;
+    int joins = 0;
+    for (int c = 0; c < C; ++c) {
+        const auto& ci = circle[static_cast<std::size_t>(c)];
+        const auto& b = back[static_cast<std::size_t>(c)];
+        if (ci[2] < 0 || b[0] == 0) continue;
+        if (b[1] < prm.rim_inside_share * b[0] || std::fabs(b[2] - ci[3]) > prm.rim_height_tol_m) continue;
+        const int ra = find_root(ws.parent, ws.rim_pairs[static_cast<std::size_t>(2 * c)]);
+        const int rb = find_root(ws.parent, ws.rim_pairs[static_cast<std::size_t>(2 * c + 1)]);
+        if (ra == rb) continue;
+        ws.parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+        ++joins;
+    }
+    if (joins == 0) return 0;
+    for (int& l : ws.label)
+        if (l) l = find_root(ws.parent, l);
+    return joins;
+}
+
 /// The colour cue: tries to split each segment in two by 2-means under the paper's
 /// distance (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ
 /// in colour, are large, meet along a short boundary across a smooth surface.
@@ -404,7 +585,8 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
 
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
-                             const LabelImage& clusters, SegmentWorkspace& ws, LabelImage& out) {
+                             const Plane* support, const LabelImage& clusters,
+                             SegmentWorkspace& ws, LabelImage& out) {
     const int W = cloud.width, H = cloud.height;
     const std::size_t N = cloud.size();
     const NormalMap* crease_normals = &normals;
@@ -487,6 +669,10 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     if (params.segmenter != Segmenter::Kmeans) {
         stats.merges = merge_convex(x, ws, n);
         if (stats.merges) n = compact(ws, n, 1);
+        if (support) {
+            stats.containers = join_containers(x, *support, ws, n);
+            if (stats.containers) n = compact(ws, n, 1);
+        }
     }
     if (params.segmenter == Segmenter::Hybrid) {
         stats.color_splits = color_splits(x, ws, n);

@@ -124,8 +124,10 @@ ObjectRun run_moving_sequence(float psi, int frames) {
         back_project(f, cloud);
         estimate_normals(NormalParams{}, cloud, normals);
         select_depth_range(DepthRange{}, cloud, active);
-        remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
+        const PlaneResult plane =
+            remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
         const SegmentStats st = segment_objects(SegmentParams{}, cloud, normals, classes,
+                                                plane.found ? &plane.support : nullptr,
                                                 LabelImage{}, sws, segments);
         tracker.step(cloud, segments, st.segments, LabelImage{}, objects, list);
         // Every listed object is in the label image with its pixel count.

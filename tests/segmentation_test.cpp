@@ -12,7 +12,7 @@ using namespace wul3d::test;
 
 namespace {
 /// Renders `s` and runs normals, depth range, support-plane removal and segmentation.
-LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
+LabelImage segment(const Scene& s, const SegmentParams& params, std::vector<int>& truth,
                    SegmentStats* stats = nullptr) {
     const RgbdFrame f = render_scene(s, &truth);
     OrganizedCloud cloud;
@@ -25,13 +25,19 @@ LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
     const PlaneResult plane =
         remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
     EXPECT_TRUE(plane.found);
-    SegmentParams params;
-    params.segmenter = segmenter;
     SegmentWorkspace ws;
     LabelImage out;
-    const SegmentStats st = segment_objects(params, cloud, normals, classes, LabelImage{}, ws, out);
+    const SegmentStats st =
+        segment_objects(params, cloud, normals, classes, &plane.support, LabelImage{}, ws, out);
     if (stats) *stats = st;
     return out;
+}
+
+LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
+                   SegmentStats* stats = nullptr) {
+    SegmentParams params;
+    params.segmenter = segmenter;
+    return segment(s, params, truth, stats);
 }
 
 }  // namespace
@@ -122,4 +128,60 @@ TEST(SegmentObjects, ColourCue_DoesNotSplitOneBox) {
     EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0), 0.95);
     EXPECT_EQ(stats.color_splits, 0);
     EXPECT_EQ(stats.segments, 1);
+}
+
+// A cup seen from above: its outer wall and, over the front rim, its inside (far wall and
+// floor) meet only across a depth step. The container rule joins them; without it they are
+// two segments.
+TEST(SegmentObjects, Cup_InsideJoinedToTheOuterWallAcrossTheRim) {
+    Scene s = pitched_tabletop_scene();
+    SceneCup cup;
+    cup.z = 0.9f;
+    s.cups = {cup};
+    std::vector<int> truth;
+    SegmentParams off;
+    off.rim_min_boundary = 0;
+    SegmentStats stats;
+    const LabelImage split = segment(s, off, truth, &stats);
+    EXPECT_GE(stats.segments, 2) << "the cup was one segment without the rule (test premise)";
+    EXPECT_LT(dominant_share(split.labels, truth, kTruthCup0), 0.85);
+
+    const LabelImage out = segment(s, SegmentParams{}, truth, &stats);
+    int label = 0;
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthCup0, &label), 0.95);
+    EXPECT_NE(label, 0);
+    EXPECT_GE(stats.containers, 1);
+    EXPECT_EQ(stats.segments, 1);
+}
+
+// What the rim does not join: a box behind the cup whose top is level with the rim (its feet
+// lie outside the rim's circle), and a box in front of the cup, level with it too (its edge
+// towards the cup is straight).
+TEST(SegmentObjects, Cup_NeighboursLevelWithTheRimStaySeparate) {
+    Scene s = pitched_tabletop_scene();
+    SceneCup cup;
+    cup.z = 0.95f;
+    SceneBox behind;
+    behind.z = 1.1f;
+    behind.w = 0.12f;
+    behind.h = cup.h;
+    behind.d = 0.06f;
+    behind.r = cup.r; behind.g = cup.g; behind.b = cup.b;  // one colour: geometry must decide
+    SceneBox front = behind;
+    front.z = 0.8f;
+    front.h = cup.h;
+    front.w = 0.2f;
+    s.cups = {cup};
+    s.boxes = {behind, front};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage out = segment(s, SegmentParams{}, truth, &stats);
+    int c = 0, b = 0, f = 0;
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthCup0, &c), 0.9);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0, &b), 0.9);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + 1, &f), 0.9);
+    EXPECT_NE(c, 0);
+    EXPECT_NE(c, b) << "the box behind was joined to the cup";
+    EXPECT_NE(c, f) << "the box in front was joined to the cup";
+    EXPECT_NE(b, f);
 }

@@ -29,6 +29,40 @@ float hit_box(float dx, float dy, float dz, float x0, float x1, float y0, float 
         return std::numeric_limits<float>::infinity();
     return t0 > 0 ? t0 : std::numeric_limits<float>::infinity();
 }
+
+// Ray (dx, dy, dz) against an open cup on the table at height `table_y` (y down): the
+// nearest of its outer and inner walls, rim and floor, or +inf. Taking the nearest hit of
+// every surface is exact for a closed thick-walled shape: a ray that meets an inner wall
+// from outside has met the outer wall or passed over the rim first.
+float hit_cup(float dx, float dy, float dz, const SceneCup& c, float table_y) {
+    const float top = table_y - c.h, floor_y = table_y - c.wall, inner = c.radius - c.wall;
+    float best = std::numeric_limits<float>::infinity();
+    auto keep = [&](float t, bool ok) {
+        if (ok && t > 0 && t < best) best = t;
+    };
+    // Vertical walls: (t dx - x)^2 + (t dz - z)^2 = r^2, between y_lo and y_hi.
+    auto tube = [&](float r, float y_lo, float y_hi) {
+        const float a = dx * dx + dz * dz, b = -2 * (dx * c.x + dz * c.z),
+                    cc = c.x * c.x + c.z * c.z - r * r;
+        const float disc = b * b - 4 * a * cc;
+        if (a < 1e-12f || disc < 0) return;
+        for (float sign : {-1.0f, 1.0f}) {
+            const float t = (-b + sign * std::sqrt(disc)) / (2 * a);
+            keep(t, t * dy >= y_lo && t * dy <= y_hi);
+        }
+    };
+    tube(c.radius, top, table_y);
+    tube(inner, top, floor_y);
+    // Horizontal rings: the rim (inner..radius at the top) and the floor (0..inner).
+    auto ring = [&](float y, float r0, float r1) {
+        if (std::fabs(dy) < 1e-12f) return;
+        const float t = y / dy, ex = t * dx - c.x, ez = t * dz - c.z, d2 = ex * ex + ez * ez;
+        keep(t, d2 >= r0 * r0 && d2 <= r1 * r1);
+    };
+    ring(top, inner, c.radius);
+    ring(floor_y, 0, inner);
+    return best;
+}
 }  // namespace
 
 RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
@@ -80,6 +114,15 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
                     best = t;
                     id = kTruthBox0 + static_cast<int>(i);
                     rgb[0] = b.r; rgb[1] = b.g; rgb[2] = b.b;
+                }
+            }
+            for (std::size_t i = 0; i < s.cups.size(); ++i) {
+                const SceneCup& c = s.cups[i];
+                const float t = hit_cup(dx, dy, dz, c, s.table_y);
+                if (t < best) {
+                    best = t;
+                    id = kTruthCup0 + static_cast<int>(i);
+                    rgb[0] = c.r; rgb[1] = c.g; rgb[2] = c.b;
                 }
             }
             const std::size_t p = static_cast<std::size_t>(v) * s.width + u;

@@ -1,6 +1,6 @@
 #pragma once
-// Synthetic RGB-D scenes whose answer is known: a table, coloured boxes standing on it and
-// a back wall, ray-cast exactly from a pinhole camera (x right, y down, z forward).
+// Synthetic RGB-D scenes whose answer is known: a table, coloured boxes and open cups
+// standing on it and a back wall, ray-cast exactly from a pinhole camera (x right, y down, z forward).
 #include <cstdint>
 #include <vector>
 
@@ -16,8 +16,18 @@ struct SceneBox {
     std::uint8_t r = 200, g = 30, b = 30;
 };
 
+/// An open container standing on the table: a vertical tube (a cup, a pot) with a floor.
+struct SceneCup {
+    float x = 0, z = 1.0f;          ///< centre of the footprint on the table, metres
+    float radius = 0.08f;           ///< outer radius, metres
+    float h = 0.08f;                ///< height, metres
+    float wall = 0.005f;            ///< wall and floor thickness, metres
+    std::uint8_t r = 230, g = 200, b = 60;
+};
+
 struct Scene {
     std::vector<SceneBox> boxes;
+    std::vector<SceneCup> cups;
     bool wall = false;          ///< a back wall at z = 2.4 m
     float table_half_width = 0.6f;            ///< table spans x in [-w, w]
     float table_near = 0.7f, table_far = 1.7f;  ///< and z in [near, far], metres
@@ -28,8 +38,8 @@ struct Scene {
                                 ///< scene's axes stay put; 0 = looking straight ahead)
 };
 
-/// Ground-truth ids: 0 nothing, 1 table, 2 wall, 10 + i box i.
-constexpr int kTruthTable = 1, kTruthWall = 2, kTruthBox0 = 10;
+/// Ground-truth ids: 0 nothing, 1 table, 2 wall, 10 + i box i, 50 + i cup i.
+constexpr int kTruthTable = 1, kTruthWall = 2, kTruthBox0 = 10, kTruthCup0 = 50;
 
 /// Intrinsics used for every synthetic scene of that size.
 PinholeIntrinsics scene_intrinsics(int width, int height);

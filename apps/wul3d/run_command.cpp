@@ -245,6 +245,8 @@ void run(const RunOptions& o) {
                             {"ms", r.times.total()},
                             {"support_plane", r.plane.found},
                             {"segments", r.segment_stats.segments},
+                            {"merges", r.segment_stats.merges},
+                            {"containers", r.segment_stats.containers},
                             {"color_splits", r.segment_stats.color_splits},
                             {"objects", r.object_list.size()}};
         if (selection) f["selected_pixels"] = selection->pixels();

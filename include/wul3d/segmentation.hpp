@@ -4,8 +4,9 @@
 /// (plane.hpp). The geometric segmenter cuts the surface where it folds inward (a concave
 /// crease: a per-pixel version of LCCP's convexity test between neighbouring normals) and
 /// where depth jumps, takes connected components, then re-attaches the cut pixels and the
-/// objects' feet to the component they touch and merges segments that meet along a boundary
-/// that is mostly not concave. The hybrid segmenter adds the colour cue of
+/// objects' feet to the component they touch, merges segments that meet along a boundary
+/// that is mostly not concave, and joins a container's inside, seen over its rim, to its
+/// outer wall. The hybrid segmenter adds the colour cue of
 /// the paper's weighted clustering where geometry is silent (two flush boxes of different
 /// colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
 #include <cstdint>
@@ -15,6 +16,7 @@
 #include "wul3d/backprojection.hpp"
 #include "wul3d/clustering.hpp"
 #include "wul3d/normals.hpp"
+#include "wul3d/plane.hpp"
 
 namespace wul3d {
 
@@ -56,6 +58,19 @@ struct SegmentParams {
     float color_max_boundary = 2.5f;  ///< boundary pairs / sqrt(smaller part) at most; > 0
     float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
                                       ///< step away on either side) within this angle; > 0
+    // Containers (needs the support plane): a bowl or a cup seen from above shows its outer
+    // wall and, over the front rim, its inside; the rim hides the inside's lower part, so
+    // the two meet only across a depth step, where no crease test or merge can join them.
+    // The rim gives it away: the nearer segment's edge along that step is a level circular
+    // arc, and the farther segment lies inside the circle and reaches up to the rim (its far
+    // side). Such a pair is joined.
+    int rim_min_boundary = 10;          ///< depth-step boundary pairs at least; >= 3, or 0 = off
+    float rim_max_residual_m = 0.0035f; ///< RMS distance of the edge from its fitted circle; > 0
+    float rim_min_arc = 0.45f;          ///< widest chord of the edge / the circle's diameter at
+                                        ///< least (0.45: an arc of 54 degrees); (0, 1]
+    float rim_inside_share = 0.95f;     ///< share of the inside's feet within the circle
+                                        ///< (radius + 10 % + 1 cm); (0, 1]
+    float rim_height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
 
     void validate() const;  ///< throws ParamError naming the field
 };
@@ -79,6 +94,11 @@ struct SegmentWorkspace {
     std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
+    std::vector<std::uint64_t> steps;  ///< containers: (segment pair, step, nearer) per
+                                       ///< boundary pair
+    std::vector<int> rim_pairs;        ///< containers: candidate (front, back) segment pairs
+    std::vector<double> rim_points;    ///< containers: (candidate, e1, e2, height) per edge pixel
+    std::vector<int> rim_next;         ///< containers: candidates of one back segment, linked
 };
 
 /// What segmentation did, as data.
@@ -86,14 +106,17 @@ struct SegmentStats {
     int segments = 0;      ///< objects written to `out`
     int color_splits = 0;  ///< segments the colour cue split
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
+    int containers = 0;    ///< insides joined to their container across the rim
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached
 };
 
-/// `classes` comes from remove_support_plane (PlaneClass: 0 removed, 1 object, 2 foot).
-/// `clusters` are the ClusterState labels of the same frame (used by kmeans; may be empty
-/// for geometric and hybrid). `out` gets 0 = background, 1..n = segment.
+/// `classes` and `support` come from remove_support_plane (PlaneClass: 0 removed, 1 object,
+/// 2 foot, 3 inside; `support` nullptr when no plane was found or removed: no container
+/// joins). `clusters` are the ClusterState labels of the same frame (used by kmeans; may be
+/// empty for geometric and hybrid). `out` gets 0 = background, 1..n = segment.
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
-                             const LabelImage& clusters, SegmentWorkspace& ws, LabelImage& out);
+                             const Plane* support, const LabelImage& clusters,
+                             SegmentWorkspace& ws, LabelImage& out);
 
 }  // namespace wul3d
