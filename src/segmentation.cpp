@@ -247,150 +247,139 @@ int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) 
     const SegmentParams& prm = x.prm;
     if (prm.rim_min_boundary <= 0 || n < 2) return 0;
     const int W = x.W, H = x.H;
-    const std::size_t N = static_cast<std::size_t>(W) * H;
     const auto& label = ws.label;
-    // Boundary pairs of two segments, keyed (lo, hi, step, lo is nearer), segments < 2^30.
-    auto key = [](int lo, int hi) { return (static_cast<std::uint64_t>(lo) << 34) | (static_cast<std::uint64_t>(hi) << 4); };
-    auto for_each_pair = [&](auto&& visit) {
-        for (int v = 0; v < H; ++v)
-            for (int u = 0; u < W; ++u) {
-                const std::size_t p = static_cast<std::size_t>(v) * W + u;
-                const int a = label[p];
-                if (a == 0) continue;
-                const std::size_t qs[2] = {u + 1 < W ? p + 1 : p, v + 1 < H ? p + static_cast<std::size_t>(W) : p};
-                for (std::size_t q : qs) {
-                    const int b = label[q];
-                    if (b == 0 || b == a) continue;
-                    visit(p, q, a, b);
-                }
-            }
-    };
+    // One pass: the boundary pairs of two segments, keyed (lo, hi, depth step, lo is nearer)
+    // with the nearer pixel, and each segment's rows.
+    constexpr std::uint64_t kPairMask = ~std::uint64_t{15};
     ws.steps.clear();
-    for_each_pair([&](std::size_t p, std::size_t q, int a, int b) {
-        const bool step = !x.connected(p, q);
-        const std::size_t lo_px = a < b ? p : q, hi_px = a < b ? q : p;
-        const bool lo_nearer = x.c.z[lo_px] < x.c.z[hi_px];
-        ws.steps.push_back(key(std::min(a, b), std::max(a, b)) | (std::uint64_t{step} << 1) | std::uint64_t{lo_nearer});
-    });
-    std::sort(ws.steps.begin(), ws.steps.end());
-    // Candidates: pairs that meet (almost) only across depth steps; the front is the segment
-    // nearer along them. cand_keys holds their keys (sorted), rim_pairs (front, back).
-    ws.rim_pairs.clear();
-    std::vector<std::uint64_t> cand_keys;
-    for (std::size_t i = 0; i < ws.steps.size();) {
-        const std::uint64_t k = ws.steps[i] & ~std::uint64_t{15};
-        int pairs = 0, steps = 0, lo_nearer = 0;
-        for (; i < ws.steps.size() && (ws.steps[i] & ~std::uint64_t{15}) == k; ++i) {
-            ++pairs;
-            if (!((ws.steps[i] >> 1) & 1)) continue;
-            ++steps;
-            lo_nearer += static_cast<int>(ws.steps[i] & 1);
+    ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            const int a = label[p];
+            if (a == 0) continue;
+            int* rows = ws.rim_rows.data() + 2 * static_cast<std::size_t>(a);
+            if (rows[0] < 0) rows[0] = v;
+            rows[1] = v;
+            const std::size_t qs[2] = {u + 1 < W ? p + 1 : p, v + 1 < H ? p + static_cast<std::size_t>(W) : p};
+            for (std::size_t q : qs) {
+                const int b = label[q];
+                if (b == 0 || b == a) continue;
+                const bool step = !x.connected(p, q);
+                const bool p_nearer = x.c.z[p] < x.c.z[q];
+                const bool lo_nearer = (a < b) == p_nearer;
+                const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 34) |
+                                          (static_cast<std::uint64_t>(std::max(a, b)) << 4) |
+                                          (std::uint64_t{step} << 1) | std::uint64_t{lo_nearer};
+                ws.steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
+            }
         }
-        if (steps < prm.rim_min_boundary || 5 * steps < 4 * pairs) continue;
-        const int lo = static_cast<int>(k >> 34), hi = static_cast<int>((k >> 4) & ((1u << 30) - 1));
-        const bool lo_front = 2 * lo_nearer > steps;
-        cand_keys.push_back(k);
-        ws.rim_pairs.push_back(lo_front ? lo : hi);
-        ws.rim_pairs.push_back(lo_front ? hi : lo);
-    }
-    const int C = static_cast<int>(cand_keys.size());
-    if (C == 0) return 0;
+    std::sort(ws.steps.begin(), ws.steps.end(),
+              [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
     // Coordinates on the support plane: e1, e2 orthogonal to its normal (a foot's position
     // is the point's).
     const Eigen::Vector3d nrm(pl.nx, pl.ny, pl.nz);
     int least = 0;  // the axis least aligned with the normal: a well-conditioned cross product
     nrm.cwiseAbs().minCoeff(&least);
-    const Eigen::Vector3d axis = Eigen::Vector3d::Unit(least);
-    const Eigen::Vector3d e1 = nrm.cross(axis).normalized(), e2 = nrm.cross(e1);
-    auto plane_xy = [&](std::size_t p, double& a, double& b) {
+    const Eigen::Vector3d e1 = nrm.cross(Eigen::Vector3d::Unit(least)).normalized(), e2 = nrm.cross(e1);
+    auto plane_xy = [&](std::size_t p) {
         const Eigen::Vector3d X(x.c.x[p], x.c.y[p], x.c.z[p]);
-        a = X.dot(e1);
-        b = X.dot(e2);
+        return Eigen::Vector2d(X.dot(e1), X.dot(e2));
     };
-    // The front's edge pixels along the steps, per candidate.
-    ws.rim_points.clear();
-    for_each_pair([&](std::size_t p, std::size_t q, int a, int b) {
-        const std::uint64_t k = key(std::min(a, b), std::max(a, b));
-        const auto it = std::lower_bound(cand_keys.begin(), cand_keys.end(), k);
-        if (it == cand_keys.end() || *it != k || x.connected(p, q)) return;
-        const int c = static_cast<int>(it - cand_keys.begin());
-        const std::size_t near = x.c.z[p] < x.c.z[q] ? p : q;
-        if (label[near] != ws.rim_pairs[static_cast<std::size_t>(2 * c)]) return;
-        double u, v;
-        plane_xy(near, u, v);
-        ws.rim_points.insert(ws.rim_points.end(),
-                             {static_cast<double>(c), u, v, static_cast<double>(pl.height(x.c.x[near], x.c.y[near], x.c.z[near]))});
-    });
-    // Per candidate: a circle fitted to the edge (algebraic least squares, Kasa), kept when
-    // the edge lies on it and spans enough of it. circle: (cx, cy, R, rim height).
-    std::vector<std::array<double, 4>> circle(static_cast<std::size_t>(C), {0, 0, -1, 0});
-    const std::size_t P = ws.rim_points.size() / 4;
-    for (int c = 0; c < C; ++c) {
-        // Centred on the edge's mean for conditioning.
-        double m = 0, mu = 0, mv = 0, mh = 0;
-        for (std::size_t i = 0; i < P; ++i) {
-            const double* r = ws.rim_points.data() + 4 * i;
-            if (static_cast<int>(r[0]) != c) continue;
-            ++m; mu += r[1]; mv += r[2]; mh += r[3];
+    // Candidates: pairs that meet (almost) only across depth steps; the front is the segment
+    // nearer along them. A circle is fitted to the front's edge pixels along the steps
+    // (algebraic least squares, Kasa, centred on the edge's mean for conditioning) and kept
+    // when the edge lies on it and spans enough of it. rim_fits per candidate: front, back,
+    // centre (2), radius, rim height.
+    ws.rim_fits.clear();
+    for (std::size_t i = 0; i < ws.steps.size();) {
+        const std::size_t i0 = i;
+        const std::uint64_t k = ws.steps[i].key & kPairMask;
+        int steps = 0, lo_nearer = 0;
+        for (; i < ws.steps.size() && (ws.steps[i].key & kPairMask) == k; ++i) {
+            if (!((ws.steps[i].key >> 1) & 1)) continue;
+            ++steps;
+            lo_nearer += static_cast<int>(ws.steps[i].key & 1);
         }
+        const int pairs = static_cast<int>(i - i0);
+        if (steps < prm.rim_min_boundary || 5 * steps < 4 * pairs) continue;
+        const int lo = static_cast<int>(k >> 34), hi = static_cast<int>((k >> 4) & ((1u << 30) - 1));
+        const int front = 2 * lo_nearer > steps ? lo : hi, back = front == lo ? hi : lo;
+        // The edge: nearer pixels of the steps that lie in the front.
+        auto for_edge = [&](auto&& visit) {
+            for (std::size_t j = i0; j < i; ++j)
+                if (((ws.steps[j].key >> 1) & 1) && label[ws.steps[j].near] == front) visit(ws.steps[j].near);
+        };
+        double m = 0, height = 0;
+        Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+        for_edge([&](std::size_t p) {
+            ++m;
+            mean += plane_xy(p);
+            height += pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+        });
         if (m < 3) continue;
-        mu /= m; mv /= m; mh /= m;
+        mean /= m;
+        height /= m;
         Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
         Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-        for (std::size_t i = 0; i < P; ++i) {
-            const double* r = ws.rim_points.data() + 4 * i;
-            if (static_cast<int>(r[0]) != c) continue;
-            const Eigen::Vector3d row(r[1] - mu, r[2] - mv, 1.0);
+        for_edge([&](std::size_t p) {
+            const Eigen::Vector2d d = plane_xy(p) - mean;
+            const Eigen::Vector3d row(d.x(), d.y(), 1.0);
             A += row * row.transpose();
-            rhs -= row * (row.x() * row.x() + row.y() * row.y());
-        }
+            rhs -= row * d.squaredNorm();
+        });
         const Eigen::Vector3d sol = A.ldlt().solve(rhs);
-        const double cu = -sol.x() / 2, cv = -sol.y() / 2, R2 = cu * cu + cv * cv - sol.z();
+        const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
+        const double R2 = centre.squaredNorm() - sol.z();
         if (!(R2 > 0) || !std::isfinite(R2)) continue;
         const double R = std::sqrt(R2);
-        // Geometric residual, and the edge's widest chord (farthest point from the mean, then
-        // the farthest from that one).
+        // Geometric residual, and the widest chord: the farthest edge pixel from the mean,
+        // then the farthest from that one.
         double res = 0, far_d = -1, chord = 0;
-        const double* far = nullptr;
-        for (std::size_t i = 0; i < P; ++i) {
-            const double* r = ws.rim_points.data() + 4 * i;
-            if (static_cast<int>(r[0]) != c) continue;
-            const double d = std::hypot(r[1] - mu - cu, r[2] - mv - cv) - R;
-            res += d * d;
-            const double dm = std::hypot(r[1] - mu, r[2] - mv);
-            if (dm > far_d) { far_d = dm; far = r; }
-        }
-        for (std::size_t i = 0; i < P; ++i) {
-            const double* r = ws.rim_points.data() + 4 * i;
-            if (static_cast<int>(r[0]) == c) chord = std::max(chord, std::hypot(r[1] - far[1], r[2] - far[2]));
-        }
+        Eigen::Vector2d far = Eigen::Vector2d::Zero();
+        for_edge([&](std::size_t p) {
+            const Eigen::Vector2d d = plane_xy(p) - mean;
+            const double r = (d - centre).norm() - R;
+            res += r * r;
+            if (d.norm() > far_d) {
+                far_d = d.norm();
+                far = d;
+            }
+        });
+        for_edge([&](std::size_t p) { chord = std::max(chord, (plane_xy(p) - mean - far).norm()); });
         if (std::sqrt(res / m) > prm.rim_max_residual_m || chord < prm.rim_min_arc * 2 * R) continue;
-        circle[static_cast<std::size_t>(c)] = {cu + mu, cv + mv, R, mh};
+        ws.rim_fits.push_back({static_cast<double>(front), static_cast<double>(back), centre.x() + mean.x(),
+                               centre.y() + mean.y(), R, height});
     }
-    // The back segments' feet: the share inside the circle, and their top. A back segment may
-    // sit behind several fronts: rim_next links its candidates.
+    const int C = static_cast<int>(ws.rim_fits.size());
+    if (C == 0) return 0;
+    // The back segments' feet: the share inside the circle, and their top, over the rows the
+    // back segments span. A back segment may sit behind several fronts: rim_next links its
+    // candidates. rim_back per candidate: pixels, inside, top.
     ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
     ws.rim_next.assign(static_cast<std::size_t>(C), -1);
+    int v0 = H, v1 = -1;
     for (int c = C - 1; c >= 0; --c) {
-        if (circle[static_cast<std::size_t>(c)][2] < 0) continue;
-        int& head = ws.remap[static_cast<std::size_t>(ws.rim_pairs[static_cast<std::size_t>(2 * c + 1)])];
+        const int back = static_cast<int>(ws.rim_fits[static_cast<std::size_t>(c)][1]);
+        int& head = ws.remap[static_cast<std::size_t>(back)];
         ws.rim_next[static_cast<std::size_t>(c)] = head;
         head = c;
+        v0 = std::min(v0, ws.rim_rows[2 * static_cast<std::size_t>(back)]);
+        v1 = std::max(v1, ws.rim_rows[2 * static_cast<std::size_t>(back) + 1]);
     }
-    std::vector<std::array<double, 3>> back(static_cast<std::size_t>(C), {0, 0, -1e9});  // pixels, inside, top
-    for (std::size_t p = 0; p < N; ++p) {
+    ws.rim_back.assign(static_cast<std::size_t>(C), {0, 0, -1e9});
+    for (std::size_t p = static_cast<std::size_t>(v0) * W; p < static_cast<std::size_t>(v1 + 1) * W; ++p) {
         const int l = label[p];
         if (l == 0) continue;
         int c = ws.remap[static_cast<std::size_t>(l)];
         if (c < 0) continue;
-        double u, v;
-        plane_xy(p, u, v);
+        const Eigen::Vector2d f = plane_xy(p);
         const double h = pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
         for (; c >= 0; c = ws.rim_next[static_cast<std::size_t>(c)]) {
-            const auto& ci = circle[static_cast<std::size_t>(c)];
-            auto& b = back[static_cast<std::size_t>(c)];
+            const auto& fit = ws.rim_fits[static_cast<std::size_t>(c)];
+            auto& b = ws.rim_back[static_cast<std::size_t>(c)];
             b[0] += 1;
-            b[1] += std::hypot(u - ci[0], v - ci[1]) <= 1.1 * ci[2] + 0.01;
+            b[1] += (f - Eigen::Vector2d(fit[2], fit[3])).norm() <= 1.1 * fit[4] + 0.01;
             b[2] = std::max(b[2], h);
         }
     }
@@ -398,12 +387,11 @@ int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) 
     for (int l = 0; l <= n; ++l) ws.parent[static_cast<std::size_t>(l)] = l;
     int joins = 0;
     for (int c = 0; c < C; ++c) {
-        const auto& ci = circle[static_cast<std::size_t>(c)];
-        const auto& b = back[static_cast<std::size_t>(c)];
-        if (ci[2] < 0 || b[0] == 0) continue;
-        if (b[1] < prm.rim_inside_share * b[0] || std::fabs(b[2] - ci[3]) > prm.rim_height_tol_m) continue;
-        const int ra = find_root(ws.parent, ws.rim_pairs[static_cast<std::size_t>(2 * c)]);
-        const int rb = find_root(ws.parent, ws.rim_pairs[static_cast<std::size_t>(2 * c + 1)]);
+        const auto& fit = ws.rim_fits[static_cast<std::size_t>(c)];
+        const auto& b = ws.rim_back[static_cast<std::size_t>(c)];
+        if (b[1] < prm.rim_inside_share * b[0] || std::fabs(b[2] - fit[5]) > prm.rim_height_tol_m) continue;
+        const int ra = find_root(ws.parent, static_cast<int>(fit[0]));
+        const int rb = find_root(ws.parent, static_cast<int>(fit[1]));
         if (ra == rb) continue;
         ws.parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
         ++joins;

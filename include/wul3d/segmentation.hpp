@@ -9,6 +9,7 @@
 /// outer wall. The hybrid segmenter adds the colour cue of
 /// the paper's weighted clustering where geometry is silent (two flush boxes of different
 /// colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -75,6 +76,12 @@ struct SegmentParams {
     void validate() const;  ///< throws ParamError naming the field
 };
 
+/// A 4-neighbour pixel pair where two segments meet (the container rule).
+struct BoundaryStep {
+    std::uint64_t key;   ///< lower segment << 34 | higher << 4 | depth step << 1 | lower nearer
+    std::uint32_t near;  ///< the nearer pixel
+};
+
 /// Scratch, sized once per resolution.
 struct SegmentWorkspace {
     NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
@@ -94,11 +101,13 @@ struct SegmentWorkspace {
     std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
-    std::vector<std::uint64_t> steps;  ///< containers: (segment pair, step, nearer) per
-                                       ///< boundary pair
-    std::vector<int> rim_pairs;        ///< containers: candidate (front, back) segment pairs
-    std::vector<double> rim_points;    ///< containers: (candidate, e1, e2, height) per edge pixel
-    std::vector<int> rim_next;         ///< containers: candidates of one back segment, linked
+    // Containers:
+    std::vector<BoundaryStep> steps;   ///< boundary pairs of two segments
+    std::vector<int> rim_rows;         ///< first and last row of each segment
+    std::vector<std::array<double, 6>> rim_fits;  ///< front, back, circle centre (2), radius,
+                                                  ///< rim height per candidate
+    std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
+    std::vector<int> rim_next;         ///< candidates of one back segment, linked
 };
 
 /// What segmentation did, as data.
