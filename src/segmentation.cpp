@@ -176,6 +176,26 @@ int find_root(std::vector<int>& parent, int a) {
     return a;
 }
 
+/// Union-find over segments 0..n, each its own set.
+void reset_sets(std::vector<int>& parent, int n) {
+    parent.resize(static_cast<std::size_t>(n) + 1);
+    for (int l = 0; l <= n; ++l) parent[static_cast<std::size_t>(l)] = l;
+}
+
+/// Joins the sets of segments a and b (the smaller root stays root); false when already one.
+bool join_sets(std::vector<int>& parent, int a, int b) {
+    const int ra = find_root(parent, a), rb = find_root(parent, b);
+    if (ra == rb) return false;
+    parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    return true;
+}
+
+/// Every labelled pixel takes its set's root.
+void relabel_to_roots(SegmentWorkspace& ws) {
+    for (int& l : ws.label)
+        if (l) l = find_root(ws.parent, l);
+}
+
 /// Joins segments that touch along a boundary that is mostly not concave. Each 4-neighbour
 /// pair (p, q) of two segments with continuous depth is tested for a crease between the
 /// pixels a crease step away on either side, inside their own segments; the pair of
@@ -215,8 +235,7 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
         }
     }
     std::sort(ws.edges.begin(), ws.edges.end());
-    ws.parent.resize(static_cast<std::size_t>(n) + 1);
-    for (int l = 0; l <= n; ++l) ws.parent[static_cast<std::size_t>(l)] = l;
+    reset_sets(ws.parent, n);
     int merges = 0;
     for (std::size_t i = 0; i < ws.edges.size();) {
         const std::uint64_t key = ws.edges[i] >> 4;
@@ -228,15 +247,9 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
         if (tested < prm.merge_min_boundary ||
             static_cast<float>(concave) > prm.merge_max_concave * static_cast<float>(tested))
             continue;
-        const int ra = find_root(ws.parent, static_cast<int>(key >> 30));
-        const int rb = find_root(ws.parent, static_cast<int>(key & ((1u << 30) - 1)));
-        if (ra == rb) continue;
-        ws.parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-        ++merges;
+        merges += join_sets(ws.parent, static_cast<int>(key >> 30), static_cast<int>(key & ((1u << 30) - 1)));
     }
-    if (merges == 0) return 0;
-    for (int& l : ws.label)
-        if (l) l = find_root(ws.parent, l);
+    if (merges > 0) relabel_to_roots(ws);
     return merges;
 }
 
@@ -383,22 +396,15 @@ int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) 
             b[2] = std::max(b[2], h);
         }
     }
-    ws.parent.resize(static_cast<std::size_t>(n) + 1);
-    for (int l = 0; l <= n; ++l) ws.parent[static_cast<std::size_t>(l)] = l;
+    reset_sets(ws.parent, n);
     int joins = 0;
     for (int c = 0; c < C; ++c) {
         const auto& fit = ws.rim_fits[static_cast<std::size_t>(c)];
         const auto& b = ws.rim_back[static_cast<std::size_t>(c)];
         if (b[1] < prm.rim_inside_share * b[0] || std::fabs(b[2] - fit[5]) > prm.rim_height_tol_m) continue;
-        const int ra = find_root(ws.parent, static_cast<int>(fit[0]));
-        const int rb = find_root(ws.parent, static_cast<int>(fit[1]));
-        if (ra == rb) continue;
-        ws.parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-        ++joins;
+        joins += join_sets(ws.parent, static_cast<int>(fit[0]), static_cast<int>(fit[1]));
     }
-    if (joins == 0) return 0;
-    for (int& l : ws.label)
-        if (l) l = find_root(ws.parent, l);
+    if (joins > 0) relabel_to_roots(ws);
     return joins;
 }
 
