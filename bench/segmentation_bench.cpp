@@ -17,12 +17,30 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     const Plane* support = pf.result.plane.found ? &pf.result.plane.support : nullptr;
     SegmentStats stats = segment_objects(params, pf.pipeline.cloud(), pf.pipeline.normals(),
                                          classes, support, clusters, ws, out);
+    SegmentStats::Phases sum;
     for (auto _ : state) {
         stats = segment_objects(params, pf.pipeline.cloud(), pf.pipeline.normals(), classes,
                                 support, clusters, ws, out);
         benchmark::DoNotOptimize(out.labels.data());
+        sum.smoothing += stats.ms.smoothing;
+        sum.cuts += stats.ms.cuts;
+        sum.components += stats.ms.components;
+        sum.reattach += stats.ms.reattach;
+        sum.merge += stats.ms.merge;
+        sum.containers += stats.ms.containers;
+        sum.color += stats.ms.color;
+        sum.compact += stats.ms.compact;
     }
+    using benchmark::Counter;
     state.counters["segments"] = stats.segments;
+    state.counters["smoothing_ms"] = Counter(sum.smoothing, Counter::kAvgIterations);
+    state.counters["cuts_ms"] = Counter(sum.cuts, Counter::kAvgIterations);
+    state.counters["components_ms"] = Counter(sum.components, Counter::kAvgIterations);
+    state.counters["reattach_ms"] = Counter(sum.reattach, Counter::kAvgIterations);
+    state.counters["merge_ms"] = Counter(sum.merge, Counter::kAvgIterations);
+    state.counters["containers_ms"] = Counter(sum.containers, Counter::kAvgIterations);
+    state.counters["color_ms"] = Counter(sum.color, Counter::kAvgIterations);
+    state.counters["compact_ms"] = Counter(sum.compact, Counter::kAvgIterations);
 }
 BENCHMARK_CAPTURE(BM_SegmentObjects, geometric, Segmenter::Geometric)
     ->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -98,7 +98,8 @@ void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, N
     }
 }
 
-void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out) {
+void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out,
+                    int row_begin, int row_end) {
     if (radius_px < 1 || radius_px > 64) {
         std::ostringstream msg;
         msg << "normal smoothing radius = " << radius_px << " px: must be in [1, 64]";
@@ -107,6 +108,14 @@ void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scra
     const int W = in.width, H = in.height, r = radius_px;
     const std::size_t N = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
     out.resize(W, H);
+    const int rb = std::clamp(row_begin, 0, H), re = row_end < 0 ? H : std::clamp(row_end, rb, H);
+    // Rows outside the range: no normal (n = 0, NormalMap's contract).
+    for (auto* a : {&out.nx, &out.ny, &out.nz}) {
+        std::fill(a->begin(), a->begin() + static_cast<std::ptrdiff_t>(rb) * W, 0.0f);
+        std::fill(a->begin() + static_cast<std::ptrdiff_t>(re) * W, a->end(), 0.0f);
+    }
+    std::fill(out.valid.begin(), out.valid.begin() + static_cast<std::ptrdiff_t>(rb) * W, 0);
+    std::fill(out.valid.begin() + static_cast<std::ptrdiff_t>(re) * W, out.valid.end(), 0);
     // Vertical window sums of (nx, ny, nz) into scratch (3 planes), then horizontal ones.
     // A pixel without a normal holds n = 0 (NormalMap's contract), so it adds nothing and
     // the sums need no branch: whole rows add up contiguously, which vectorizes.
@@ -114,13 +123,13 @@ void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scra
     std::fill(scratch.begin() + static_cast<std::ptrdiff_t>(3 * N), scratch.end(), 0.0f);
     float* const planes[3] = {scratch.data(), scratch.data() + N, scratch.data() + 2 * N};
     const float* const src[3] = {in.nx.data(), in.ny.data(), in.nz.data()};
-    // Fixed bands of rows, each starting with a full window: the same sums (hence the same
-    // result) whatever the number of threads.
+    // Fixed bands of the rows, each starting with a full window: the same sums (hence the
+    // same result) whatever the number of threads.
     constexpr int kBands = 4;
     const float* const zeros = scratch.data() + 3 * N;  // a row of zeros
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kBands; ++band) {
-        const int v0 = H * band / kBands, v1 = H * (band + 1) / kBands;
+        const int v0 = rb + (re - rb) * band / kBands, v1 = rb + (re - rb) * (band + 1) / kBands;
         for (int c = 0; c < 3; ++c) {
             float* const dst = planes[c];
             for (int v = v0; v < v1; ++v) {
@@ -146,7 +155,7 @@ void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scra
     // Horizontal window sums straight into the output, one shifted row at a time (each
     // pass vectorizes), then renormalized.
 #pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
+    for (int v = rb; v < re; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * W;
         float* const dst[3] = {out.nx.data() + row, out.ny.data() + row, out.nz.data() + row};
         for (int c = 0; c < 3; ++c) {

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -124,12 +125,21 @@ int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentW
 /// container, however wide).
 std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool inside_only = false) {
     const int W = x.W, H = x.H;
-    const std::size_t N = static_cast<std::size_t>(W) * H;
     int head = 0, tail = 0;
-    for (std::size_t p = 0; p < N; ++p) {
-        ws.dist[p] = ws.label[p] ? 0 : -1;
-        if (ws.label[p]) ws.queue[tail++] = static_cast<int>(p);
-    }
+    // Only labelled pixels with a neighbour they may grow into start the search, in raster
+    // order: the others would find nothing to label, so leaving them out changes no label.
+    auto grows_into = [&](std::size_t q) {
+        return !ws.label[q] && x.cls[q] != kPlaneRemoved && (!inside_only || x.cls[q] == kPlaneInside);
+    };
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            ws.dist[p] = ws.label[p] ? 0 : -1;
+            if (!ws.label[p]) continue;
+            if ((u > 0 && grows_into(p - 1)) || (u + 1 < W && grows_into(p + 1)) ||
+                (v > 0 && grows_into(p - W)) || (v + 1 < H && grows_into(p + W)))
+                ws.queue[tail++] = static_cast<int>(p);
+        }
     std::size_t added = 0;
     while (head < tail) {
         const int p = ws.queue[head++];
@@ -317,6 +327,7 @@ int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) 
         const int pairs = static_cast<int>(i - i0);
         if (steps < prm.rim_min_boundary || 5 * steps < 4 * pairs) continue;
         const int lo = static_cast<int>(k >> 34), hi = static_cast<int>((k >> 4) & ((1u << 30) - 1));
+        if (2 * lo_nearer == steps) continue;  // neither is in front
         const int front = 2 * lo_nearer > steps ? lo : hi, back = front == lo ? hi : lo;
         // The edge: nearer pixels of the steps that lie in the front.
         auto for_edge = [&](auto&& visit) {
@@ -477,6 +488,13 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
             return best;
         };
         const int a0 = farthest(mr, mg, mb);
+        // The parts' mean colours lie among the segment's colours, so they are at most the
+        // segment's colour diameter apart, at most twice the farthest colour from the mean:
+        // below the minimum distance no split can be kept.
+        {
+            const double dr = x.c.r[px[a0]] - mr, dg = x.c.g[px[a0]] - mg, db = x.c.b[px[a0]] - mb;
+            if (2 * std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
+        }
         const int b0 = farthest(x.c.r[px[a0]], x.c.g[px[a0]], x.c.b[px[a0]]);
         float cen[2][6];
         for (int q = 0; q < 6; ++q) {
@@ -583,17 +601,38 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
                              SegmentWorkspace& ws, LabelImage& out) {
     const int W = cloud.width, H = cloud.height;
     const std::size_t N = cloud.size();
+    SegmentStats stats;
+    using Clock = std::chrono::steady_clock;
+    auto t = Clock::now();
+    auto ms_since = [&t] {
+        const auto now = Clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+        t = now;
+        return ms;
+    };
     const NormalMap* crease_normals = &normals;
     if (params.normal_smooth_px > 0) {
-        smooth_normals(normals, params.normal_smooth_px, ws.smooth_scratch, ws.smooth);
+        // Smoothed normals are read at segment pixels (never removed ones) and a crease step
+        // away from them: only those rows are smoothed.
+        int first = H, last = -1;
+        for (int v = 0; v < H; ++v) {
+            const auto row = classes.begin() + static_cast<std::ptrdiff_t>(v) * W;
+            if (std::any_of(row, row + W, [](std::uint8_t c) { return c != kPlaneRemoved; })) {
+                first = std::min(first, v);
+                last = v;
+            }
+        }
+        const int margin = params.crease_step_px + 1;
+        smooth_normals(normals, params.normal_smooth_px, ws.smooth_scratch, ws.smooth,
+                       std::max(0, first - margin), std::min(H, last + 1 + margin));
         crease_normals = &ws.smooth;
     }
+    stats.ms.smoothing = ms_since();
     const Ctx x{params, cloud, *crease_normals, classes, W, H};
     ws.cut.resize(N);
     ws.label.resize(N);
     ws.queue.resize(N);
     ws.dist.resize(N);
-    SegmentStats stats;
 
     if (params.segmenter == Segmenter::Kmeans) {
         // The paper's clusters on the object points: pixels are seedable, and a component
@@ -652,25 +691,28 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     }
     // ws.cut now holds "seedable"; components of it.
     std::vector<std::uint8_t>& seedable = ws.cut;
+    stats.ms.cuts = ms_since();
     int n = components(x, seedable, ws);
     // Fragments too small to seed an object go back to the unassigned pool.
     for (std::size_t p = 0; p < N; ++p)
         if (ws.label[p] && ws.sizes[static_cast<std::size_t>(ws.label[p])] < params.min_seed_points)
             ws.label[p] = 0;
+    stats.ms.components = ms_since();
     stats.reattached = reattach(x, ws, params.reattach_px);
     stats.reattached += reattach(x, ws, W + H, true);
-    n = compact(ws, n, 1);
+    stats.ms.reattach = ms_since();
+    // Labels stay in 1..n with gaps (dropped fragments, merged segments) until the last
+    // renumbering: every step below works per pair or per segment, whatever the numbers.
     if (params.segmenter != Segmenter::Kmeans) {
         stats.merges = merge_convex(x, ws, n);
-        if (stats.merges) n = compact(ws, n, 1);
-        if (support) {
-            stats.containers = join_containers(x, *support, ws, n);
-            if (stats.containers) n = compact(ws, n, 1);
-        }
+        stats.ms.merge = ms_since();
+        if (support) stats.containers = join_containers(x, *support, ws, n);
+        stats.ms.containers = ms_since();
     }
     if (params.segmenter == Segmenter::Hybrid) {
         stats.color_splits = color_splits(x, ws, n);
         n += stats.color_splits;
+        stats.ms.color = ms_since();
     }
     n = compact(ws, n, params.min_points);
     stats.segments = n;
@@ -679,6 +721,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     out.height = H;
     out.labels.resize(N);
     for (std::size_t p = 0; p < N; ++p) out.labels[p] = static_cast<std::uint16_t>(std::min(ws.label[p], 65535));
+    stats.ms.compact += ms_since();
     return stats;
 }
 

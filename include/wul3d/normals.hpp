@@ -38,7 +38,10 @@ void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, N
 /// sensor noise for tests that compare normals a few pixels apart (segmentation's crease
 /// cuts). Separable: vertical running sums, then a direct horizontal sum (O(N r), cheap for
 /// the small radii used); a pixel without a normal stays without one. `scratch` is resized
-/// as needed and reused.
-void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out);
+/// as needed and reused. Only rows [row_begin, row_end) are computed (row_end < 0: to the
+/// last row); the others get no normal. The result depends on the row range (the running
+/// sums restart at fixed bands of it), not on the number of threads.
+void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scratch, NormalMap& out,
+                    int row_begin = 0, int row_end = -1);
 
 }  // namespace wul3d

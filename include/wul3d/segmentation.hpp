@@ -117,6 +117,13 @@ struct SegmentStats {
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached
+    /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
+    /// components, re-attachment, convexity merge, container rule, colour cue, and the
+    /// renumbering passes with the output. For the profile in bench/.
+    struct Phases {
+        double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
+               color = 0, compact = 0;
+    } ms;
 };
 
 /// `classes` and `support` come from remove_support_plane (PlaneClass: 0 removed, 1 object,
