@@ -161,4 +161,23 @@ TEST(SmoothNormals, NoisyPlane_CloserToTheTruth_InvalidStaysInvalid) {
     }
     EXPECT_LT(smooth_err, 0.35 * raw_err);
     EXPECT_THROW(smooth_normals(raw, 0, scratch, smooth), ParamError);
+
+    // A row range: those rows as over the whole image (up to the running sums' rounding),
+    // the others without a normal, even where the whole-image pass had one.
+    NormalMap part = smooth;  // stale values outside the range must be cleared
+    smooth_normals(raw, 3, scratch, part, 10, 30);
+    for (int v = 0; v < raw.height; ++v)
+        for (int u = 0; u < raw.width; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * raw.width + u;
+            if (v < 10 || v >= 30) {
+                EXPECT_EQ(part.valid[p], 0) << v;
+                EXPECT_EQ(part.nx[p], 0.0f);
+                EXPECT_EQ(part.nz[p], 0.0f);
+                continue;
+            }
+            EXPECT_EQ(part.valid[p], smooth.valid[p]);
+            EXPECT_NEAR(part.nx[p], smooth.nx[p], 1e-5f);
+            EXPECT_NEAR(part.ny[p], smooth.ny[p], 1e-5f);
+            EXPECT_NEAR(part.nz[p], smooth.nz[p], 1e-5f);
+        }
 }
