@@ -82,6 +82,9 @@ void require(bool ok, const char* name, T value, const char* range) {
 constexpr int kSegSums = 4;
 // Per-object sums: count, x, y, z, xx, xy, xz, yy, yz, zz, r, g, b.
 constexpr int kObjSums = 13;
+// The per-pixel passes are summed per fixed band of rows, then in band order, so that the
+// results do not depend on the number of threads.
+constexpr int kBands = 16;
 }  // namespace
 
 void ObjectParams::validate() const {
@@ -201,22 +204,40 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
 
     // 1. Each segment's votes for the track slots: the sum of its pixels' weights, i.e. the
     //    overlap with the previous frames' objects as the paper's weights remember them.
-    votes_.assign(static_cast<std::size_t>(S + 1) * Kz, 0.0);
-    seg_sums_.assign(static_cast<std::size_t>(S + 1) * kSegSums, 0.0);
-    for (std::size_t p = 0; p < N; ++p) {
-        const int s = segments.labels[p];
-        if (s == 0) continue;
-        double* ss = seg_sums_.data() + static_cast<std::size_t>(s) * kSegSums;
-        ss[0] += 1;
-        ss[1] += cloud.x[p];
-        ss[2] += cloud.y[p];
-        ss[3] += cloud.z[p];
-        if (!has_mu_[p]) continue;
-        double* vs = votes_.data() + static_cast<std::size_t>(s) * Kz;
-        const PixelWeights& w = mu_[p];
-        for (int q = 0; q < PixelWeights::kSlots; ++q)
-            if (w.mu[q] > 0) vs[w.cluster[q]] += w.mu[q] / static_cast<double>(PixelWeights::kOne);
+    //    Summed per fixed band of rows, then in band order: the same result whatever the
+    //    number of threads (votes in integer units of the weights: exact in any order).
+    const std::size_t S1 = static_cast<std::size_t>(S + 1);
+    band_votes_.assign(kBands * S1 * Kz, 0);
+    band_seg_sums_.assign(kBands * S1 * kSegSums, 0.0);
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kBands; ++band) {
+        std::uint64_t* const votes = band_votes_.data() + static_cast<std::size_t>(band) * S1 * Kz;
+        double* const sums = band_seg_sums_.data() + static_cast<std::size_t>(band) * S1 * kSegSums;
+        const std::size_t p0 = static_cast<std::size_t>(H * band / kBands) * W;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kBands) * W;
+        for (std::size_t p = p0; p < p1; ++p) {
+            const int s = segments.labels[p];
+            if (s == 0) continue;
+            double* ss = sums + static_cast<std::size_t>(s) * kSegSums;
+            ss[0] += 1;
+            ss[1] += cloud.x[p];
+            ss[2] += cloud.y[p];
+            ss[3] += cloud.z[p];
+            if (!has_mu_[p]) continue;
+            std::uint64_t* vs = votes + static_cast<std::size_t>(s) * Kz;
+            const PixelWeights& w = mu_[p];
+            for (int q = 0; q < PixelWeights::kSlots; ++q) vs[w.cluster[q]] += w.mu[q];
+        }
     }
+    votes_.assign(S1 * Kz, 0.0);
+    seg_sums_.assign(S1 * kSegSums, 0.0);
+    for (int band = 0; band < kBands; ++band) {
+        const std::uint64_t* votes = band_votes_.data() + static_cast<std::size_t>(band) * S1 * Kz;
+        const double* sums = band_seg_sums_.data() + static_cast<std::size_t>(band) * S1 * kSegSums;
+        for (std::size_t i = 0; i < S1 * Kz; ++i) votes_[i] += static_cast<double>(votes[i]);
+        for (std::size_t i = 0; i < S1 * kSegSums; ++i) seg_sums_[i] += sums[i];
+    }
+    for (double& v : votes_) v /= static_cast<double>(PixelWeights::kOne);
 
     // 2. Greedy one-to-one matching by vote, largest first.
     struct Pair {
@@ -332,24 +353,48 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         }
     }
 
-    // 5. Objects: sums per slot, then boxes.
+    // 5. Objects: sums per slot and 2D boxes, per band of rows (as in 1), then summed.
+    band_obj_sums_.assign(kBands * Kz * kObjSums, 0.0);
+    band_boxes_.assign(kBands * Kz * 4, 0);
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kBands; ++band) {
+        double* const sums = band_obj_sums_.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
+        int* const boxes = band_boxes_.data() + static_cast<std::size_t>(band) * Kz * 4;
+        for (std::size_t j = 0; j < Kz; ++j) {
+            boxes[4 * j] = W;  // umin, vmin, umax, vmax
+            boxes[4 * j + 1] = H;
+            boxes[4 * j + 2] = boxes[4 * j + 3] = -1;
+        }
+        for (int v = H * band / kBands; v < H * (band + 1) / kBands; ++v)
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                if (!slot_of_[p]) continue;
+                const std::size_t j = slot_of_[p] - 1u;
+                double* o = sums + j * kObjSums;
+                const double x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
+                o[0] += 1;
+                o[1] += x; o[2] += y; o[3] += z;
+                o[4] += x * x; o[5] += x * y; o[6] += x * z;
+                o[7] += y * y; o[8] += y * z; o[9] += z * z;
+                o[10] += cloud.r[p]; o[11] += cloud.g[p]; o[12] += cloud.b[p];
+                int* box = boxes + 4 * j;
+                box[0] = std::min(box[0], u); box[2] = std::max(box[2], u);
+                box[1] = std::min(box[1], v); box[3] = std::max(box[3], v);
+            }
+    }
     obj_sums_.assign(Kz * kObjSums, 0.0);
     std::vector<int> umin(Kz, W), vmin(Kz, H), umax(Kz, -1), vmax(Kz, -1);
-    for (int v = 0; v < H; ++v)
-        for (int u = 0; u < W; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            if (!slot_of_[p]) continue;
-            const std::size_t j = slot_of_[p] - 1u;
-            double* o = obj_sums_.data() + j * kObjSums;
-            const double x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
-            o[0] += 1;
-            o[1] += x; o[2] += y; o[3] += z;
-            o[4] += x * x; o[5] += x * y; o[6] += x * z;
-            o[7] += y * y; o[8] += y * z; o[9] += z * z;
-            o[10] += cloud.r[p]; o[11] += cloud.g[p]; o[12] += cloud.b[p];
-            umin[j] = std::min(umin[j], u); umax[j] = std::max(umax[j], u);
-            vmin[j] = std::min(vmin[j], v); vmax[j] = std::max(vmax[j], v);
+    for (int band = 0; band < kBands; ++band) {
+        const double* sums = band_obj_sums_.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
+        const int* boxes = band_boxes_.data() + static_cast<std::size_t>(band) * Kz * 4;
+        for (std::size_t i = 0; i < Kz * kObjSums; ++i) obj_sums_[i] += sums[i];
+        for (std::size_t j = 0; j < Kz; ++j) {
+            umin[j] = std::min(umin[j], boxes[4 * j]);
+            vmin[j] = std::min(vmin[j], boxes[4 * j + 1]);
+            umax[j] = std::max(umax[j], boxes[4 * j + 2]);
+            vmax[j] = std::max(vmax[j], boxes[4 * j + 3]);
         }
+    }
     // Objects too small after weighting are dropped (their pixels become background).
     std::vector<std::uint8_t> keep(Kz, 0);
     for (std::size_t j = 0; j < Kz; ++j)
@@ -388,53 +433,90 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         index_of[j] = static_cast<int>(out.size());
         out.push_back(std::move(d));
     }
-    // Second pass: boxes' extents, source clusters and segments, the label image.
-    std::vector<std::array<float, 6>> proj(out.size(), {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY});
+    // Second pass, per band of rows: the label image, the boxes' extents (axis-aligned and
+    // along the OBB axes), source clusters and segments; then merged in band order (minima,
+    // maxima, counts and flags: exact in any order).
+    const std::size_t O = out.size();
     int max_cluster = 0;
-    for (std::uint16_t l : clusters.labels) max_cluster = std::max<int>(max_cluster, l);
-    cluster_count_.assign(out.size() * static_cast<std::size_t>(max_cluster + 1), 0);
-    std::vector<std::vector<int>> seg_count(out.size());
-    for (std::size_t p = 0; p < N; ++p) {
-        const int i = slot_of_[p] ? index_of[slot_of_[p] - 1u] : -1;
-        if (i < 0) {
-            objects.labels[p] = 0;
-            continue;
-        }
-        DetectedObject& d = out[static_cast<std::size_t>(i)];
-        objects.labels[p] = static_cast<std::uint16_t>(std::min(d.id, 65535));
-        const float pt[3] = {cloud.x[p], cloud.y[p], cloud.z[p]};
-        for (int a = 0; a < 3; ++a) {
-            d.aabb_min[static_cast<std::size_t>(a)] = std::min(d.aabb_min[static_cast<std::size_t>(a)], pt[a]);
-            d.aabb_max[static_cast<std::size_t>(a)] = std::max(d.aabb_max[static_cast<std::size_t>(a)], pt[a]);
-            const float* ax = d.obb_axes.data() + 3 * a;
-            const float t = ax[0] * (pt[0] - d.centroid[0]) + ax[1] * (pt[1] - d.centroid[1]) + ax[2] * (pt[2] - d.centroid[2]);
-            auto& pr = proj[static_cast<std::size_t>(i)];
-            pr[static_cast<std::size_t>(a)] = std::min(pr[static_cast<std::size_t>(a)], t);
-            pr[static_cast<std::size_t>(a + 3)] = std::max(pr[static_cast<std::size_t>(a + 3)], t);
-        }
-        if (!clusters.labels.empty())
-            ++cluster_count_[static_cast<std::size_t>(i) * static_cast<std::size_t>(max_cluster + 1) + clusters.labels[p]];
-        const int s = segments.labels[p];
-        if (s) {
-            auto& sc = seg_count[static_cast<std::size_t>(i)];
-            if (std::find(sc.begin(), sc.end(), s) == sc.end()) sc.push_back(s);
+    const auto Nc = static_cast<std::ptrdiff_t>(clusters.labels.size());
+#pragma omp parallel for schedule(static) reduction(max : max_cluster)
+    for (std::ptrdiff_t p = 0; p < Nc; ++p) max_cluster = std::max<int>(max_cluster, clusters.labels[static_cast<std::size_t>(p)]);
+    const std::size_t C1 = static_cast<std::size_t>(max_cluster) + 1;
+    constexpr int kExt = 12;  // aabb min (3), aabb max (3), OBB projection min (3), max (3)
+    band_extents_.assign(kBands * O * kExt, 0.0f);
+    band_cluster_count_.assign(kBands * O * C1, 0);
+    band_segment_seen_.assign(kBands * O * S1, 0);
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kBands; ++band) {
+        float* const ext = band_extents_.data() + static_cast<std::size_t>(band) * O * kExt;
+        int* const ccount = band_cluster_count_.data() + static_cast<std::size_t>(band) * O * C1;
+        std::uint8_t* const seen = band_segment_seen_.data() + static_cast<std::size_t>(band) * O * S1;
+        for (std::size_t i = 0; i < O; ++i)
+            for (int a = 0; a < 6; ++a) {
+                ext[i * kExt + static_cast<std::size_t>(a)] = INFINITY;
+                ext[i * kExt + static_cast<std::size_t>(a) + 6] = -INFINITY;
+            }
+        const std::size_t p0 = static_cast<std::size_t>(H * band / kBands) * W;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kBands) * W;
+        for (std::size_t p = p0; p < p1; ++p) {
+            const int i = slot_of_[p] ? index_of[slot_of_[p] - 1u] : -1;
+            if (i < 0) {
+                objects.labels[p] = 0;
+                continue;
+            }
+            const DetectedObject& d = out[static_cast<std::size_t>(i)];
+            objects.labels[p] = static_cast<std::uint16_t>(std::min(d.id, 65535));
+            float* e = ext + static_cast<std::size_t>(i) * kExt;
+            const float pt[3] = {cloud.x[p], cloud.y[p], cloud.z[p]};
+            for (int a = 0; a < 3; ++a) {
+                const float* ax = d.obb_axes.data() + 3 * a;
+                const float t = ax[0] * (pt[0] - d.centroid[0]) + ax[1] * (pt[1] - d.centroid[1]) + ax[2] * (pt[2] - d.centroid[2]);
+                e[a] = std::min(e[a], pt[a]);
+                e[a + 6] = std::max(e[a + 6], pt[a]);
+                e[a + 3] = std::min(e[a + 3], t);
+                e[a + 9] = std::max(e[a + 9], t);
+            }
+            if (!clusters.labels.empty()) ++ccount[static_cast<std::size_t>(i) * C1 + clusters.labels[p]];
+            seen[static_cast<std::size_t>(i) * S1 + segments.labels[p]] = 1;
         }
     }
-    for (std::size_t i = 0; i < out.size(); ++i) {
+    for (std::size_t i = 0; i < O; ++i) {
         DetectedObject& d = out[i];
-        const auto& pr = proj[i];
+        float e[kExt];
+        for (int a = 0; a < 6; ++a) {
+            e[a] = INFINITY;
+            e[a + 6] = -INFINITY;
+        }
+        for (int band = 0; band < kBands; ++band) {
+            const float* be = band_extents_.data() + (static_cast<std::size_t>(band) * O + i) * kExt;
+            for (int a = 0; a < 6; ++a) {
+                e[a] = std::min(e[a], be[a]);
+                e[a + 6] = std::max(e[a + 6], be[a + 6]);
+            }
+        }
         for (int a = 0; a < 3; ++a) {
-            const float mid = 0.5f * (pr[static_cast<std::size_t>(a)] + pr[static_cast<std::size_t>(a + 3)]);
-            d.obb_half_extent[static_cast<std::size_t>(a)] = 0.5f * (pr[static_cast<std::size_t>(a + 3)] - pr[static_cast<std::size_t>(a)]);
+            const std::size_t az = static_cast<std::size_t>(a);
+            d.aabb_min[az] = e[a];
+            d.aabb_max[az] = e[a + 6];
+            const float lo = e[a + 3], hi = e[a + 9];
+            const float mid = 0.5f * (lo + hi);
+            d.obb_half_extent[az] = 0.5f * (hi - lo);
             for (int b = 0; b < 3; ++b) d.obb_centre[static_cast<std::size_t>(b)] += mid * d.obb_axes[static_cast<std::size_t>(3 * a + b)];
         }
         for (int b = 0; b < 3; ++b) d.obb_centre[static_cast<std::size_t>(b)] += d.centroid[static_cast<std::size_t>(b)];
-        for (int l = 1; l <= max_cluster; ++l) {
-            const int cnt = cluster_count_[i * static_cast<std::size_t>(max_cluster + 1) + static_cast<std::size_t>(l)];
-            if (cnt > 0 && static_cast<double>(cnt) >= 0.05 * static_cast<double>(d.pixels)) d.source_clusters.push_back(l);
+        for (std::size_t l = 1; l < C1; ++l) {
+            int cnt = 0;
+            for (int band = 0; band < kBands; ++band)
+                cnt += band_cluster_count_[(static_cast<std::size_t>(band) * O + i) * C1 + l];
+            if (cnt > 0 && static_cast<double>(cnt) >= 0.05 * static_cast<double>(d.pixels))
+                d.source_clusters.push_back(static_cast<int>(l));
         }
-        d.source_segments = seg_count[i];
-        std::sort(d.source_segments.begin(), d.source_segments.end());
+        for (std::size_t sgm = 1; sgm < S1; ++sgm)
+            for (int band = 0; band < kBands; ++band)
+                if (band_segment_seen_[(static_cast<std::size_t>(band) * O + i) * S1 + sgm]) {
+                    d.source_segments.push_back(static_cast<int>(sgm));
+                    break;
+                }
     }
 
     // 6. Tracks: remember where each object is; count frames unseen; retire the long lost.

@@ -105,7 +105,13 @@ private:
     int scene_cuts_ = 0;
     // per-frame scratch
     std::vector<double> votes_, seg_sums_, obj_sums_;
-    std::vector<int> seg_slot_, cluster_count_;
+    std::vector<int> seg_slot_;
+    // Per band of rows (objects.cpp, kBands), reduced in band order:
+    std::vector<std::uint64_t> band_votes_;
+    std::vector<double> band_seg_sums_, band_obj_sums_;
+    std::vector<int> band_boxes_, band_cluster_count_;
+    std::vector<float> band_extents_;
+    std::vector<std::uint8_t> band_segment_seen_;
 };
 
 /// Follows one user-picked object through the labels of successive frames.
