@@ -83,7 +83,8 @@ namespace {
 /// opening) are object material, not the support: a 4-connected patch of removed on-band
 /// pixels that touches neither the image border nor other removed points, borders object
 /// points, is small and sits on average above the plane is given back (kPlaneInside).
-/// `ws.on_band` marks the removed on-band pixels (the caller's classification pass). The
+/// `ws.on_band` marks the removed on-band pixels and `ws.row_first_run[v + 1]` holds row v's
+/// number of runs of them (the caller's classification pass). The
 /// patches are found as runs of on-band pixels per row joined by union-find where runs of
 /// consecutive rows overlap: a few thousand runs instead of a flood fill over the table.
 std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
@@ -93,8 +94,6 @@ std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& clo
     const std::size_t N = cloud.size();
     const std::uint8_t* band = ws.on_band.data();
     auto& runs = ws.runs;
-    runs.clear();
-    ws.row_first_run.assign(static_cast<std::size_t>(H) + 1, 0);
     auto find = [&](int a) {
         while (runs[static_cast<std::size_t>(a)].parent != a) {
             auto& r = runs[static_cast<std::size_t>(a)];
@@ -103,8 +102,15 @@ std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& clo
         }
         return a;
     };
+    // The runs, row by row in parallel, each row's at its offset (the counts per row come
+    // from the caller).
+    for (int v = 0; v < H; ++v)
+        ws.row_first_run[static_cast<std::size_t>(v) + 1] += ws.row_first_run[static_cast<std::size_t>(v)];
+    const std::size_t R = static_cast<std::size_t>(ws.row_first_run[static_cast<std::size_t>(H)]);
+    runs.resize(R);
+#pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
-        ws.row_first_run[static_cast<std::size_t>(v)] = static_cast<int>(runs.size());
+        int id = ws.row_first_run[static_cast<std::size_t>(v)];
         const std::uint8_t* row = band + static_cast<std::size_t>(v) * W;
         for (int u = 0; u < W;) {
             if (!row[u]) {
@@ -113,24 +119,10 @@ std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& clo
             }
             const int begin = u;
             while (u < W && row[u]) ++u;
-            const int id = static_cast<int>(runs.size());
-            runs.push_back({v, begin, u, id});
-        }
-        if (v == 0) continue;
-        // Join with the previous row's runs that share a column (4-connectivity).
-        int a = ws.row_first_run[static_cast<std::size_t>(v) - 1];
-        const int a_end = ws.row_first_run[static_cast<std::size_t>(v)];
-        for (int b = a_end; b < static_cast<int>(runs.size()); ++b) {
-            const auto& rb = runs[static_cast<std::size_t>(b)];
-            while (a < a_end && runs[static_cast<std::size_t>(a)].end <= rb.begin) ++a;
-            for (int c = a; c < a_end && runs[static_cast<std::size_t>(c)].begin < rb.end; ++c) {
-                const int ra = find(c), rb_root = find(b);
-                if (ra != rb_root) runs[static_cast<std::size_t>(std::max(ra, rb_root))].parent = std::min(ra, rb_root);
-            }
+            runs[static_cast<std::size_t>(id)] = {v, begin, u, id};
+            ++id;
         }
     }
-    ws.row_first_run[static_cast<std::size_t>(H)] = static_cast<int>(runs.size());
-    const std::size_t R = runs.size();
     ws.island_height.assign(R, 0.0);
     ws.island_size.assign(R, 0);
     ws.island_flags.assign(R, 0);
@@ -141,30 +133,50 @@ std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& clo
         if (classes[q] != kPlaneRemoved) flags |= 2;
         else if (active[q]) flags |= 1;
     };
-    // Per run (in parallel): its heights and what borders it; then summed per island.
+    // Per run (in parallel): what borders it and, unless that opens it (its island is then
+    // open whatever else it holds: most of the table's runs), its heights; then summed per
+    // island.
     const auto Rn = static_cast<std::ptrdiff_t>(R);
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t i = 0; i < Rn; ++i) {
         const auto& r = runs[static_cast<std::size_t>(i)];
         std::uint8_t flags = 0;
         const std::size_t row = static_cast<std::size_t>(r.row) * W;
-        double height = 0;
-        for (int u = r.begin; u < r.end; ++u) {
-            const std::size_t p = row + static_cast<std::size_t>(u);
-            height += pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-        }
         if (r.row == 0 || r.row == H - 1 || r.begin == 0 || r.end == W) {
             flags |= 1;  // touches the image border
         } else {
             look(row + static_cast<std::size_t>(r.begin) - 1, flags);
             look(row + static_cast<std::size_t>(r.end), flags);
-            for (int u = r.begin; u < r.end; ++u) {
+            for (int u = r.begin; u < r.end && !(flags & 1); ++u) {
                 look(row - W + static_cast<std::size_t>(u), flags);
                 look(row + W + static_cast<std::size_t>(u), flags);
             }
         }
+        double height = 0;
+        if (!(flags & 1))
+            for (int u = r.begin; u < r.end; ++u) {
+                const std::size_t p = row + static_cast<std::size_t>(u);
+                height += pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+            }
         ws.island_height[static_cast<std::size_t>(i)] = height;
         ws.island_flags[static_cast<std::size_t>(i)] = flags;
+    }
+    // Runs of consecutive rows that share a column (4-connectivity) join, except two open
+    // runs: their islands are open whatever else they join (most of the table's runs).
+    for (int v = 1; v < H; ++v) {
+        int a = ws.row_first_run[static_cast<std::size_t>(v) - 1];
+        const int a_end = ws.row_first_run[static_cast<std::size_t>(v)];
+        const int b_end = ws.row_first_run[static_cast<std::size_t>(v) + 1];
+        for (int b = a_end; b < b_end; ++b) {
+            const auto& rb = runs[static_cast<std::size_t>(b)];
+            while (a < a_end && runs[static_cast<std::size_t>(a)].end <= rb.begin) ++a;
+            const bool b_open = ws.island_flags[static_cast<std::size_t>(b)] & 1;
+            for (int c = a; c < a_end && runs[static_cast<std::size_t>(c)].begin < rb.end; ++c) {
+                if (b_open && (ws.island_flags[static_cast<std::size_t>(c)] & 1)) continue;
+                const int ra = find(c), rb_root = find(b);
+                if (ra != rb_root) runs[static_cast<std::size_t>(std::max(ra, rb_root))].parent = std::min(ra, rb_root);
+            }
+        }
     }
     for (std::size_t i = 0; i < R; ++i) {
         const auto& r = runs[i];
@@ -432,12 +444,16 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     const Plane pl = result.support;
     if (hull_of != best) build_hull(pl);
     ws.on_band.resize(N);
+    ws.row_first_run.assign(static_cast<std::size_t>(H) + 1, 0);
 
     // 5. Classify every pixel: below or on the plane (and facing like it) is removed; on the
     //    band but facing otherwise is a candidate foot; above and over the support is object.
+    //    The runs of removed on-band pixels are counted per row for restore_islands.
     std::size_t kept = 0;
 #pragma omp parallel for schedule(static) reduction(+ : kept)
     for (int v = 0; v < H; ++v) {
+        int runs = 0;
+        std::uint8_t previous = 0;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             std::uint8_t c = kPlaneRemoved;
@@ -458,7 +474,10 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             classes[p] = c;
             ws.on_band[p] = on_band_removed;
             kept += c != kPlaneRemoved;
+            runs += on_band_removed > previous;
+            previous = on_band_removed;
         }
+        ws.row_first_run[static_cast<std::size_t>(v) + 1] = runs;
     }
     kept += restore_islands(params, cloud, active, pl, ws, classes);
     result.kept = kept;
