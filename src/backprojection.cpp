@@ -31,27 +31,44 @@ std::size_t back_project(const RgbdFrame& frame, OrganizedCloud& cloud) {
     const std::uint16_t* depth = frame.depth.data.data();
     const std::uint8_t* rgb = frame.has_color() ? frame.color.rgb.data() : nullptr;
 
+    // Raw pointers: a byte store (valid, colour) may alias anything, so through the vectors
+    // the compiler would reload every data pointer per pixel and not vectorize.
+    float* const xs = cloud.x.data();
+    float* const ys = cloud.y.data();
+    float* const zs = cloud.z.data();
+    std::uint8_t* const valid = cloud.valid.data();
+    std::uint8_t* const rs = cloud.r.data();
+    std::uint8_t* const gs = cloud.g.data();
+    std::uint8_t* const bs = cloud.b.data();
     std::size_t count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count)
     for (int v = 0; v < H; ++v) {
         const float yv = (static_cast<float>(v) - cy) * inv_fy;
         const std::size_t row = static_cast<std::size_t>(v) * W;
+        int row_count = 0;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = row + u;
-            const float z = static_cast<float>(depth[p]) * scale;
-            const bool ok = depth[p] != 0;
-            cloud.valid[p] = ok ? 1 : 0;
-            count += ok;
-            cloud.z[p] = ok ? z : 0.0f;
-            cloud.x[p] = ok ? (static_cast<float>(u) - cx) * inv_fx * z : 0.0f;
-            cloud.y[p] = ok ? yv * z : 0.0f;
-            if (rgb) {
-                cloud.r[p] = rgb[3 * p];
-                cloud.g[p] = rgb[3 * p + 1];
-                cloud.b[p] = rgb[3 * p + 2];
-            } else {
-                cloud.r[p] = cloud.g[p] = cloud.b[p] = 0;
+            const float z = static_cast<float>(depth[p]) * scale;  // 0 where there is no depth
+            const std::uint8_t ok = depth[p] != 0;
+            valid[p] = ok;
+            row_count += ok;
+            zs[p] = z;
+            // + 0: a point without depth gets x = y = +0, never -0 (no branch: vectorizes).
+            xs[p] = (static_cast<float>(u) - cx) * inv_fx * z + 0.0f;
+            ys[p] = yv * z + 0.0f;
+        }
+        count += static_cast<std::size_t>(row_count);
+        if (rgb) {
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = row + u;
+                rs[p] = rgb[3 * p];
+                gs[p] = rgb[3 * p + 1];
+                bs[p] = rgb[3 * p + 2];
             }
+        } else {
+            std::fill(rs + row, rs + row + W, 0);
+            std::fill(gs + row, gs + row + W, 0);
+            std::fill(bs + row, bs + row + W, 0);
         }
     }
     return count;
