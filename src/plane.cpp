@@ -75,6 +75,28 @@ struct Grid {
     int w = 0, h = 0, s = 1, W = 0;
 };
 
+/// The support's extent as a grid-resolution mask, and the test the pixels take against it:
+/// a point belongs over the support when its foot (the point moved down the normal onto the
+/// plane, `h` above it) projects into the mask. Plain values and a raw pointer: the
+/// per-pixel loops that call it store bytes, which would otherwise make the compiler reload
+/// every member on each pixel.
+struct HullMask {
+    const std::uint8_t* mask;
+    std::size_t w;
+    float fw, fh;            // w, h as floats
+    float gfx, gfy, gcx, gcy;  // intrinsics in grid cells, centres + 0.5 (cell by truncation)
+    float nx, ny, nz;        // the plane's normal
+
+    bool has_foot(float x, float y, float z, float h) const {
+        const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
+        if (fz <= 1e-3f) return false;
+        const float inv_z = 1.0f / fz;
+        const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
+        if (!(gu >= 0.0f && gv >= 0.0f && gu < fw && gv < fh)) return false;
+        return mask[static_cast<std::size_t>(gv) * w + static_cast<std::size_t>(gu)] != 0;
+    }
+};
+
 }  // namespace
 
 namespace {
@@ -391,19 +413,14 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             cv::dilate(mask, mask, kernel);
         }
     };
-    // Per pixel in the hot loop below: float arithmetic, grid cell by rounding (no libm call).
-    const float inv_s = 1.0f / static_cast<float>(grid.s);
-    const float gfx = static_cast<float>(K.fx) * inv_s, gfy = static_cast<float>(K.fy) * inv_s;
-    const float gcx = static_cast<float>(K.cx) * inv_s + 0.5f, gcy = static_cast<float>(K.cy) * inv_s + 0.5f;
-    auto foot_in_hull = [&](const Plane& pl, float x, float y, float z, float h) {
-        const float fx = x - h * pl.nx, fy = y - h * pl.ny, fz = z - h * pl.nz;
-        if (fz <= 1e-3f) return false;
-        const float inv_z = 1.0f / fz;
-        const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
-        if (!(gu >= 0.0f && gv >= 0.0f && gu < static_cast<float>(grid.w) && gv < static_cast<float>(grid.h)))
-            return false;
-        return ws.hull[static_cast<std::size_t>(gv) * static_cast<std::size_t>(grid.w) +
-                       static_cast<std::size_t>(gu)] != 0;
+    // Per pixel in the hot loops below: float arithmetic, grid cell by rounding (no libm call).
+    // Valid after build_hull(pl).
+    auto hull_of_plane = [&](const Plane& pl) {
+        const float inv_s = 1.0f / static_cast<float>(grid.s);
+        return HullMask{ws.hull.data(), static_cast<std::size_t>(grid.w), static_cast<float>(grid.w),
+                        static_cast<float>(grid.h), static_cast<float>(K.fx) * inv_s,
+                        static_cast<float>(K.fy) * inv_s, static_cast<float>(K.cx) * inv_s + 0.5f,
+                        static_cast<float>(K.cy) * inv_s + 0.5f, pl.nx, pl.ny, pl.nz};
     };
 
     // 4. The support: among planes that face up, the one that carries most: score = points
@@ -415,12 +432,13 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         if (pl.up < params.min_up) continue;
         build_hull(pl);
         hull_of = static_cast<int>(c);
+        const HullMask hull = hull_of_plane(pl);
         std::size_t above = 0;
         for (std::size_t p = 0; p < static_cast<std::size_t>(G); ++p) {
             if (!gp.active[p]) continue;
             const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
             if (h <= on_band(gp.z[p]) || h > params.max_object_height_m) continue;
-            if (foot_in_hull(pl, gp.x[p], gp.y[p], gp.z[p], h)) ++above;
+            if (hull.has_foot(gp.x[p], gp.y[p], gp.z[p], h)) ++above;
         }
         pl.above = above;
         // Points standing on a plane count up to its own extent (a small tilted plane, a box
@@ -450,6 +468,18 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     //    band but facing otherwise is a candidate foot; above and over the support is object.
     //    The runs of removed on-band pixels are counted per row for restore_islands.
     std::size_t kept = 0;
+    // Raw pointers: the byte stores below may alias anything, so through the containers the
+    // compiler would reload their data pointers on every pixel.
+    const float *const xs = cloud.x.data(), *const ys = cloud.y.data(), *const zs = cloud.z.data();
+    const float *const nxs = normals.nx.data(), *const nys = normals.ny.data(), *const nzs = normals.nz.data();
+    const std::uint8_t *const act = active.data(), *const has_normal = normals.valid.data();
+    std::uint8_t* const cls = classes.data();
+    std::uint8_t* const band_out = ws.on_band.data();
+    // ... and the plane and the band as plain values (a byte store could change them too, as
+    // far as the compiler knows).
+    const HullMask hull = hull_of_plane(pl);
+    const float pnx = pl.nx, pny = pl.ny, pnz = pl.nz, pd = pl.d;
+    const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
 #pragma omp parallel for schedule(static) reduction(+ : kept)
     for (int v = 0; v < H; ++v) {
         int runs = 0;
@@ -458,21 +488,20 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             std::uint8_t c = kPlaneRemoved;
             std::uint8_t on_band_removed = 0;
-            if (active[p]) {
-                const float x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
-                const float h = pl.height(x, y, z), band = on_band(z);
+            if (act[p]) {
+                const float x = xs[p], y = ys[p], z = zs[p];
+                const float h = pnx * x + pny * y + pnz * z + pd, band = band_m + band_rel * z * z;
                 if (h > band) {
-                    if (foot_in_hull(pl, x, y, z, h)) c = kPlaneObject;
-                } else if (h > -band && normals.valid[p] &&
-                           normals.nx[p] * pl.nx + normals.ny[p] * pl.ny + normals.nz[p] * pl.nz <
-                               cos_inlier &&
-                           foot_in_hull(pl, x, y, z, h)) {
+                    if (hull.has_foot(x, y, z, h)) c = kPlaneObject;
+                } else if (h > -band && has_normal[p] &&
+                           nxs[p] * pnx + nys[p] * pny + nzs[p] * pnz < cos_inlier &&
+                           hull.has_foot(x, y, z, h)) {
                     c = kPlaneFoot;
                 }
                 on_band_removed = c == kPlaneRemoved && std::fabs(h) <= band;
             }
-            classes[p] = c;
-            ws.on_band[p] = on_band_removed;
+            cls[p] = c;
+            band_out[p] = on_band_removed;
             kept += c != kPlaneRemoved;
             runs += on_band_removed > previous;
             previous = on_band_removed;
