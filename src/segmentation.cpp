@@ -658,34 +658,50 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
         // when any pair spanning it is concave (two passes: no two threads write one byte).
         const int s = params.crease_step_px;
         ws.crease.resize(N);
+        // Raw pointers and plain values: the byte stores would otherwise make the compiler
+        // reload every container's data pointer and every parameter on each pixel.
+        const std::uint8_t *const cls = classes.data(), *const has_normal = normals.valid.data();
+        const float *const cx = cloud.x.data(), *const cy = cloud.y.data(), *const cz = cloud.z.data();
+        const NormalMap& cn = *crease_normals;
+        const float *const nx = cn.nx.data(), *const ny = cn.ny.data(), *const nz = cn.nz.data();
+        std::uint8_t* const crease = ws.crease.data();
+        std::uint8_t* const seedable_out = ws.cut.data();
+        const float jump_m = params.depth_jump_m, jump_rel = params.depth_jump_rel;
+        const float concavity = params.concavity, steps = static_cast<float>(s);
 #pragma omp parallel for schedule(static)
         for (int v = 0; v < H; ++v) {
             for (int u = 0; u < W; ++u) {
                 const std::size_t p = static_cast<std::size_t>(v) * W + u;
                 std::uint8_t bits = 0;
-                if (classes[p] == kPlaneObject && normals.valid[p]) {
+                if (cls[p] == kPlaneObject && has_normal[p]) {
                     const std::size_t qs[2] = {u + s < W ? p + s : p,
                                                v + s < H ? p + static_cast<std::size_t>(s) * W : p};
+                    const float z = cz[p];
                     for (int k = 0; k < 2; ++k) {
                         const std::size_t q = qs[k];
-                        if (q == p || classes[q] != kPlaneObject || !normals.valid[q]) continue;
-                        if (!x.connected(p, q, static_cast<float>(s))) continue;
-                        if (x.concavity(p, q) > params.concavity) bits |= static_cast<std::uint8_t>(1 << k);
+                        if (q == p || cls[q] != kPlaneObject || !has_normal[q]) continue;
+                        // Ctx::connected over s pixels, then Ctx::concavity, on values.
+                        if (!(std::fabs(z - cz[q]) <= steps * (jump_m + jump_rel * z * z))) continue;
+                        const float dx = cx[q] - cx[p], dy = cy[q] - cy[p], dz = cz[q] - z;
+                        const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+                        if (!(len > 1e-6f)) continue;
+                        const float c = ((nx[p] - nx[q]) * dx + (ny[p] - ny[q]) * dy + (nz[p] - nz[q]) * dz) / len;
+                        if (c > concavity) bits |= static_cast<std::uint8_t>(1 << k);
                     }
                 }
-                ws.crease[p] = bits;
+                crease[p] = bits;
             }
         }
 #pragma omp parallel for schedule(static)
         for (int v = 0; v < H; ++v) {
             for (int u = 0; u < W; ++u) {
                 const std::size_t p = static_cast<std::size_t>(v) * W + u;
-                bool seed = classes[p] == kPlaneObject && normals.valid[p];
+                bool seed = cls[p] == kPlaneObject && has_normal[p];
                 for (int k = 0; k <= s && seed; ++k) {
-                    if (u - k >= 0 && (ws.crease[p - k] & 1)) seed = false;
-                    if (v - k >= 0 && (ws.crease[p - static_cast<std::size_t>(k) * W] & 2)) seed = false;
+                    if (u - k >= 0 && (crease[p - k] & 1)) seed = false;
+                    if (v - k >= 0 && (crease[p - static_cast<std::size_t>(k) * W] & 2)) seed = false;
                 }
-                ws.cut[p] = seed;
+                seedable_out[p] = seed;
             }
         }
     }
