@@ -426,16 +426,45 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     const SegmentParams& prm = x.prm;
     const int W = x.W;
     const std::size_t N = static_cast<std::size_t>(W) * x.H;
-    // Counting sort of the pixels by segment.
-    ws.offsets.assign(static_cast<std::size_t>(n) + 2, 0);
-    for (std::size_t p = 0; p < N; ++p) ++ws.offsets[static_cast<std::size_t>(ws.label[p]) + 1];
-    for (int l = 0; l <= n; ++l) ws.offsets[l + 1] += ws.offsets[l];
-    ws.order.resize(N);
-    ws.remap.assign(ws.offsets.begin(), ws.offsets.end());
-    for (std::size_t p = 0; p < N; ++p)
-        ws.order[static_cast<std::size_t>(ws.remap[static_cast<std::size_t>(ws.label[p])]++)] = static_cast<int>(p);
-    ws.part.assign(N, 0);
-    ws.part_in_order.resize(N);
+    // Counting sort of the segments' pixels by segment (background left out), per fixed
+    // band of rows in parallel: counts per band, then each band writes from its own start
+    // (segment by segment, bands in order), so every segment lists its pixels in raster order.
+    constexpr int kSortBands = 8;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.remap.assign(kSortBands * L, 0);  // per band: counts, then write positions
+    const int H = x.H;
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kSortBands; ++band) {
+        int* const count = ws.remap.data() + static_cast<std::size_t>(band) * L;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
+        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p)
+            ++count[static_cast<std::size_t>(ws.label[p])];
+    }
+    ws.offsets.assign(L + 1, 0);  // segment l's pixels: order[offsets[l], offsets[l + 1])
+    int position = 0;
+    for (std::size_t l = 1; l < L; ++l) {
+        ws.offsets[l] = position;
+        for (int band = 0; band < kSortBands; ++band) {
+            int& slot = ws.remap[static_cast<std::size_t>(band) * L + l];
+            const int count = slot;
+            slot = position;
+            position += count;
+        }
+    }
+    ws.offsets[L] = position;
+    ws.order.resize(static_cast<std::size_t>(position));
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kSortBands; ++band) {
+        int* const next = ws.remap.data() + static_cast<std::size_t>(band) * L;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
+        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p) {
+            const int l = ws.label[p];
+            if (l) ws.order[static_cast<std::size_t>(next[l]++)] = static_cast<int>(p);
+        }
+    }
+    // part is written for a segment's pixels before anything reads them: no clearing.
+    ws.part.resize(N);
+    ws.part_in_order.resize(static_cast<std::size_t>(position));
     ws.split.assign(static_cast<std::size_t>(n) + 1, 0);
     // Features gathered in segment order, one plane each: every pass below reads contiguous
     // memory. Scaled by the paper's delta and alpha (eq. 4) so a squared distance is a sum.
