@@ -428,8 +428,6 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
                     static_cast<float>(eig.eigenvectors()(b, 2 - a));  // largest spread first
         d.u_min = umin[j]; d.u_max = umax[j]; d.v_min = vmin[j]; d.v_max = vmax[j];
         d.mean_rgb = {static_cast<float>(o[10] / n), static_cast<float>(o[11] / n), static_cast<float>(o[12] / n)};
-        d.aabb_min = {INFINITY, INFINITY, INFINITY};
-        d.aabb_max = {-INFINITY, -INFINITY, -INFINITY};
         index_of[j] = static_cast<int>(out.size());
         out.push_back(std::move(d));
     }
