@@ -29,6 +29,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
         sum.merge += stats.ms.merge;
         sum.containers += stats.ms.containers;
         sum.color += stats.ms.color;
+        sum.gaps += stats.ms.gaps;
         sum.compact += stats.ms.compact;
     }
     using benchmark::Counter;
@@ -40,6 +41,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     state.counters["merge_ms"] = Counter(sum.merge, Counter::kAvgIterations);
     state.counters["containers_ms"] = Counter(sum.containers, Counter::kAvgIterations);
     state.counters["color_ms"] = Counter(sum.color, Counter::kAvgIterations);
+    state.counters["gaps_ms"] = Counter(sum.gaps, Counter::kAvgIterations);
     state.counters["compact_ms"] = Counter(sum.compact, Counter::kAvgIterations);
 }
 BENCHMARK_CAPTURE(BM_SegmentObjects, geometric, Segmenter::Geometric)

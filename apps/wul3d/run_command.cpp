@@ -247,6 +247,7 @@ void run(const RunOptions& o) {
                             {"segments", r.segment_stats.segments},
                             {"merges", r.segment_stats.merges},
                             {"containers", r.segment_stats.containers},
+                            {"gaps_filled", r.segment_stats.gaps_filled},
                             {"color_splits", r.segment_stats.color_splits},
                             {"objects", r.object_list.size()}};
         if (selection) f["selected_pixels"] = selection->pixels();

@@ -72,6 +72,11 @@ struct SegmentParams {
     float rim_inside_share = 0.95f;     ///< share of the inside's feet within the circle
                                         ///< (radius + 10 % + 1 cm); (0, 1]
     float rim_height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
+    /// Gaps in a container's floor: a patch of unlabelled points enclosed by one segment and
+    /// touching its inside (kPlaneInside: floor points whose patch was too noisy to pass the
+    /// plane's island test) joins that segment. A true hole (a mug's handle, the table seen
+    /// through it) touches no inside and stays. Patches up to this many pixels; 0 = off.
+    int gap_max_px = 500;
 
     void validate() const;  ///< throws ParamError naming the field
 };
@@ -108,6 +113,9 @@ struct SegmentWorkspace {
                                                   ///< rim height per candidate
     std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
     std::vector<int> rim_next;         ///< candidates of one back segment, linked
+    // Floor gaps:
+    std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
+    std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
 };
 
 /// What segmentation did, as data.
@@ -116,13 +124,14 @@ struct SegmentStats {
     int color_splits = 0;  ///< segments the colour cue split
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim
+    std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
-    /// components, re-attachment, convexity merge, container rule, colour cue, and the
-    /// renumbering passes with the output. For the profile in bench/.
+    /// components, re-attachment, convexity merge, container rule, colour cue, floor gaps,
+    /// and the renumbering passes with the output. For the profile in bench/.
     struct Phases {
         double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
-               color = 0, compact = 0;
+               color = 0, gaps = 0, compact = 0;
     } ms;
 };
 
