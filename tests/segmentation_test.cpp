@@ -11,26 +11,46 @@ using namespace wul3d;
 using namespace wul3d::test;
 
 namespace {
+/// A rendered scene with what segmentation takes: the cloud, normals and plane classes.
+struct PlaneStage {
+    std::vector<int> truth;
+    OrganizedCloud cloud;
+    NormalMap normals;
+    std::vector<std::uint8_t> classes;
+    PlaneResult plane;
+};
+
+/// Renders `s` and runs normals, depth range and support-plane removal.
+PlaneStage up_to_the_plane(const Scene& s) {
+    PlaneStage st;
+    const RgbdFrame f = render_scene(s, &st.truth);
+    std::vector<std::uint8_t> active;
+    back_project(f, st.cloud);
+    estimate_normals(NormalParams{}, st.cloud, st.normals);
+    select_depth_range(DepthRange{}, st.cloud, active);
+    PlaneWorkspace pws;
+    st.plane = remove_support_plane(PlaneParams{}, f.intrinsics, st.cloud, st.normals, active, pws,
+                                    st.classes);
+    EXPECT_TRUE(st.plane.found);
+    return st;
+}
+
+/// Segments a scene up to the plane stage.
+LabelImage segment(const PlaneStage& in, const SegmentParams& params, SegmentStats* stats = nullptr) {
+    SegmentWorkspace ws;
+    LabelImage out;
+    const SegmentStats st = segment_objects(params, in.cloud, in.normals, in.classes,
+                                            &in.plane.support, LabelImage{}, ws, out);
+    if (stats) *stats = st;
+    return out;
+}
+
 /// Renders `s` and runs normals, depth range, support-plane removal and segmentation.
 LabelImage segment(const Scene& s, const SegmentParams& params, std::vector<int>& truth,
                    SegmentStats* stats = nullptr) {
-    const RgbdFrame f = render_scene(s, &truth);
-    OrganizedCloud cloud;
-    NormalMap normals;
-    std::vector<std::uint8_t> active, classes;
-    back_project(f, cloud);
-    estimate_normals(NormalParams{}, cloud, normals);
-    select_depth_range(DepthRange{}, cloud, active);
-    PlaneWorkspace pws;
-    const PlaneResult plane =
-        remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
-    EXPECT_TRUE(plane.found);
-    SegmentWorkspace ws;
-    LabelImage out;
-    const SegmentStats st =
-        segment_objects(params, cloud, normals, classes, &plane.support, LabelImage{}, ws, out);
-    if (stats) *stats = st;
-    return out;
+    const PlaneStage in = up_to_the_plane(s);
+    truth = in.truth;
+    return segment(in, params, stats);
 }
 
 LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
@@ -195,20 +215,12 @@ TEST(SegmentObjects, Cup_FloorGapsFilledWallHoleKept) {
     cup.z = 0.9f;
     cup.radius = 0.1f;
     s.cups = {cup};
-    std::vector<int> truth;
-    const RgbdFrame f = render_scene(s, &truth);
-    OrganizedCloud cloud;
-    NormalMap normals;
-    std::vector<std::uint8_t> active, classes;
-    back_project(f, cloud);
-    estimate_normals(NormalParams{}, cloud, normals);
-    select_depth_range(DepthRange{}, cloud, active);
-    PlaneWorkspace pws;
-    const PlaneResult plane =
-        remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
-    ASSERT_TRUE(plane.found);
+    PlaneStage in = up_to_the_plane(s);
+    ASSERT_TRUE(in.plane.found);
+    const std::vector<int>& truth = in.truth;
+    std::vector<std::uint8_t>& classes = in.classes;
     // A pixel whose 5 x 5 neighbourhood is all of one class: the centre of a block to punch.
-    const int W = cloud.width, H = cloud.height;
+    const int W = in.cloud.width, H = in.cloud.height;
     auto block_of = [&](std::uint8_t cls) {
         for (int v = 2; v + 2 < H; ++v)
             for (int u = 2; u + 2 < W; ++u) {
@@ -237,10 +249,8 @@ TEST(SegmentObjects, Cup_FloorGapsFilledWallHoleKept) {
     for (const int max_px : {0, 500}) {
         SegmentParams params;
         params.gap_max_px = max_px;
-        SegmentWorkspace ws;
-        LabelImage out;
-        const SegmentStats st =
-            segment_objects(params, cloud, normals, classes, &plane.support, LabelImage{}, ws, out);
+        SegmentStats st;
+        const LabelImage out = segment(in, params, &st);
         int cup_label = 0;
         EXPECT_GT(dominant_share(out.labels, truth, kTruthCup0, &cup_label), 0.9);
         ASSERT_NE(cup_label, 0);
