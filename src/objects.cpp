@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "param_check.hpp"
+#include "point_moments.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -80,8 +81,8 @@ void require(bool ok, const char* name, T value, const char* range) {
 }
 // Per-segment sums: count, x, y, z.
 constexpr int kSegSums = 4;
-// Per-object sums: count, x, y, z, xx, xy, xz, yy, yz, zz, r, g, b.
-constexpr int kObjSums = 13;
+// Per-object sums: the point moments (point_moments.hpp), then r, g, b.
+constexpr int kObjSums = detail::kMoments + 3;
 // The per-pixel passes are summed per fixed band of rows, then in band order, so that the
 // results do not depend on the number of threads.
 constexpr int kBands = 16;
@@ -371,11 +372,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
                 if (!slot_of_[p]) continue;
                 const std::size_t j = slot_of_[p] - 1u;
                 double* o = sums + j * kObjSums;
-                const double x = cloud.x[p], y = cloud.y[p], z = cloud.z[p];
-                o[0] += 1;
-                o[1] += x; o[2] += y; o[3] += z;
-                o[4] += x * x; o[5] += x * y; o[6] += x * z;
-                o[7] += y * y; o[8] += y * z; o[9] += z * z;
+                detail::add_moments(o, cloud.x[p], cloud.y[p], cloud.z[p]);
                 o[10] += cloud.r[p]; o[11] += cloud.g[p]; o[12] += cloud.b[p];
                 int* box = boxes + 4 * j;
                 box[0] = std::min(box[0], u); box[2] = std::max(box[2], u);
@@ -412,15 +409,10 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         DetectedObject d;
         d.track_id = d.id = tracks_[j].id;
         d.pixels = static_cast<std::size_t>(n);
-        const Eigen::Vector3d c(o[1] / n, o[2] / n, o[3] / n);
-        d.centroid = {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
+        Eigen::Vector3d c;
         Eigen::Matrix3d m;
-        m(0, 0) = o[4] / n - c.x() * c.x();
-        m(0, 1) = m(1, 0) = o[5] / n - c.x() * c.y();
-        m(0, 2) = m(2, 0) = o[6] / n - c.x() * c.z();
-        m(1, 1) = o[7] / n - c.y() * c.y();
-        m(1, 2) = m(2, 1) = o[8] / n - c.y() * c.z();
-        m(2, 2) = o[9] / n - c.z() * c.z();
+        detail::mean_and_covariance(o, c, m);
+        d.centroid = {static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z())};
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)

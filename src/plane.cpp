@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "param_check.hpp"
+#include "point_moments.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -18,8 +19,8 @@ void require(bool ok, const char* name, T value, const char* range) {
     detail::require_param(ok, "PlaneParams", name, value, range);
 }
 constexpr float kDegToRad = 3.14159265358979f / 180.0f;
-// Per-region sums: count, x, y, z, xx, xy, xz, yy, yz, zz, nx, ny, nz.
-constexpr int kSums = 13;
+// Per-region sums: the point moments (point_moments.hpp), then nx, ny, nz.
+constexpr int kSums = detail::kMoments + 3;
 }  // namespace
 
 void PlaneParams::validate() const {
@@ -45,15 +46,9 @@ namespace {
 /// Least-squares plane of a region's sums: the normal is the eigenvector of the smallest
 /// eigenvalue of the scatter matrix, oriented towards the camera (d > 0).
 Plane fit(const double* s) {
-    const double n = s[0];
-    const Eigen::Vector3d c(s[1] / n, s[2] / n, s[3] / n);
+    Eigen::Vector3d c;
     Eigen::Matrix3d m;
-    m(0, 0) = s[4] / n - c.x() * c.x();
-    m(0, 1) = m(1, 0) = s[5] / n - c.x() * c.y();
-    m(0, 2) = m(2, 0) = s[6] / n - c.x() * c.z();
-    m(1, 1) = s[7] / n - c.y() * c.y();
-    m(1, 2) = m(2, 1) = s[8] / n - c.y() * c.z();
-    m(2, 2) = s[9] / n - c.z() * c.z();
+    detail::mean_and_covariance(s, c, m);
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
     Eigen::Vector3d normal = eig.eigenvectors().col(0);
     double d = -normal.dot(c);
@@ -285,11 +280,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         while (top > 0) {
             const int g = ws.stack[--top];
             const std::size_t p = static_cast<std::size_t>(g);
-            const double x = gp.x[p], y = gp.y[p], z = gp.z[p];
-            s[0] += 1;
-            s[1] += x; s[2] += y; s[3] += z;
-            s[4] += x * x; s[5] += x * y; s[6] += x * z;
-            s[7] += y * y; s[8] += y * z; s[9] += z * z;
+            detail::add_moments(s, gp.x[p], gp.y[p], gp.z[p]);
             s[10] += gp.nx[p]; s[11] += gp.ny[p]; s[12] += gp.nz[p];
             const double nlen = std::sqrt(s[10] * s[10] + s[11] * s[11] + s[12] * s[12]);
             const float mnx = static_cast<float>(s[10] / nlen), mny = static_cast<float>(s[11] / nlen),
