@@ -5,6 +5,10 @@
 #include <cmath>
 #include <sstream>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
 
@@ -77,7 +81,7 @@ int update_weights(float* mu, int k, int winner, float psi) {
     return best;
 }
 
-int update_weights(PixelWeights& w, int winner, float psi) {
+int detail::update_weights_scalar(PixelWeights& w, int winner, float psi) {
     constexpr int S = PixelWeights::kSlots;
     // A pixel whose whole weight is already on the winner stays so: (1 + psi) / (1 + psi).
     // That is every pixel of a still scene, so it is worth checking first.
@@ -113,6 +117,102 @@ int update_weights(PixelWeights& w, int winner, float psi) {
     }
     return label;
 }
+
+#if defined(__SSE2__)
+namespace {
+/// Lanes 0-5 of a 16-bit vector; lanes 6 and 7 are padding.
+constexpr int kSlotBytes = (1 << (2 * PixelWeights::kSlots)) - 1;
+
+/// Unsigned 16-bit lanes as signed ones with the same order (SSE2 compares signed only).
+inline __m128i flip(__m128i a) { return _mm_xor_si128(a, _mm_set1_epi16(static_cast<short>(0x8000))); }
+
+/// Every lane set to the minimum (max_lanes = false) or maximum of the 8 signed lanes.
+inline __m128i spread(__m128i a, bool max_lanes) {
+    auto pick = [max_lanes](__m128i x, __m128i y) { return max_lanes ? _mm_max_epi16(x, y) : _mm_min_epi16(x, y); };
+    a = pick(a, _mm_shuffle_epi32(a, _MM_SHUFFLE(1, 0, 3, 2)));
+    a = pick(a, _mm_shuffle_epi32(a, _MM_SHUFFLE(2, 3, 0, 1)));
+    return pick(a, _mm_shufflelo_epi16(_mm_shufflehi_epi16(a, _MM_SHUFFLE(2, 3, 0, 1)),
+                                       _MM_SHUFFLE(2, 3, 0, 1)));
+}
+
+/// 0-based lane of the first (lowest) set lane of a movemask over 16-bit lanes.
+inline int first_lane(int mask) { return __builtin_ctz(static_cast<unsigned>(mask)) / 2; }
+}  // namespace
+
+int update_weights(PixelWeights& w, int winner, float psi) {
+    // The scalar update (detail::update_weights_scalar) on one pixel's six slots at once,
+    // without a data-dependent branch: on a new scene the winner is kept or not at random
+    // and the scalar loop's branches mispredict. Same float operations in the same order
+    // (sums of 16-bit integers are exact in float), so the result is bit-identical
+    // (tests/clustering_test.cpp, PixelWeights.VectorUpdateMatchesScalar).
+    constexpr int S = PixelWeights::kSlots;
+    static_assert(sizeof(PixelWeights) == 4 * S && S == 6, "24-byte layout: cluster[6], mu[6]");
+    if (w.mu[0] == static_cast<std::uint16_t>(PixelWeights::kOne) && w.cluster[0] == winner)
+        return winner;  // still scene: see the scalar version
+    auto* const bytes = reinterpret_cast<std::uint8_t*>(&w);
+    const __m128i zero = _mm_setzero_si128();
+    // Bytes 0-15: cluster[0..5], mu[0..1]; bytes 8-23: cluster[4..5], mu[0..5].
+    __m128i cluster = _mm_loadu_si128(reinterpret_cast<const __m128i*>(bytes));
+    const __m128i mu = _mm_srli_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(bytes + 8)), 4);
+    const __m128i lanes = _mm_setr_epi16(0, 1, 2, 3, 4, 5, 6, 7);
+
+    const __m128i kept = _mm_andnot_si128(_mm_cmpeq_epi16(mu, zero),
+                                          _mm_cmpeq_epi16(cluster, _mm_set1_epi16(static_cast<short>(winner))));
+    const int kept_mask = _mm_movemask_epi8(kept) & kSlotBytes;
+    int slot;
+    __m128i mu_in = mu;  // the weights before psi, with the dropped one zeroed
+    if (kept_mask) {
+        slot = (31 - __builtin_clz(static_cast<unsigned>(kept_mask))) / 2;  // the last, as the scalar loop
+    } else {
+        // The smallest slot (the first of equals) takes the winner; padding lanes never win.
+        const __m128i padded = flip(_mm_or_si128(mu, _mm_setr_epi16(0, 0, 0, 0, 0, 0, -1, -1)));
+        slot = first_lane(_mm_movemask_epi8(_mm_cmpeq_epi16(padded, spread(padded, false))));
+        const __m128i at_slot = _mm_cmpeq_epi16(lanes, _mm_set1_epi16(static_cast<short>(slot)));
+        cluster = _mm_or_si128(_mm_andnot_si128(at_slot, cluster),
+                               _mm_and_si128(at_slot, _mm_set1_epi16(static_cast<short>(winner))));
+        mu_in = _mm_andnot_si128(at_slot, mu);
+    }
+    // Paper eq. (2), then (7)-(8) on the kept weights, in units of kOne (as the scalar one).
+    const __m128i lo32 = _mm_unpacklo_epi16(mu_in, zero), hi32 = _mm_unpackhi_epi16(mu_in, zero);
+    __m128i isum = _mm_add_epi32(lo32, hi32);
+    isum = _mm_add_epi32(isum, _mm_shuffle_epi32(isum, _MM_SHUFFLE(1, 0, 3, 2)));
+    isum = _mm_add_epi32(isum, _mm_shuffle_epi32(isum, _MM_SHUFFLE(2, 3, 0, 1)));
+    const float psi_one = psi * PixelWeights::kOne;
+    const float sum = static_cast<float>(_mm_cvtsi128_si32(isum));
+    const __m128 scale = _mm_set1_ps(PixelWeights::kOne / (sum + psi_one));
+    const __m128i slot32 = _mm_set1_epi32(slot);
+    const __m128 add_lo = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_setr_epi32(0, 1, 2, 3), slot32)), _mm_set1_ps(psi_one));
+    const __m128 add_hi = _mm_and_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_setr_epi32(4, 5, 6, 7), slot32)), _mm_set1_ps(psi_one));
+    const __m128 one = _mm_set1_ps(PixelWeights::kOne), half = _mm_set1_ps(0.5f);
+    auto normalize = [&](__m128i m32, __m128 add) {
+        const __m128 m = _mm_add_ps(_mm_cvtepi32_ps(m32), add);
+        // Truncation after + 0.5, then re-centred so that the signed pack keeps 0..65535.
+        return _mm_sub_epi32(_mm_cvttps_epi32(_mm_min_ps(one, _mm_add_ps(_mm_mul_ps(m, scale), half))),
+                             _mm_set1_epi32(32768));
+    };
+    const __m128i out = flip(_mm_packs_epi32(normalize(lo32, add_lo), normalize(hi32, add_hi)));
+    // Store cluster[0..3], then cluster[4..5] with mu[0..5]: exactly the struct's 24 bytes.
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(bytes), cluster);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(bytes + 8),
+                     _mm_or_si128(_mm_srli_si128(_mm_slli_si128(cluster, 4), 12), _mm_slli_si128(out, 4)));
+    // Arg-max, ties to the winner's slot; else the first of the largest (as the scalar loop).
+    const __m128i signed_out = flip(out);  // padding lanes are 0, below every kept weight
+    const __m128i largest = spread(signed_out, true);
+    int best = slot;
+    if (w.mu[slot] != static_cast<std::uint16_t>(_mm_extract_epi16(flip(largest), 0)))
+        best = first_lane(_mm_movemask_epi8(_mm_cmpeq_epi16(signed_out, largest)) & kSlotBytes);
+    const std::uint16_t label = w.cluster[best];
+    if (w.mu[best] == static_cast<std::uint16_t>(PixelWeights::kOne) && best != 0) {
+        std::swap(w.cluster[0], w.cluster[best]);  // keeps the fast path above reachable
+        std::swap(w.mu[0], w.mu[best]);
+    }
+    return label;
+}
+#else
+int update_weights(PixelWeights& w, int winner, float psi) {
+    return detail::update_weights_scalar(w, winner, psi);
+}
+#endif
 
 // ---- ClusterState -----------------------------------------------------------------------
 

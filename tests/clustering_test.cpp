@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <numeric>
+#include <random>
 #include <set>
 
 #include "synthetic_scene.hpp"
@@ -361,6 +363,50 @@ TEST(PixelWeights, NewPixelTakesTheWinnerAndPsiOneHalves) {
     EXPECT_EQ(update_weights(w, 2, 1.0f), 2);  // a tie at 0.5: the newest winner
     EXPECT_NEAR(w.weight(5), 0.5f, 1e-4f);
     EXPECT_NEAR(w.weight(2), 0.5f, 1e-4f);
+}
+
+TEST(PixelWeights, VectorUpdateMatchesScalar) {
+    // update_weights (SSE2 where the build has it) against detail::update_weights_scalar,
+    // bit for bit: on the states that updates reach, and on arbitrary ones with ties, zeros
+    // and repeated ids, which exercise every tie rule of the slot search and the arg-max.
+    std::mt19937 rng(7);
+    auto run = [](PixelWeights a, int winner, float psi) {
+        PixelWeights b = a;
+        const int la = update_weights(a, winner, psi);
+        const int lb = detail::update_weights_scalar(b, winner, psi);
+        const bool same = la == lb && std::memcmp(&a, &b, sizeof a) == 0;
+        return std::make_pair(same, a);
+    };
+    const float psis[] = {1.0f, 0.5f, 0.25f, 0.1f, 0.013f};
+    int mismatches = 0, swaps = 0, replaced = 0;
+    for (int seq = 0; seq < 2000; ++seq) {  // reachable states: sequences of winners
+        const int k = std::uniform_int_distribution<int>(1, 12)(rng);
+        const float psi = psis[seq % 5];
+        PixelWeights w;
+        for (int t = 0; t < 40; ++t) {
+            const int winner = std::uniform_int_distribution<int>(0, k - 1)(rng);
+            bool kept = false;
+            for (int s = 0; s < PixelWeights::kSlots; ++s) kept |= w.mu[s] > 0 && w.cluster[s] == winner;
+            replaced += !kept;
+            auto [same, next] = run(w, winner, psi);
+            mismatches += !same;
+            swaps += next.mu[0] == 65535 && next.cluster[0] == winner && w.cluster[0] != winner;
+            w = next;
+        }
+    }
+    std::uniform_int_distribution<int> small(0, 3), id(0, 7);
+    const std::uint16_t levels[] = {0, 1, 20000, 65535};
+    for (int t = 0; t < 200000; ++t) {  // arbitrary states
+        PixelWeights w;
+        for (int s = 0; s < PixelWeights::kSlots; ++s) {
+            w.cluster[s] = static_cast<std::uint16_t>(id(rng));
+            w.mu[s] = t % 2 ? levels[small(rng)] : static_cast<std::uint16_t>(rng());
+        }
+        mismatches += !run(w, id(rng), psis[t % 5]).first;
+    }
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_GT(replaced, 1000);  // both branches of the slot search ran
+    EXPECT_GT(swaps, 10);       // and the swap to slot 0
 }
 
 namespace {

@@ -107,6 +107,12 @@ struct PixelWeights {
 /// weights are L1-normalized. Returns the 0-based arg-max cluster; ties go to the winner.
 int update_weights(PixelWeights& w, int winner, float psi);
 
+namespace detail {
+/// The same update, one slot at a time: the reference the SSE2 update_weights above is tested
+/// against bit for bit, and the update itself where SSE2 is missing.
+int update_weights_scalar(PixelWeights& w, int winner, float psi);
+}  // namespace detail
+
 /// State across frames. Construct once per sequence; step() once per frame.
 class ClusterState {
 public:
