@@ -4,9 +4,10 @@
 Usage: eval/osd_table.py [--wul3d build/wul3d] [--data ../shared/data] [--out /tmp/wul3d-osd]
 
 Runs `wul3d run` on osd_mosd (78 frames) once per variant (default, --segmenter geometric,
---segmenter kmeans, --no-plane, and the paper's clusters: labels.png at k = 10), scores each
-with `wul3d eval` on the learn* frames, the test* frames and all, then the two osd_moving
-sequences with the paper's weights on objects (--object-psi 0.5) and without (1). Prints
+--segmenter kmeans, --no-plane, --decimate 2, and the paper's clusters: labels.png at
+k = 10), scores each with `wul3d eval` on the learn* frames, the test* frames and all, then
+the two osd_moving sequences with the paper's weights on objects (--object-psi 0.5), without
+(1), and with --decimate 2. Prints
 Markdown. OSD is research-only data: it is read from ../shared/data, never shipped.
 """
 import argparse
@@ -48,6 +49,7 @@ def main():
         ("wul3d --segmenter kmeans (the paper's clusters as objects, plane removed)",
          ["--segmenter", "kmeans"], "objects.png"),
         ("wul3d --no-plane", ["--no-plane"], "objects.png"),
+        ("wul3d --decimate 2 (stages on a quarter of the pixels)", ["--decimate", "2"], "objects.png"),
         ("the paper's method as published (clusters, labels.png, k = 10)", ["--k", "10"], "labels.png"),
     ]
     rows = []
@@ -70,9 +72,10 @@ def main():
     print("| osd_moving sequence | object psi | Overlap F | Boundary F | id switches (max per object) | flicker % |")
     print("|---|---|---|---|---|---|")
     for seq in sorted(p for p in (data / "osd_moving").iterdir() if p.is_dir()):
-        for psi in ("0.5", "1"):
-            pred = out / f"moving-{seq.name}-{psi}"
-            run([args.wul3d, "run", str(seq), "--out", str(pred), "-q", "--object-psi", psi])
+        for psi, flags in (("0.5", []), ("1", []), ("0.5, --decimate 2", ["--decimate", "2"])):
+            pred = out / f"moving-{seq.name}-{psi.replace(', ', '-').replace(' ', '')}"
+            run([args.wul3d, "run", str(seq), "--out", str(pred), "-q", "--object-psi",
+                 psi.split(",")[0], *flags])
             s = score(args.wul3d, pred, seq, "", "objects.png", ["--temporal"])
             print(f"| {seq.name} | {psi} | {100 * s['overlap_f']:.1f} | {100 * s['boundary_f']:.1f} | "
                   f"{s['id_switches']} ({s['max_switches']}) | {100 * s['flicker']:.1f} |")

@@ -1,7 +1,9 @@
 #include "wul3d/pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
 
+#include "param_check.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -15,12 +17,36 @@ PipelineParams PipelineParams::paper() {
 }
 
 void PipelineParams::validate() const {
+    detail::require_param(decimation >= 1 && decimation <= 8, "", "decimate", decimation,
+                          "in [1, 8]");
     normals.validate();
     range.validate();
     cluster.validate();
     plane.validate();
     segmentation.validate();
     objects.validate();
+}
+
+PipelineParams PipelineParams::stage_params() const {
+    PipelineParams s = *this;
+    const int n = decimation;
+    if (n <= 1) return s;
+    // What counts an object's pixels or spans the scene scales, so that --min-points 300 is
+    // the same object at every N; 0 keeps meaning "off". The neighbourhoods (normal radius,
+    // crease step and smoothing, re-attachment, depth jumps) and the seeds' size stay in the
+    // decimated pixels: scaling them cost up to 7 points of Boundary F on osd_mosd's learn
+    // frames (README, "Decimation").
+    auto length = [n](int px, int at_least) { return px == 0 ? 0 : std::max(at_least, (px + n / 2) / n); };
+    auto area = [n](int px) { return px == 0 ? 0 : std::max(1, (px + n * n / 2) / (n * n)); };
+    s.plane.grid_stride_px = length(plane.grid_stride_px, 1);  // the grid keeps its points
+    s.plane.hull_margin_px = length(plane.hull_margin_px, 0);
+    SegmentParams& g = s.segmentation;
+    g.min_points = area(segmentation.min_points);
+    g.gap_max_px = area(segmentation.gap_max_px);
+    g.merge_min_boundary = length(segmentation.merge_min_boundary, 1);
+    g.rim_min_boundary = length(segmentation.rim_min_boundary, 3);
+    s.objects.min_points = area(objects.min_points);
+    return s;
 }
 
 namespace {
@@ -31,7 +57,10 @@ double ms_since(Clock::time_point t0) {
 }  // namespace
 
 Pipeline::Pipeline(const PipelineParams& params)
-    : params_((params.validate(), params)), state_(params.cluster), tracker_(params.objects) {}
+    : params_((params.validate(), params)),
+      stage_params_(params.stage_params()),
+      state_(stage_params_.cluster),
+      tracker_(stage_params_.objects) {}
 
 const FrameResult& Pipeline::process(const RgbdFrame& frame) { return run_stages(frame, 0.0); }
 
@@ -46,23 +75,40 @@ const FrameResult& Pipeline::process(const RawRgbdFrame& raw, const StereoCalibr
 }
 
 const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registration_ms) {
-    FrameResult& r = result_;
-    r.times = StageTimes{};
-    r.times.registration = registration_ms;
     if (frame.width() <= 0 || frame.height() <= 0 || frame.depth.empty())
         throw InputError(frame.name + ": empty depth image");
+    const int n = params_.decimation;
+    if (n == 1) {
+        run_on(frame, result_);
+    } else {
+        auto t = Clock::now();
+        decimate_frame(frame, n, decimated_);
+        double ms = ms_since(t);
+        run_on(decimated_, decimated_result_);
+        t = Clock::now();
+        expand_result(frame);
+        ms += ms_since(t);
+        result_.times = decimated_result_.times;
+        result_.times.decimation = ms;
+    }
+    result_.times.registration = registration_ms;
+    return result_;
+}
 
+void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
+    const PipelineParams& params = stage_params_;
+    r.times = StageTimes{};
     auto t = Clock::now();
     const std::size_t valid = back_project(frame, cloud_);
     r.times.backprojection = ms_since(t);
     if (valid == 0) throw InputError(frame.name + ": depth has no valid pixel (all zero)");
 
     t = Clock::now();
-    estimate_normals(params_.normals, cloud_, normals_);
+    estimate_normals(params.normals, cloud_, normals_);
     r.times.normals = ms_since(t);
 
     t = Clock::now();
-    r.active_points = select_depth_range(params_.range, cloud_, r.active);
+    r.active_points = select_depth_range(params.range, cloud_, r.active);
     r.times.background = ms_since(t);
 
     t = Clock::now();
@@ -72,22 +118,22 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
     t = Clock::now();
     render_weight_colors(state_, r.labels, frame, r.colors);
     r.times.colors = ms_since(t);
-    if (!params_.detect_objects) {
+    if (!params.detect_objects) {
         r.plane = PlaneResult{};
         r.plane_classes.clear();
         r.segments = LabelImage{};
         r.segment_stats = SegmentStats{};
         r.objects = LabelImage{};
         r.object_list.clear();
-        return r;
+        return;
     }
 
     // Objects: the support plane goes (part of the paper's background step, done after the
     // clustering so that labels.png keeps the paper's clusters), the rest is segmented and
     // tracked.
     t = Clock::now();
-    if (params_.remove_plane) {
-        r.plane = remove_support_plane(params_.plane, frame.intrinsics, cloud_, normals_,
+    if (params.remove_plane) {
+        r.plane = remove_support_plane(params.plane, frame.intrinsics, cloud_, normals_,
                                        r.active, plane_ws_, r.plane_classes);
     } else {
         r.plane = PlaneResult{};
@@ -99,7 +145,7 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
     r.times.plane = ms_since(t);
 
     t = Clock::now();
-    r.segment_stats = segment_objects(params_.segmentation, cloud_, normals_, r.plane_classes,
+    r.segment_stats = segment_objects(params.segmentation, cloud_, normals_, r.plane_classes,
                                       r.plane.found ? &r.plane.support : nullptr, r.labels,
                                       segment_ws_, r.segments);
     r.times.segmentation = ms_since(t);
@@ -108,7 +154,126 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
     tracker_.step(cloud_, r.segments, r.segment_stats.segments, r.labels, r.objects,
                   r.object_list);
     r.times.objects = ms_since(t);
-    return r;
+}
+
+void Pipeline::expand_result(const RgbdFrame& frame) {
+    const FrameResult& s = decimated_result_;
+    FrameResult& r = result_;
+    const int W = frame.width(), H = frame.height();
+    // An input pixel takes a neighbouring block's results across a depth step no larger
+    // than the segmentation's own connection rule over the block's width.
+    const float n = static_cast<float>(params_.decimation);
+    const DecimatedSource source(frame.depth, decimated_.depth, params_.decimation,
+                                 n * params_.segmentation.depth_jump_m,
+                                 n * params_.segmentation.depth_jump_rel);
+    r.stats = s.stats;
+    r.plane = s.plane;
+    r.segment_stats = s.segment_stats;
+    r.object_list = s.object_list;
+    const bool objects = params_.detect_objects;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    for (LabelImage* img : {&r.labels, &r.segments, &r.objects}) {
+        img->width = W;
+        img->height = H;
+    }
+    r.labels.labels.resize(N);
+    r.colors.width = W;
+    r.colors.height = H;
+    r.colors.rgb.resize(3 * N);
+    r.active.resize(N);
+    r.plane_classes.resize(objects ? N : 0);
+    r.segments.labels.resize(objects ? N : 0);
+    r.objects.labels.resize(objects ? N : 0);
+    if (!objects) r.segments.width = r.segments.height = r.objects.width = r.objects.height = 0;
+
+    // Track id -> index in object_list, for each object's pixel count and 2D box.
+    int max_id = 0;
+    for (const DetectedObject& d : r.object_list) max_id = std::max(max_id, d.id);
+    object_index_.assign(static_cast<std::size_t>(max_id) + 1, -1);
+    for (std::size_t i = 0; i < r.object_list.size(); ++i)
+        object_index_[static_cast<std::size_t>(r.object_list[i].id)] = static_cast<int>(i);
+    const std::size_t n_obj = r.object_list.size();
+    band_boxes_.assign(kExpandBands * n_obj, PixelBox{W, H, -1, -1, 0});
+    band_active_.assign(kExpandBands, 0);
+
+    // One pass: every result of the pixel's source, or "no point" without one; the counts
+    // and boxes per fixed row band, reduced in band order below.
+    // Raw pointers: through the vectors, every byte store would make the compiler reload
+    // every data pointer.
+    const std::uint8_t* const frame_rgb = frame.color.rgb.size() == 3 * N ? frame.color.rgb.data() : nullptr;
+    const std::uint16_t *const in_labels = s.labels.labels.data(), *const in_segments = s.segments.labels.data(),
+                        *const in_objects = s.objects.labels.data();
+    const std::uint8_t *const in_rgb = s.colors.rgb.data(), *const in_active = s.active.data(),
+                       *const in_classes = s.plane_classes.data();
+    std::uint16_t *const labels = r.labels.labels.data(), *const segments = r.segments.labels.data(),
+                  *const objects_out = r.objects.labels.data();
+    std::uint8_t *const colors = r.colors.rgb.data(), *const active_out = r.active.data(),
+                 *const classes = r.plane_classes.data();
+    const int* const object_index = object_index_.data();
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kExpandBands; ++band) {
+        PixelBox* const boxes = band_boxes_.data() + static_cast<std::size_t>(band) * n_obj;
+        std::size_t active = 0;
+        for (int v = band * H / kExpandBands; v < (band + 1) * H / kExpandBands; ++v) {
+            const int bv = v / source.factor();
+            for (int u = 0, bu = 0, in_block = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                std::uint8_t* const rgb = colors + 3 * p;
+                const std::int32_t q = source.in_block(u, v, bu, bv);
+                if (++in_block == source.factor()) {
+                    in_block = 0;
+                    ++bu;
+                }
+                if (q < 0) {
+                    labels[p] = 0;
+                    rgb[0] = rgb[1] = rgb[2] = frame_rgb ? dimmed_grey(frame_rgb + 3 * p) : 0;
+                    active_out[p] = 0;
+                    if (!objects) continue;
+                    classes[p] = kPlaneRemoved;
+                    segments[p] = 0;
+                    objects_out[p] = 0;
+                    continue;
+                }
+                const auto sq = static_cast<std::size_t>(q);
+                labels[p] = in_labels[sq];
+                rgb[0] = in_rgb[3 * sq];
+                rgb[1] = in_rgb[3 * sq + 1];
+                rgb[2] = in_rgb[3 * sq + 2];
+                active += active_out[p] = in_active[sq];
+                if (!objects) continue;
+                classes[p] = in_classes[sq];
+                segments[p] = in_segments[sq];
+                const std::uint16_t id = objects_out[p] = in_objects[sq];
+                if (id == 0 || id > max_id || object_index[id] < 0) continue;
+                PixelBox& b = boxes[object_index[id]];
+                ++b.pixels;
+                b.u_min = std::min(b.u_min, u);
+                b.v_min = std::min(b.v_min, v);
+                b.u_max = std::max(b.u_max, u);
+                b.v_max = std::max(b.v_max, v);
+            }
+        }
+        band_active_[static_cast<std::size_t>(band)] = active;
+    }
+    r.active_points = 0;
+    for (std::size_t a : band_active_) r.active_points += a;
+    for (std::size_t i = 0; i < n_obj; ++i) {
+        DetectedObject& d = r.object_list[i];
+        PixelBox total{W, H, -1, -1, 0};
+        for (int band = 0; band < kExpandBands; ++band) {
+            const PixelBox& b = band_boxes_[static_cast<std::size_t>(band) * n_obj + i];
+            total.pixels += b.pixels;
+            total.u_min = std::min(total.u_min, b.u_min);
+            total.v_min = std::min(total.v_min, b.v_min);
+            total.u_max = std::max(total.u_max, b.u_max);
+            total.v_max = std::max(total.v_max, b.v_max);
+        }
+        d.pixels = total.pixels;
+        d.u_min = total.u_min;
+        d.v_min = total.v_min;
+        d.u_max = total.u_max;
+        d.v_max = total.v_max;
+    }
 }
 
 }  // namespace wul3d

@@ -68,10 +68,7 @@ void render_weight_colors(const ClusterState& state, const LabelImage& labels,
                 for (int q = 0; q < 3; ++q)
                     o[q] = static_cast<std::uint8_t>(std::min(255.0f, acc[q] + 0.5f));
             } else if (rgb) {
-                const float grey = 0.299f * rgb[3 * p] + 0.587f * rgb[3 * p + 1] +
-                                   0.114f * rgb[3 * p + 2];
-                const auto dim = static_cast<std::uint8_t>(grey * 0.35f);
-                o[0] = o[1] = o[2] = dim;
+                o[0] = o[1] = o[2] = dimmed_grey(rgb + 3 * p);
             } else {
                 o[0] = o[1] = o[2] = 0;
             }

@@ -328,6 +328,35 @@ TEST(CliRun, Ply_WritesBinaryLittleEndianCloudOfLabelledPoints) {
     EXPECT_EQ(ply.size() - header.size(), vertices * (3 * 4 + 3 + 2));
 }
 
+// --decimate 2: the stages run on a quarter of the pixels, every output at the input's size,
+// and --ply writes the input's own points (the frame is back-projected again for it).
+TEST(CliRun, Decimate_OutputsAtTheInputsSize) {
+    TempDir tmp;
+    const fs::path out = tmp / "out";
+    const CommandResult r = run_logged({"run", tabletop_frame().string(), "--out", out.string(),
+                                        "--decimate", "2", "--ply"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    ASSERT_EQ(frame_dirs(out).size(), 1u);
+    const fs::path frame = out / *frame_dirs(out).begin();
+    const auto input = wul3d::read_depth_png((tabletop_frame() / "depth.png").string(), 0.001f);
+    for (const char* name : {"labels.png", "objects.png"}) {
+        const auto l = wul3d::read_label_png((frame / name).string());
+        EXPECT_EQ(l.width, input.width) << name;
+        EXPECT_EQ(l.height, input.height) << name;
+    }
+    const auto objects = wul3d::read_label_png((frame / "objects.png").string());
+    EXPECT_GT(std::count_if(objects.labels.begin(), objects.labels.end(),
+                            [](std::uint16_t l) { return l != 0; }),
+              1000);
+    const std::string ply = read_text(frame / "cloud.ply");
+    const auto labels = wul3d::read_label_png((frame / "labels.png").string());
+    const auto labelled = labels.labels.size() - static_cast<std::size_t>(std::count(
+                                                     labels.labels.begin(), labels.labels.end(), 0));
+    EXPECT_NE(ply.find("element vertex " + std::to_string(labelled) + "\n"), std::string::npos);
+    const auto summary = nlohmann::json::parse(read_text(out / "summary.json"));
+    EXPECT_GT(summary["stage_ms_median"]["decimation"].get<double>(), 0.0);
+}
+
 // ---- bad input ---------------------------------------------------------------------------
 
 /// A folder with one writable copy of a sample frame, named `frame_name`, and an output path.
@@ -477,6 +506,14 @@ INSTANTIATE_TEST_SUITE_P(
         ParamCase{"GammaBelowRange", {"--gamma", "0.00001"}, "gamma"},
         ParamCase{"PsiZero", {"--psi", "0"}, "psi"},
         ParamCase{"PsiAboveOne", {"--psi", "1.5"}, "psi"}),
+    [](const ::testing::TestParamInfo<ParamCase>& case_info) {
+        return std::string(case_info.param.test_name);
+    });
+
+INSTANTIATE_TEST_SUITE_P(
+    Decimation, CliRunBadParam,
+    ::testing::Values(ParamCase{"DecimateZero", {"--decimate", "0"}, "decimate"},
+                      ParamCase{"DecimateNine", {"--decimate", "9"}, "decimate"}),
     [](const ::testing::TestParamInfo<ParamCase>& case_info) {
         return std::string(case_info.param.test_name);
     });

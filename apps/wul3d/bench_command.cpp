@@ -35,6 +35,7 @@ struct BenchOptions {
     std::string pipeline = "objects";  // objects: the default object pipeline; paper: its steps only
     std::string segmenter;             // empty: the default
     int threads = 0;                   // 0: all cores
+    int decimate = 1;                  // PipelineParams::decimation
     int single_k = 0;        // internal: measure this k in this process and print one row
 };
 
@@ -103,6 +104,7 @@ void measure_one(const BenchOptions& o) {
     params.cluster.k = o.single_k;
     params.detect_objects = o.pipeline == "objects";
     if (!o.segmenter.empty()) params.segmentation.segmenter = parse_segmenter(o.segmenter);
+    params.decimation = o.decimate;
     if (o.threads > 0) omp_set_num_threads(o.threads);
     Pipeline pipeline(params);
     pipeline.process(frames.front());  // seeding is a one-off: not timed
@@ -137,7 +139,8 @@ std::string run_child(const BenchOptions& o, int k) {
                                          "--resolution", o.resolution, "--frames",
                                          std::to_string(o.frames), "--passes",
                                          std::to_string(o.passes), "--pipeline", o.pipeline,
-                                         "--threads", std::to_string(o.threads)};
+                                         "--threads", std::to_string(o.threads),
+                                         "--decimate", std::to_string(o.decimate)};
         if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
@@ -225,6 +228,10 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--segmenter", opts->segmenter, "geometric|kmeans|hybrid (default: hybrid)");
     cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 1 << 16));
+    cmd->add_option("--decimate", opts->decimate,
+                    "Run the stages on every N-th pixel in u and v, results at the input's size")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 8));
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");
     cmd->callback([opts]() { run(*opts); });

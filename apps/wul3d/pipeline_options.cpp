@@ -61,6 +61,9 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
                     "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
     cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(1, 1 << 30));
+    cmd->add_option("--decimate", o.decimate,
+                    "N in [1, 8]: run the stages on every N-th pixel in u and v (N^2 times fewer "
+                    "points), results at the input's size (default 1)");
     cmd->add_option("--tum-camera", o.tum_camera,
                     "TUM intrinsics preset: kinect_v1|tum_fr1|tum_fr2|tum_fr3 (default: from folder name)");
     cmd->add_option("--intrinsics", o.intrinsics, "fx,fy,cx,cy: override every frame's intrinsics");
@@ -95,6 +98,7 @@ PipelineParams make_pipeline_params(const PipelineOptions& o) {
     if (o.no_plane) p.remove_plane = false;
     if (o.min_points) p.segmentation.min_points = *o.min_points;
     if (o.object_psi) p.objects.psi = *o.object_psi;
+    if (o.decimate) p.decimation = *o.decimate;
     p.validate();
     return p;
 }

@@ -29,7 +29,7 @@ struct PipelineOptions {
     bool no_plane = false;
     int threads = 0;  // 0 = all cores
     // Parameters given on the command line override the preset; kept apart so we know.
-    std::optional<int> k, iters, stride, normal_radius, min_points;
+    std::optional<int> k, iters, stride, normal_radius, min_points, decimate;
     std::optional<float> alpha, delta, gamma, psi, zmin, zmax, object_psi;
     std::optional<std::uint64_t> seed;
 };

@@ -116,7 +116,7 @@ std::string objects_json(const FrameResult& r, int selected_id) {
 /// Writes one frame's outputs into OUT/.<name>.partial, then renames it to OUT/<name>, so a
 /// frame folder is either complete or absent.
 void write_frame(const fs::path& out_dir, const std::string& name, const Pipeline& pipeline,
-                 const FrameResult& r, const std::vector<std::uint8_t>* selected,
+                 const RgbdFrame& frame, const FrameResult& r, const std::vector<std::uint8_t>* selected,
                  const std::vector<std::uint8_t>* selected_object, int selected_id, bool ply) {
     const fs::path final_dir = out_dir / name;
     const fs::path tmp_dir = out_dir / ("." + name + ".partial");
@@ -135,7 +135,13 @@ void write_frame(const fs::path& out_dir, const std::string& name, const Pipelin
         if (selected_object)
             write_mask_png((tmp_dir / "selected_object.png").string(), r.objects.width,
                            r.objects.height, *selected_object);
-        if (ply) write_ply((tmp_dir / "cloud.ply").string(), pipeline.cloud(), r.labels, r.colors);
+        if (ply && pipeline.cloud().size() == r.labels.labels.size()) {
+            write_ply((tmp_dir / "cloud.ply").string(), pipeline.cloud(), r.labels, r.colors);
+        } else if (ply) {  // --decimate: the results are at the input's size, the cloud is not
+            OrganizedCloud full;
+            back_project(frame, full);
+            write_ply((tmp_dir / "cloud.ply").string(), full, r.labels, r.colors);
+        }
         fs::remove_all(final_dir, ec);
         fs::rename(tmp_dir, final_dir);
     } catch (...) {
@@ -219,13 +225,14 @@ void run(const RunOptions& o) {
         }
 
         const auto t_out = Clock::now();
-        write_frame(out_dir, name, pipeline, r, selection ? &selected_mask : nullptr,
+        write_frame(out_dir, name, pipeline, frame, r, selection ? &selected_mask : nullptr,
                     selected_object ? &selected_object_mask : nullptr,
                     object_selected ? selected_object->label() : 0, o.ply);
         const double out_ms =
             std::chrono::duration<double, std::milli>(Clock::now() - t_out).count();
 
         stage_ms["registration"].push_back(r.times.registration);
+        stage_ms["decimation"].push_back(r.times.decimation);
         stage_ms["backprojection"].push_back(r.times.backprojection);
         stage_ms["normals"].push_back(r.times.normals);
         stage_ms["background"].push_back(r.times.background);

@@ -156,6 +156,7 @@ private:
     void apply_pending();
     void refresh_views();
     void rebuild_cloud();
+    const OrganizedCloud& result_cloud();
     void select_at(int u, int v);
     void handle_keys();
     void draw_controls(const Rect& area);
@@ -201,6 +202,7 @@ private:
     std::vector<float> xyz_;
     std::vector<std::uint8_t> rgb_;
     std::vector<std::int32_t> pixel_of_point_;
+    OrganizedCloud full_cloud_;  // the frame's own cloud under --decimate (result_cloud)
     int cloud_colour_mode_ = 0;  // 0 clusters (eq. 9), 1 the frame's colour
     bool show_inactive_ = true;
     float point_size_ = 2.0f;
@@ -246,7 +248,7 @@ void Viewer::process(std::size_t index) {
     if (played_ == 1) {
         // Where the scene is, for the orbit camera's first target.
         std::vector<float> z;
-        const OrganizedCloud& c = pipeline_->cloud();
+        const OrganizedCloud& c = result_cloud();
         for (std::size_t p = 0; p < c.z.size(); p += 7)
             if (result_->active[p]) z.push_back(c.z[p]);
         if (!z.empty()) {
@@ -300,8 +302,16 @@ void Viewer::refresh_views() {
     rebuild_cloud();
 }
 
-void Viewer::rebuild_cloud() {
+const OrganizedCloud& Viewer::result_cloud() {
+    // The cloud on the results' pixels: under --decimate the pipeline's is the smaller frame's.
     const OrganizedCloud& c = pipeline_->cloud();
+    if (c.size() == result_->labels.labels.size()) return c;
+    back_project(*frame_, full_cloud_);
+    return full_cloud_;
+}
+
+void Viewer::rebuild_cloud() {
+    const OrganizedCloud& c = result_cloud();
     const FrameResult& r = *result_;
     const bool selected = selection_ && mask_.size() == c.x.size();
     xyz_.clear();

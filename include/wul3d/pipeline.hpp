@@ -10,6 +10,7 @@
 #include "wul3d/background.hpp"
 #include "wul3d/backprojection.hpp"
 #include "wul3d/clustering.hpp"
+#include "wul3d/decimation.hpp"
 #include "wul3d/normals.hpp"
 #include "wul3d/objects.hpp"
 #include "wul3d/plane.hpp"
@@ -30,23 +31,33 @@ struct PipelineParams {
     PlaneParams plane;
     SegmentParams segmentation;
     ObjectParams objects;
+    /// 1: every pixel. N in [2, 8]: the stages run on the frame decimated N x N
+    /// (decimation.hpp) and the per-pixel results come back at the input's size. The
+    /// parameters above stay in the input's pixels; stage_params() scales them.
+    int decimation = 1;
 
     /// The paper's setting: ClusterParams::paper(), depth range 0.5-4.5 m (Kinect v2).
     static PipelineParams paper();
     void validate() const;
+    /// The parameters the stages run with: with decimation N, the pixel counts of objects
+    /// (min_points of segments and tracks, gap_max_px) divided by N^2 and the plane's grid, hull
+    /// margin and the merge and rim boundary lengths by N (rounded; 0 stays off). The
+    /// neighbourhood sizes stay as given, in decimated pixels (pipeline.cpp says why).
+    PipelineParams stage_params() const;
 };
 
 /// Milliseconds spent in each stage on one frame (0 for a stage that did not run).
 struct StageTimes {
-    double registration = 0, backprojection = 0, normals = 0, background = 0, clustering = 0,
-           colors = 0, plane = 0, segmentation = 0, objects = 0;
+    double registration = 0, decimation = 0, backprojection = 0, normals = 0, background = 0,
+           clustering = 0, colors = 0, plane = 0, segmentation = 0, objects = 0;
     double total() const {
-        return registration + backprojection + normals + background + clustering + colors +
-               plane + segmentation + objects;
+        return registration + decimation + backprojection + normals + background + clustering +
+               colors + plane + segmentation + objects;
     }
 };
 
-/// Everything one frame produced. Valid until the next process() call.
+/// Everything one frame produced, at the input frame's size (also with decimation). Valid
+/// until the next process() call.
 struct FrameResult {
     LabelImage labels;                  ///< 0 = no point, 1..k
     ColorImage colors;                  ///< eq. (9) display colours over the scene
@@ -74,6 +85,8 @@ public:
                                RegistrationMode mode);
 
     const PipelineParams& params() const { return params_; }
+    /// The cloud, normals and clusters the stages ran on: the decimated frame's with
+    /// decimation > 1 (its pixels are not FrameResult's then).
     const OrganizedCloud& cloud() const { return cloud_; }
     const NormalMap& normals() const { return normals_; }
     const ClusterState& state() const { return state_; }
@@ -82,8 +95,13 @@ public:
 
 private:
     const FrameResult& run_stages(const RgbdFrame& frame, double registration_ms);
+    /// Every stage from back-projection on, with stage_params_, into `r`.
+    void run_on(const RgbdFrame& frame, FrameResult& r);
+    /// `decimated_result_` carried back to `frame`'s pixels, into result_.
+    void expand_result(const RgbdFrame& frame);
 
     PipelineParams params_;
+    PipelineParams stage_params_;  ///< params_.stage_params()
     OrganizedCloud cloud_;
     NormalMap normals_;
     ClusterState state_;
@@ -92,6 +110,18 @@ private:
     SegmentWorkspace segment_ws_;
     RegistrationWorkspace registration_ws_;
     RgbdFrame registered_;
+    RgbdFrame decimated_;
+    FrameResult decimated_result_;
+    // expand_result's scratch: track id -> object_list index, and per row band the active
+    // pixels and each object's pixels and box.
+    struct PixelBox {
+        int u_min, v_min, u_max, v_max;
+        std::size_t pixels;
+    };
+    static constexpr int kExpandBands = 16;
+    std::vector<int> object_index_;
+    std::vector<std::size_t> band_active_;
+    std::vector<PixelBox> band_boxes_;
     FrameResult result_;
 };
 

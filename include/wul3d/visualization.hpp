@@ -19,4 +19,10 @@ std::array<std::uint8_t, 3> cluster_color(int j);
 void render_weight_colors(const ClusterState& state, const LabelImage& labels,
                           const RgbdFrame& frame, ColorImage& out);
 
+/// The dim grey shown for a pixel without a label, from its R, G, B.
+inline std::uint8_t dimmed_grey(const std::uint8_t* rgb) {
+    const float grey = 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2];
+    return static_cast<std::uint8_t>(grey * 0.35f);
+}
+
 }  // namespace wul3d

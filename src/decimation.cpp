@@ -1,0 +1,79 @@
+#include "wul3d/decimation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "param_check.hpp"
+#include "wul3d/error.hpp"
+
+namespace wul3d {
+
+void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out) {
+    detail::require_param(factor >= 1 && factor <= 8, "", "decimate", factor, "in [1, 8]");
+    const int W = in.width(), H = in.height();
+    const bool color = in.has_color();
+    if (color && (in.color.width != W || in.color.height != H))
+        throw InputError(in.name + ": colour and depth sizes differ");
+    const int w = (W + factor - 1) / factor, h = (H + factor - 1) / factor;
+    out.name = in.name;
+    out.intrinsics = in.intrinsics;
+    out.intrinsics.width = w;
+    out.intrinsics.height = h;
+    // Pixel (u, v) of `out` samples (N u, N v) of `in`: u_in = fx X / Z + cx = N u.
+    out.intrinsics.fx /= factor;
+    out.intrinsics.fy /= factor;
+    out.intrinsics.cx /= factor;
+    out.intrinsics.cy /= factor;
+    out.depth.width = w;
+    out.depth.height = h;
+    out.depth.scale_m_per_unit = in.depth.scale_m_per_unit;
+    out.depth.data.resize(static_cast<std::size_t>(w) * h);
+    out.color.width = color ? w : 0;
+    out.color.height = color ? h : 0;
+    out.color.rgb.resize(color ? static_cast<std::size_t>(w) * h * 3 : 0);
+    const std::uint16_t* const depth = in.depth.data.data();
+    const std::uint8_t* const rgb = color ? in.color.rgb.data() : nullptr;
+
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < h; ++v) {
+        for (int u = 0; u < w; ++u) {
+            // The block's first pixel with depth, row-major; the top-left one if none has.
+            std::size_t pick = static_cast<std::size_t>(v) * factor * W + static_cast<std::size_t>(u) * factor;
+            const int rows = std::min(factor, H - v * factor), cols = std::min(factor, W - u * factor);
+            bool found = false;
+            for (int dv = 0; dv < rows && !found; ++dv)
+                for (int du = 0; du < cols && !found; ++du) {
+                    const std::size_t q = static_cast<std::size_t>(v * factor + dv) * W + u * factor + du;
+                    if (depth[q] != 0) {
+                        pick = q;
+                        found = true;
+                    }
+                }
+            const std::size_t o = static_cast<std::size_t>(v) * w + u;
+            out.depth.data[o] = depth[pick];
+            if (rgb)
+                for (int c = 0; c < 3; ++c) out.color.rgb[3 * o + c] = rgb[3 * pick + c];
+        }
+    }
+}
+
+DecimatedSource::DecimatedSource(const DepthImage& input, const DepthImage& decimated,
+                                 int factor, float same_m, float same_rel)
+    : full_(input.data.data()),
+      small_(decimated.data.data()),
+      W_(input.width),
+      w_(decimated.width),
+      h_(decimated.height),
+      factor_(factor),
+      // Depths compared in the images' units: metres = units * scale.
+      same_(same_m / input.scale_m_per_unit),
+      same_rel_(same_rel * input.scale_m_per_unit) {
+    if (factor < 1 || w_ != (W_ + factor - 1) / factor ||
+        h_ != (input.height + factor - 1) / factor ||
+        decimated.data.size() != static_cast<std::size_t>(w_) * h_ ||
+        input.data.size() != static_cast<std::size_t>(W_) * input.height)
+        throw InputError("decimation: the decimated depth does not match the input's size");
+}
+
+}  // namespace wul3d

@@ -1,0 +1,265 @@
+#include "wul3d/decimation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <array>
+#include <map>
+#include <set>
+
+#include "synthetic_scene.hpp"
+#include "test_support.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+#include "wul3d/pipeline.hpp"
+
+using namespace wul3d;
+using namespace wul3d::test;
+
+namespace {
+// A 5 x 3 frame (odd sizes: the last block column is partial), depth = 100 + p and colour
+// (p, 2p, 3p) at pixel p, with holes where `holes` says.
+RgbdFrame small_frame(const std::vector<int>& holes) {
+    RgbdFrame f;
+    f.name = "small";
+    f.intrinsics = PinholeIntrinsics{5, 3, 500.0, 400.0, 2.0, 1.0};
+    f.depth.width = 5;
+    f.depth.height = 3;
+    f.color.width = 5;
+    f.color.height = 3;
+    for (int p = 0; p < 15; ++p) {
+        f.depth.data.push_back(static_cast<std::uint16_t>(100 + p));
+        for (int c = 1; c <= 3; ++c) f.color.rgb.push_back(static_cast<std::uint8_t>(c * p));
+    }
+    for (int p : holes) f.depth.data[static_cast<std::size_t>(p)] = 0;
+    return f;
+}
+}  // namespace
+
+TEST(DecimateFrame, EachBlockTakesItsFirstPixelWithDepthAndThatPixelsColour) {
+    // Blocks of 2 x 2 over 5 x 3: (0,1,5,6) (2,3,7,8) (4,9) / (10,11) (12,13) (14).
+    const RgbdFrame f = small_frame({0, 2, 3, 7, 12, 13});
+    RgbdFrame d;
+    decimate_frame(f, 2, d);
+    ASSERT_EQ(d.width(), 3);
+    ASSERT_EQ(d.height(), 2);
+    ASSERT_EQ(d.color.width, 3);
+    // Block 0: pixel 0 has no depth, 1 has; block 1: 2, 3, 7 none, 8 has; block 4: none.
+    const std::vector<int> picked = {1, 8, 4, 10, -1, 14};
+    for (std::size_t o = 0; o < picked.size(); ++o) {
+        SCOPED_TRACE(o);
+        if (picked[o] < 0) {
+            EXPECT_EQ(d.depth.data[o], 0);
+            EXPECT_EQ(d.color.rgb[3 * o], 12);  // the top-left pixel's colour
+            continue;
+        }
+        EXPECT_EQ(d.depth.data[o], 100 + picked[o]);
+        EXPECT_EQ(d.color.rgb[3 * o + 1], 2 * picked[o]);
+    }
+    // Intrinsics of the top-left samples: u_in = N u.
+    EXPECT_DOUBLE_EQ(d.intrinsics.fx, 250.0);
+    EXPECT_DOUBLE_EQ(d.intrinsics.fy, 200.0);
+    EXPECT_DOUBLE_EQ(d.intrinsics.cx, 1.0);
+    EXPECT_DOUBLE_EQ(d.intrinsics.cy, 0.5);
+    EXPECT_EQ(d.intrinsics.width, 3);
+    EXPECT_EQ(d.depth.scale_m_per_unit, f.depth.scale_m_per_unit);
+
+    RgbdFrame same;
+    decimate_frame(f, 1, same);
+    EXPECT_EQ(same.depth.data, f.depth.data);
+    EXPECT_EQ(same.color.rgb, f.color.rgb);
+}
+
+TEST(DecimateFrame, RejectsBadFactorsAndMismatchedColour) {
+    RgbdFrame f = small_frame({}), d;
+    EXPECT_THROW(decimate_frame(f, 0, d), ParamError);
+    EXPECT_THROW(decimate_frame(f, 9, d), ParamError);
+    f.color.width = 4;
+    EXPECT_THROW(decimate_frame(f, 2, d), InputError);
+    f.color = ColorImage{};  // depth-only frames decimate too
+    decimate_frame(f, 2, d);
+    EXPECT_FALSE(d.has_color());
+    EXPECT_EQ(d.depth.data.size(), 6u);
+}
+
+TEST(DecimatedSource, OwnBlockOnTheSameSurfaceElseTheNearestNeighbourInDepth) {
+    // Input 4 x 2 (two blocks): a near surface (1000 mm) on the left, far (2000) on the right,
+    // with pixel (2, 0) near although its block was sampled far.
+    DepthImage in;
+    in.width = 4;
+    in.height = 2;
+    in.data = {1000, 1001, 1002, 2000, 1000, 0, 2000, 2001};
+    DepthImage small;
+    small.width = 2;
+    small.height = 1;
+    small.data = {1000, 2000};  // block 1's first pixel with depth would be 1002: made far here
+    const DecimatedSource source(in, small, 2, 0.004f, 0.0f);
+    EXPECT_EQ(source(0, 0), 0);
+    EXPECT_EQ(source(1, 0), 0);   // 1 mm off: the same surface
+    EXPECT_EQ(source(2, 0), 0);   // near pixel in the far block: the near neighbour
+    EXPECT_EQ(source(3, 0), 1);
+    EXPECT_EQ(source(1, 1), -1);  // no depth
+    EXPECT_EQ(source(3, 1), 1);
+    EXPECT_EQ(source.in_block(2, 0, 1, 0), source(2, 0));
+    // No neighbouring block with depth: none.
+    small.data = {0, 0};
+    EXPECT_EQ(DecimatedSource(in, small, 2, 0.004f, 0.0f)(0, 0), -1);
+    // A decimated image of the wrong size is an input error.
+    small.width = 3;
+    small.data = {1, 2, 3};
+    EXPECT_THROW(DecimatedSource(in, small, 2, 0.004f, 0.0f), InputError);
+}
+
+TEST(PipelineParams, DecimationScalesObjectSizesNotNeighbourhoods) {
+    PipelineParams p;
+    p.decimation = 2;
+    const PipelineParams s = p.stage_params();
+    EXPECT_EQ(s.segmentation.min_points, 75);
+    EXPECT_EQ(s.segmentation.gap_max_px, 125);
+    EXPECT_EQ(s.segmentation.merge_min_boundary, 3);
+    EXPECT_EQ(s.segmentation.rim_min_boundary, 5);
+    EXPECT_EQ(s.objects.min_points, 25);
+    EXPECT_EQ(s.plane.grid_stride_px, 2);
+    EXPECT_EQ(s.plane.hull_margin_px, 6);
+    EXPECT_EQ(s.normals.radius_px, p.normals.radius_px);
+    EXPECT_EQ(s.segmentation.crease_step_px, p.segmentation.crease_step_px);
+    EXPECT_EQ(s.segmentation.reattach_px, p.segmentation.reattach_px);
+    EXPECT_EQ(s.segmentation.min_seed_points, p.segmentation.min_seed_points);
+    p.segmentation.gap_max_px = 0;  // off stays off
+    EXPECT_EQ(p.stage_params().segmentation.gap_max_px, 0);
+    p.decimation = 1;
+    EXPECT_EQ(p.stage_params().segmentation.min_points, p.segmentation.min_points);
+    p.decimation = 9;
+    EXPECT_THROW(p.validate(), ParamError);
+}
+
+namespace {
+// Pixels of each object id, and whether each object's 2D box is the tight box of its pixels.
+void expect_object_list_matches_image(const FrameResult& r) {
+    std::map<int, std::size_t> count;
+    std::map<int, std::array<int, 4>> box;
+    for (int v = 0; v < r.objects.height; ++v)
+        for (int u = 0; u < r.objects.width; ++u) {
+            const int id = r.objects.labels[static_cast<std::size_t>(v) * r.objects.width + u];
+            if (id == 0) continue;
+            if (!count[id]++) box[id] = {u, v, u, v};
+            auto& b = box[id];
+            b = {std::min(b[0], u), std::min(b[1], v), std::max(b[2], u), std::max(b[3], v)};
+        }
+    ASSERT_EQ(count.size(), r.object_list.size());
+    for (const DetectedObject& d : r.object_list) {
+        SCOPED_TRACE(d.id);
+        EXPECT_EQ(d.pixels, count[d.id]);
+        EXPECT_EQ((std::array<int, 4>{d.u_min, d.v_min, d.u_max, d.v_max}), box[d.id]);
+    }
+}
+}  // namespace
+
+// A scene whose answer is known, at 640 x 480: with --decimate 2 every result comes back at
+// the input's size, each box is one object, and objects.json's counts and boxes are those of
+// objects.png.
+TEST(Pipeline, Decimated_BoxesFoundAtTheInputsSize) {
+    Scene s = pitched_tabletop_scene();
+    s.width = 640;
+    s.height = 480;
+    s.noise_seed = 3;
+    SceneBox red, blue, green;
+    red.x = -0.3f;
+    red.z = 0.9f;
+    blue.x = 0.25f;
+    blue.z = 1.2f;
+    blue.r = 30; blue.g = 60; blue.b = 220;
+    green.x = -0.05f;
+    green.z = 1.4f;
+    green.w = 0.08f;
+    green.r = 40; green.g = 200; green.b = 60;
+    s.boxes = {red, blue, green};
+    std::vector<int> truth;
+    const RgbdFrame f = render_scene(s, &truth);
+    for (int n : {1, 2, 4}) {
+        SCOPED_TRACE(n);
+        PipelineParams p;
+        p.decimation = n;
+        Pipeline pipeline(p);
+        const FrameResult& r = pipeline.process(f);
+        ASSERT_EQ(r.objects.width, 640);
+        ASSERT_EQ(r.objects.height, 480);
+        ASSERT_EQ(r.labels.labels.size(), truth.size());
+        ASSERT_EQ(r.colors.rgb.size(), 3 * truth.size());
+        ASSERT_EQ(r.plane_classes.size(), truth.size());
+        EXPECT_EQ(pipeline.cloud().width, (640 + n - 1) / n);
+        if (n == 1) {
+            EXPECT_EQ(r.times.decimation, 0.0);
+        } else {
+            EXPECT_GT(r.times.decimation, 0.0);
+        }
+        EXPECT_TRUE(r.plane.found);
+        EXPECT_EQ(r.object_list.size(), 3u);
+        std::set<int> ids;
+        for (int b = 0; b < 3; ++b) {
+            int id = 0;
+            // Edge pixels of a box may take the table's block: a pixel's worth at N = 4.
+            EXPECT_GE(dominant_share(r.objects.labels, truth, kTruthBox0 + b, &id), n < 4 ? 0.95 : 0.9) << b;
+            EXPECT_NE(id, 0);
+            ids.insert(id);
+        }
+        EXPECT_EQ(ids.size(), 3u);
+        // Pixels without depth have no result.
+        for (std::size_t q = 0; q < truth.size(); ++q) {
+            if (f.depth.data[q] != 0) continue;
+            ASSERT_EQ(r.labels.labels[q] | r.objects.labels[q], 0);
+        }
+        expect_object_list_matches_image(r);
+    }
+}
+
+// Real shipped frames: with --decimate 2 the support is the same plane as at full resolution,
+// and most objects of the full-resolution run larger than 3000 px are found again, overlapping
+// by at least 75 % (intersection over union). Known divergence: in image_0005 the decimated
+// run takes a part of the floor under the table as the support (the support score is close
+// there: points standing on the floor's part include the table top), so that frame is only
+// checked for its shapes.
+TEST(Pipeline, Decimated_RealTabletopObjectsMatchFullResolution) {
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    PipelineParams full_params, half_params;
+    half_params.decimation = 2;
+    Pipeline full(full_params), half(half_params);
+    SourceItem item;
+    int compared = 0, matched = 0;
+    for (std::size_t i = 0; i < source->size(); ++i) {
+        source->read(i, item);
+        SCOPED_TRACE(item.frame.name);
+        const FrameResult& a = full.process(item.frame);
+        const std::vector<std::uint16_t> full_objects = a.objects.labels;
+        const std::vector<DetectedObject> full_list = a.object_list;
+        const Plane full_support = a.plane.support;
+        const FrameResult& b = half.process(item.frame);
+        expect_object_list_matches_image(b);
+        ASSERT_TRUE(b.plane.found);
+        if (item.frame.name == "image_0005") continue;
+        const Plane& s = b.plane.support;
+        EXPECT_GT(s.nx * full_support.nx + s.ny * full_support.ny + s.nz * full_support.nz,
+                  std::cos(2.0 * 3.14159265 / 180));
+        EXPECT_NEAR(s.d, full_support.d, 0.01);
+        for (const DetectedObject& d : full_list) {
+            if (d.pixels < 3000) continue;
+            std::map<int, std::size_t> overlap;
+            for (std::size_t p = 0; p < full_objects.size(); ++p)
+                if (full_objects[p] == d.id && b.objects.labels[p] != 0) ++overlap[b.objects.labels[p]];
+            double best = 0;
+            for (const auto& [id, inter] : overlap) {
+                const auto it = std::find_if(b.object_list.begin(), b.object_list.end(),
+                                             [id = id](const DetectedObject& o) { return o.id == id; });
+                ASSERT_NE(it, b.object_list.end());
+                best = std::max(best, static_cast<double>(inter) /
+                                          static_cast<double>(d.pixels + it->pixels - inter));
+            }
+            ++compared;
+            matched += best >= 0.75;
+        }
+    }
+    // 15 of 17 when written: the box at the back of image_0002 is lost in the decimated run.
+    EXPECT_GE(compared, 15);
+    EXPECT_GE(matched, compared * 85 / 100) << matched << " of " << compared;
+}
