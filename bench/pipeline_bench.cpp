@@ -6,13 +6,33 @@
 
 using namespace wul3d;
 
+// decimate: PipelineParams::decimation (1 = every pixel). The times of each stage are the
+// counters, averaged over the iterations (StageTimes).
 static void BM_Pipeline(benchmark::State& state) {
     PipelineParams params;
     params.cluster.k = static_cast<int>(state.range(0));
+    params.decimation = static_cast<int>(state.range(1));
     Pipeline pipeline(params);
     const RgbdFrame& f = bench::tabletop_frame();
     pipeline.process(f);
-    for (auto _ : state) benchmark::DoNotOptimize(pipeline.process(f).stats.points);
+    StageTimes sum;
+    for (auto _ : state) {
+        const StageTimes& t = pipeline.process(f).times;
+        sum.decimation += t.decimation;
+        sum.plane += t.plane;
+        sum.segmentation += t.segmentation;
+        sum.objects += t.objects;
+    }
+    using benchmark::Counter;
+    state.counters["decimation_ms"] = Counter(sum.decimation, Counter::kAvgIterations);
+    state.counters["plane_ms"] = Counter(sum.plane, Counter::kAvgIterations);
+    state.counters["segmentation_ms"] = Counter(sum.segmentation, Counter::kAvgIterations);
+    state.counters["objects_ms"] = Counter(sum.objects, Counter::kAvgIterations);
 }
-BENCHMARK(BM_Pipeline)->ArgName("k")->Arg(7)->Arg(10)->Unit(benchmark::kMillisecond)
+BENCHMARK(BM_Pipeline)
+    ->ArgNames({"k", "decimate"})
+    ->Args({7, 1})
+    ->Args({10, 1})
+    ->Args({10, 2})
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -5,9 +5,11 @@ Usage: scripts/plot-bench.py OUT.png CSV [CSV ...]   (needs Debian's python3-mat
 
 Each CSV (k,width,height,points,fps_median,ms_median,peak_rss_mb) is one line per panel,
 labelled by its resolution and, from its file name, the pipeline: a name containing "paper"
-is `wul3d bench --pipeline paper` (the paper's steps alone), any other the object pipeline.
+is `wul3d bench --pipeline paper` (the paper's steps alone), any other the object pipeline;
+"decimateN" in the name adds `--decimate N`.
 """
 import csv
+import re
 import sys
 
 try:
@@ -29,7 +31,11 @@ def main():
         if not rows:
             sys.exit(f"plot-bench.py: {path} has no rows")
         k = [int(r["k"]) for r in rows]
-        pipeline = "paper's steps" if "paper" in path.rsplit("/", 1)[-1] else "objects"
+        name = path.rsplit("/", 1)[-1]
+        pipeline = "paper's steps" if "paper" in name else "objects"
+        decimate = re.search(r"decimate(\d+)", name)
+        if decimate:
+            pipeline += f", --decimate {decimate[1]}"
         label = f"{rows[0]['width']}x{rows[0]['height']}, {pipeline}"
         ax_fps.plot(k, [float(r["fps_median"]) for r in rows], "o-", label=label)
         ax_mem.plot(k, [float(r["peak_rss_mb"]) for r in rows], "o-", label=label)
