@@ -1,8 +1,6 @@
 #include "wul3d/decimation.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
