@@ -415,14 +415,25 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     };
 
     // 4. The support: among planes that face up, the one that carries most: score = points
-    //    standing on it (at most its extent) + 0.1 x its extent.
+    //    standing on it (at most its extent) + 0.1 x its extent. A candidate scores at most
+    //    1.1 x its extent, so once one scores more, smaller candidates are not counted (each
+    //    count builds a hull and passes over the grid). Largest first; ties go to the lower
+    //    index, as in index order.
     double best_score = -1;
     int best = -1, hull_of = -1;  // hull_of: the candidate whose extent ws.hull holds
-    for (std::size_t c = 0; c < result.candidates.size(); ++c) {
-        Plane& pl = result.candidates[c];
+    ws.by_extent.resize(result.candidates.size());
+    std::iota(ws.by_extent.begin(), ws.by_extent.end(), 0);
+    std::stable_sort(ws.by_extent.begin(), ws.by_extent.end(), [&](int a, int b) {
+        return result.candidates[static_cast<std::size_t>(a)].inliers >
+               result.candidates[static_cast<std::size_t>(b)].inliers;
+    });
+    for (const int c : ws.by_extent) {
+        Plane& pl = result.candidates[static_cast<std::size_t>(c)];
         if (pl.up < params.min_up) continue;
+        const double extent = static_cast<double>(pl.inliers);
+        if (extent + 0.1 * extent < best_score) break;  // the score's largest value, as computed
         build_hull(pl);
-        hull_of = static_cast<int>(c);
+        hull_of = c;
         const HullMask hull = hull_of_plane(pl);
         std::size_t above = 0;
         for (std::size_t p = 0; p < static_cast<std::size_t>(G); ++p) {
@@ -437,9 +448,9 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         // uncropped scene is often larger than the table, but little stands on it).
         const double score = static_cast<double>(std::min(above, pl.inliers)) +
                              0.1 * static_cast<double>(pl.inliers);
-        if (score > best_score) {
+        if (score > best_score || (score == best_score && c < best)) {
             best_score = score;
-            best = static_cast<int>(c);
+            best = c;
         }
     }
 

@@ -51,7 +51,8 @@ struct PlaneParams {
 struct Plane {
     float nx = 0, ny = 0, nz = 0, d = 0;  ///< n . X + d = 0, |n| = 1, n towards the camera
     std::size_t inliers = 0;  ///< grid points on it (distance and normal agree)
-    std::size_t above = 0;    ///< grid points standing on it (0 < height <= max, foot on it)
+    std::size_t above = 0;    ///< grid points standing on it (0 < height <= max, foot on it);
+                              ///< 0 if not counted (a candidate that could not be the support)
     float up = 0;             ///< -n_y
     float height(float x, float y, float z) const { return nx * x + ny * y + nz * z + d; }
 };
@@ -83,6 +84,7 @@ struct PlaneWorkspace {
     std::vector<double> sums;         ///< per region: count, sum x, y, z, xx, xy, xz, yy, yz, zz
     std::vector<std::uint8_t> hull;   ///< grid-resolution mask of the support's extent
     std::vector<int> hull_points;     ///< (gu, gv) pairs: each grid row's outermost inliers
+    std::vector<int> by_extent;       ///< candidate indices, largest extent first
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
     struct Run {
