@@ -1,6 +1,8 @@
 #include "wul3d/decimation.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
@@ -72,6 +74,62 @@ DecimatedSource::DecimatedSource(const DepthImage& input, const DepthImage& deci
         decimated.data.size() != static_cast<std::size_t>(w_) * h_ ||
         input.data.size() != static_cast<std::size_t>(W_) * input.height)
         throw InputError("decimation: the decimated depth does not match the input's size");
+}
+
+void DecimatedSource::use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
+                                          const std::uint8_t* edge_blocks) {
+    if (input.empty() || decimated.empty()) return;  // depth only: depth decides alone
+    if (input.rgb.size() != 3 * static_cast<std::size_t>(W_) * (input.height) ||
+        input.width != W_ || decimated.width != w_ || decimated.height != h_)
+        throw InputError("decimation: colour and depth sizes differ");
+    rgb_ = input.rgb.data();
+    small_rgb_ = decimated.rgb.data();
+    edges_ = edge_blocks;
+}
+
+std::int32_t DecimatedSource::search(int u, int v, int bu, int bv, float z, bool on_own) const {
+    const int v0 = std::max(0, bv - 1), v1 = std::min(h_ - 1, bv + 1);
+    const int u0 = std::max(0, bu - 1), u1 = std::min(w_ - 1, bu + 1);
+    const std::int32_t own = bv * w_ + bu;
+    if (edges_ && edges_[own]) {
+        // Its own block and the three beside the quarter it lies in, on its surface: the
+        // nearest in colour, its own first.
+        const std::uint8_t* const c = rgb_ + 3 * (static_cast<std::size_t>(v) * W_ + u);
+        auto colour_distance = [&](std::int32_t q) {
+            const std::uint8_t* const s = small_rgb_ + 3 * static_cast<std::size_t>(q);
+            const int dr = c[0] - s[0], dg = c[1] - s[1], db = c[2] - s[2];
+            return dr * dr + dg * dg + db * db;
+        };
+        const int nu = 2 * (u - bu * factor_) < factor_ ? bu - 1 : bu + 1;
+        const int nv = 2 * (v - bv * factor_) < factor_ ? bv - 1 : bv + 1;
+        const bool u_in = nu >= 0 && nu < w_, v_in = nv >= 0 && nv < h_;
+        const std::int32_t beside[3] = {u_in ? bv * w_ + nu : -1, v_in ? nv * w_ + bu : -1,
+                                        u_in && v_in ? nv * w_ + nu : -1};
+        std::int32_t best = on_own ? own : -1;
+        int best_d = on_own ? colour_distance(own) : std::numeric_limits<int>::max();
+        for (const std::int32_t q : beside) {
+            if (q < 0 || !same_surface(q, z)) continue;
+            const int d = colour_distance(q);
+            if (d < best_d) {
+                best_d = d;
+                best = q;
+            }
+        }
+        if (best >= 0) return best;
+    }
+    std::int32_t best = -1;  // no block on its surface: the nearest in depth
+    float best_dz = std::numeric_limits<float>::infinity();
+    for (int nv = v0; nv <= v1; ++nv)
+        for (int nu = u0; nu <= u1; ++nu) {
+            const std::int32_t q = nv * w_ + nu;
+            if (small_[q] == 0) continue;
+            const float dz = std::fabs(small_[q] - z);
+            if (dz < best_dz) {
+                best_dz = dz;
+                best = q;
+            }
+        }
+    return best;
 }
 
 }  // namespace wul3d

@@ -163,9 +163,43 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
     // An input pixel takes a neighbouring block's results across a depth step no larger
     // than the segmentation's own connection rule over the block's width.
     const float n = static_cast<float>(params_.decimation);
-    const DecimatedSource source(frame.depth, decimated_.depth, params_.decimation,
-                                 n * params_.segmentation.depth_jump_m,
-                                 n * params_.segmentation.depth_jump_rel);
+    DecimatedSource source(frame.depth, decimated_.depth, params_.decimation,
+                           n * params_.segmentation.depth_jump_m,
+                           n * params_.segmentation.depth_jump_rel);
+    // Edge blocks: an object (or, without the object stages, a cluster) other than the
+    // block's own in its 3 x 3 neighbourhood. There the input's colour places the outline.
+    const LabelImage& outline = params_.detect_objects ? s.objects : s.labels;
+    const int w = outline.width, h = outline.height;
+    const std::size_t n_small = outline.labels.size();
+    // Separable: each pixel's row-wise minimum and maximum over three, then column-wise;
+    // an edge where the 3 x 3 minimum and maximum differ (plain loops that vectorize).
+    edge_blocks_.resize(n_small);
+    edge_lo_.resize(n_small);
+    edge_hi_.resize(n_small);
+    const std::uint16_t* const l = outline.labels.data();
+    std::uint16_t *const lo = edge_lo_.data(), *const hi = edge_hi_.data();
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < h; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * w;
+        for (int u = 0; u < w; ++u) {
+            const std::uint16_t a = l[row + std::max(u - 1, 0)], b = l[row + u],
+                                c = l[row + std::min(u + 1, w - 1)];
+            lo[row + u] = std::min({a, b, c});
+            hi[row + u] = std::max({a, b, c});
+        }
+    }
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < h; ++v) {
+        const std::size_t up = static_cast<std::size_t>(std::max(v - 1, 0)) * w,
+                          row = static_cast<std::size_t>(v) * w,
+                          down = static_cast<std::size_t>(std::min(v + 1, h - 1)) * w;
+        for (int u = 0; u < w; ++u) {
+            const std::uint16_t mn = std::min({lo[up + u], lo[row + u], lo[down + u]}),
+                                mx = std::max({hi[up + u], hi[row + u], hi[down + u]});
+            edge_blocks_[row + u] = mn != mx;
+        }
+    }
+    source.use_colour_at_edges(frame.color, decimated_.color, edge_blocks_.data());
     r.stats = s.stats;
     r.plane = s.plane;
     r.segment_stats = s.segment_stats;

@@ -111,6 +111,53 @@ TEST(DecimatedSource, OwnBlockOnTheSameSurfaceElseTheNearestNeighbourInDepth) {
     EXPECT_THROW(DecimatedSource(in, small, 2, 0.004f, 0.0f), InputError);
 }
 
+TEST(DecimatedSource, AtEdgeBlocksTheColourPlacesTheOutline) {
+    // One flat surface, 4 x 2 input: red at u = 0, blue at u = 1..3. Block 0 was sampled red
+    // at (0, 0), block 1 blue at (2, 0); pixel (1, 0) is blue but lies in block 0.
+    DepthImage in;
+    in.width = 4;
+    in.height = 2;
+    in.data = {1000, 1000, 1000, 1000, 1000, 1000, 1000, 1000};
+    ColorImage rgb;
+    rgb.width = 4;
+    rgb.height = 2;
+    for (int p = 0; p < 8; ++p) {
+        const bool red = p % 4 == 0;
+        rgb.rgb.insert(rgb.rgb.end(), {std::uint8_t(red ? 200 : 10), 10, std::uint8_t(red ? 10 : 200)});
+    }
+    RgbdFrame f;
+    f.depth = in;
+    f.color = rgb;
+    f.intrinsics = PinholeIntrinsics{4, 2, 100.0, 100.0, 2.0, 1.0};
+    RgbdFrame small;
+    decimate_frame(f, 2, small);
+    DecimatedSource source(in, small.depth, 2, 0.004f, 0.0f);
+    EXPECT_EQ(source(1, 0), 0);  // depth alone: its own block
+    const std::vector<std::uint8_t> edges = {1, 1}, no_edges = {0, 0};
+    source.use_colour_at_edges(rgb, small.color, edges.data());
+    EXPECT_EQ(source(1, 0), 1);  // the blue block beside it
+    EXPECT_EQ(source(0, 0), 0);
+    EXPECT_EQ(source(3, 1), 1);
+    source.use_colour_at_edges(rgb, small.color, no_edges.data());
+    EXPECT_EQ(source(1, 0), 0);  // not an edge block: its own
+    // The colour never overrides the surface: the blue block 6 cm farther is not taken.
+    DepthImage stepped = in;
+    stepped.data = {1000, 1000, 1060, 1060, 1000, 1000, 1060, 1060};
+    RgbdFrame g = f;
+    g.depth = stepped;
+    decimate_frame(g, 2, small);
+    DecimatedSource on_surface(stepped, small.depth, 2, 0.004f, 0.0f);
+    on_surface.use_colour_at_edges(rgb, small.color, edges.data());
+    EXPECT_EQ(on_surface(1, 0), 0);
+    // Colour of another size: an input error; no colour: depth decides alone.
+    ColorImage wrong = rgb;
+    wrong.width = 3;
+    EXPECT_THROW(on_surface.use_colour_at_edges(wrong, small.color, edges.data()), InputError);
+    DecimatedSource depth_only(in, small.depth, 2, 0.004f, 0.0f);
+    depth_only.use_colour_at_edges(ColorImage{}, ColorImage{}, edges.data());
+    EXPECT_EQ(depth_only(1, 0), 0);
+}
+
 TEST(PipelineParams, DecimationScalesObjectSizesNotNeighbourhoods) {
     PipelineParams p;
     p.decimation = 2;

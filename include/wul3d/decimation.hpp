@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 
 #include "wul3d/frame.hpp"
 
@@ -25,15 +24,25 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out);
 
 /// Which pixel of the decimated frame an input pixel takes its results from (the pipeline
 /// copies every per-pixel result through it: Pipeline::expand_result). An input pixel
-/// without depth has none (-1). One with depth z takes its own block when that block's depth
-/// is within same_m + same_rel z^2 (metres) of z, else the one of the 3 x 3 neighbouring
-/// blocks whose depth is nearest to z (an edge pixel whose block was sampled on the other
-/// surface), else none when none of them has depth.
+/// without depth has none (-1). One with depth z is on the surface of a block whose depth is
+/// within same_m + same_rel z^2 (metres) of z. It takes its own block when on its surface,
+/// else the one of the 3 x 3 neighbouring blocks nearest to z in depth (an edge pixel whose
+/// block was sampled on the other surface), else none when none of them has depth. With
+/// use_colour_at_edges, a pixel of an edge block takes, among its own block and the three
+/// beside the block's quarter it lies in (left or right, above or below, and the corner
+/// between) that are on its surface, the one nearest in colour (its own on a tie): an
+/// outline between two objects at one depth, or an object and the table under it, then
+/// follows the input's colour edge instead of the blocks' staircase.
 class DecimatedSource {
 public:
     /// Throws InputError unless `decimated` is `input` decimated by `factor` in size.
     DecimatedSource(const DepthImage& input, const DepthImage& decimated, int factor,
                     float same_m, float same_rel);
+    /// `edge_blocks`: one flag per decimated pixel (results differ from a neighbour's). The
+    /// three stay owned by the caller. Ignored for frames without colour. Throws InputError
+    /// for colour images of other sizes than the depths'.
+    void use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
+                             const std::uint8_t* edge_blocks);
 
     int factor() const { return factor_; }
     /// The decimated pixel (v' w + u') for input pixel (u, v), or -1.
@@ -41,30 +50,29 @@ public:
     /// The same, for loops that step the block (bu, bv) = (u / factor, v / factor) themselves
     /// (a division per pixel costs more than the rest of the test).
     std::int32_t in_block(int u, int v, int bu, int bv) const {
-        const float z = full_[static_cast<std::size_t>(v) * W_ + u];
+        const std::size_t p = static_cast<std::size_t>(v) * W_ + u;
+        const float z = full_[p];
         if (z == 0) return -1;
         const std::int32_t own = bv * w_ + bu;
-        if (small_[own] != 0 && std::fabs(small_[own] - z) <= same_ + same_rel_ * z * z) return own;
-        std::int32_t best = -1;
-        float best_dz = std::numeric_limits<float>::infinity();
-        for (int nv = std::max(0, bv - 1); nv <= std::min(h_ - 1, bv + 1); ++nv)
-            for (int nu = std::max(0, bu - 1); nu <= std::min(w_ - 1, bu + 1); ++nu) {
-                const std::int32_t q = nv * w_ + nu;
-                if (small_[q] == 0) continue;
-                const float dz = std::fabs(small_[q] - z);
-                if (dz < best_dz) {
-                    best_dz = dz;
-                    best = q;
-                }
-            }
-        return best;
+        const bool on_own = same_surface(own, z);
+        if (on_own && !(edges_ && edges_[own])) return own;
+        return search(u, v, bu, bv, z, on_own);
     }
 
 private:
+    bool same_surface(std::int32_t q, float z) const {
+        return small_[q] != 0 && std::fabs(small_[q] - z) <= same_ + same_rel_ * z * z;
+    }
+    /// The search of an edge pixel, or of one off its own block's surface.
+    std::int32_t search(int u, int v, int bu, int bv, float z, bool on_own) const;
+
     const std::uint16_t* full_;
     const std::uint16_t* small_;
     int W_, w_, h_, factor_;
     float same_, same_rel_;  ///< in the depth images' units
+    const std::uint8_t* rgb_ = nullptr;        ///< input colour, with use_colour_at_edges
+    const std::uint8_t* small_rgb_ = nullptr;  ///< decimated colour
+    const std::uint8_t* edges_ = nullptr;      ///< edge blocks
 };
 
 }  // namespace wul3d

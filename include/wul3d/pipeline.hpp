@@ -122,6 +122,8 @@ private:
     std::vector<int> object_index_;
     std::vector<std::size_t> band_active_;
     std::vector<PixelBox> band_boxes_;
+    std::vector<std::uint8_t> edge_blocks_;  ///< decimated pixels at an object's outline
+    std::vector<std::uint16_t> edge_lo_, edge_hi_;  ///< their 3-wide row minima and maxima
     FrameResult result_;
 };
 
