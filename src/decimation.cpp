@@ -63,6 +63,7 @@ DecimatedSource::DecimatedSource(const DepthImage& input, const DepthImage& deci
     : full_(input.data.data()),
       small_(decimated.data.data()),
       W_(input.width),
+      H_(input.height),
       w_(decimated.width),
       h_(decimated.height),
       factor_(factor),
@@ -70,17 +71,18 @@ DecimatedSource::DecimatedSource(const DepthImage& input, const DepthImage& deci
       same_(same_m / input.scale_m_per_unit),
       same_rel_(same_rel * input.scale_m_per_unit) {
     if (factor < 1 || w_ != (W_ + factor - 1) / factor ||
-        h_ != (input.height + factor - 1) / factor ||
+        h_ != (H_ + factor - 1) / factor ||
         decimated.data.size() != static_cast<std::size_t>(w_) * h_ ||
-        input.data.size() != static_cast<std::size_t>(W_) * input.height)
+        input.data.size() != static_cast<std::size_t>(W_) * H_)
         throw InputError("decimation: the decimated depth does not match the input's size");
 }
 
 void DecimatedSource::use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
                                           const std::uint8_t* edge_blocks) {
     if (input.empty() || decimated.empty()) return;  // depth only: depth decides alone
-    if (input.rgb.size() != 3 * static_cast<std::size_t>(W_) * (input.height) ||
-        input.width != W_ || decimated.width != w_ || decimated.height != h_)
+    if (input.width != W_ || input.height != H_ || decimated.width != w_ || decimated.height != h_ ||
+        input.rgb.size() != 3 * static_cast<std::size_t>(W_) * H_ ||
+        decimated.rgb.size() != 3 * static_cast<std::size_t>(w_) * h_)
         throw InputError("decimation: colour and depth sizes differ");
     rgb_ = input.rgb.data();
     small_rgb_ = decimated.rgb.data();

@@ -153,6 +153,10 @@ TEST(DecimatedSource, AtEdgeBlocksTheColourPlacesTheOutline) {
     ColorImage wrong = rgb;
     wrong.width = 3;
     EXPECT_THROW(on_surface.use_colour_at_edges(wrong, small.color, edges.data()), InputError);
+    wrong = rgb;
+    wrong.height = 1;
+    wrong.rgb.resize(12);
+    EXPECT_THROW(on_surface.use_colour_at_edges(wrong, small.color, edges.data()), InputError);
     DecimatedSource depth_only(in, small.depth, 2, 0.004f, 0.0f);
     depth_only.use_colour_at_edges(ColorImage{}, ColorImage{}, edges.data());
     EXPECT_EQ(depth_only(1, 0), 0);

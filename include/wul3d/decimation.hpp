@@ -68,7 +68,7 @@ private:
 
     const std::uint16_t* full_;
     const std::uint16_t* small_;
-    int W_, w_, h_, factor_;
+    int W_, H_, w_, h_, factor_;
     float same_, same_rel_;  ///< in the depth images' units
     const std::uint8_t* rgb_ = nullptr;        ///< input colour, with use_colour_at_edges
     const std::uint8_t* small_rgb_ = nullptr;  ///< decimated colour
