@@ -206,19 +206,20 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
     r.object_list = s.object_list;
     const bool objects = params_.detect_objects;
     const std::size_t N = static_cast<std::size_t>(W) * H;
-    for (LabelImage* img : {&r.labels, &r.segments, &r.objects}) {
-        img->width = W;
-        img->height = H;
-    }
-    r.labels.labels.resize(N);
+    // Without the object stages their images stay empty, as run_on leaves them.
+    auto shape = [](LabelImage& img, int width, int height) {
+        img.width = width;
+        img.height = height;
+        img.labels.resize(static_cast<std::size_t>(width) * height);
+    };
+    shape(r.labels, W, H);
+    shape(r.segments, objects ? W : 0, objects ? H : 0);
+    shape(r.objects, objects ? W : 0, objects ? H : 0);
     r.colors.width = W;
     r.colors.height = H;
     r.colors.rgb.resize(3 * N);
     r.active.resize(N);
     r.plane_classes.resize(objects ? N : 0);
-    r.segments.labels.resize(objects ? N : 0);
-    r.objects.labels.resize(objects ? N : 0);
-    if (!objects) r.segments.width = r.segments.height = r.objects.width = r.objects.height = 0;
 
     // Track id -> index in object_list, for each object's pixel count and 2D box.
     int max_id = 0;
@@ -279,12 +280,7 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
                 segments[p] = in_segments[sq];
                 const std::uint16_t id = objects_out[p] = in_objects[sq];
                 if (id == 0 || id > max_id || object_index[id] < 0) continue;
-                PixelBox& b = boxes[object_index[id]];
-                ++b.pixels;
-                b.u_min = std::min(b.u_min, u);
-                b.v_min = std::min(b.v_min, v);
-                b.u_max = std::max(b.u_max, u);
-                b.v_max = std::max(b.v_max, v);
+                boxes[object_index[id]].add(u, v);
             }
         }
         band_active_[static_cast<std::size_t>(band)] = active;
@@ -294,14 +290,8 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
     for (std::size_t i = 0; i < n_obj; ++i) {
         DetectedObject& d = r.object_list[i];
         PixelBox total{W, H, -1, -1, 0};
-        for (int band = 0; band < kExpandBands; ++band) {
-            const PixelBox& b = band_boxes_[static_cast<std::size_t>(band) * n_obj + i];
-            total.pixels += b.pixels;
-            total.u_min = std::min(total.u_min, b.u_min);
-            total.v_min = std::min(total.v_min, b.v_min);
-            total.u_max = std::max(total.u_max, b.u_max);
-            total.v_max = std::max(total.v_max, b.v_max);
-        }
+        for (int band = 0; band < kExpandBands; ++band)
+            total.merge(band_boxes_[static_cast<std::size_t>(band) * n_obj + i]);
         d.pixels = total.pixels;
         d.u_min = total.u_min;
         d.v_min = total.v_min;

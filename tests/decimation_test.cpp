@@ -7,6 +7,7 @@
 #include <array>
 #include <map>
 #include <set>
+#include <utility>
 
 #include "synthetic_scene.hpp"
 #include "test_support.hpp"
@@ -34,6 +35,14 @@ RgbdFrame small_frame(const std::vector<int>& holes) {
     }
     for (int p : holes) f.depth.data[static_cast<std::size_t>(p)] = 0;
     return f;
+}
+
+DepthImage depth_image(int width, int height, std::vector<std::uint16_t> data) {
+    DepthImage d;
+    d.width = width;
+    d.height = height;
+    d.data = std::move(data);
+    return d;
 }
 }  // namespace
 
@@ -86,14 +95,9 @@ TEST(DecimateFrame, RejectsBadFactorsAndMismatchedColour) {
 TEST(DecimatedSource, OwnBlockOnTheSameSurfaceElseTheNearestNeighbourInDepth) {
     // Input 4 x 2 (two blocks): a near surface (1000 mm) on the left, far (2000) on the right,
     // with pixel (2, 0) near although its block was sampled far.
-    DepthImage in;
-    in.width = 4;
-    in.height = 2;
-    in.data = {1000, 1001, 1002, 2000, 1000, 0, 2000, 2001};
-    DepthImage small;
-    small.width = 2;
-    small.height = 1;
-    small.data = {1000, 2000};  // block 1's first pixel with depth would be 1002: made far here
+    const DepthImage in = depth_image(4, 2, {1000, 1001, 1002, 2000, 1000, 0, 2000, 2001});
+    // Block 1's first pixel with depth would be 1002: made far here.
+    DepthImage small = depth_image(2, 1, {1000, 2000});
     const DecimatedSource source(in, small, 2, 0.004f, 0.0f);
     EXPECT_EQ(source(0, 0), 0);
     EXPECT_EQ(source(1, 0), 0);   // 1 mm off: the same surface
@@ -114,10 +118,7 @@ TEST(DecimatedSource, OwnBlockOnTheSameSurfaceElseTheNearestNeighbourInDepth) {
 TEST(DecimatedSource, AtEdgeBlocksTheColourPlacesTheOutline) {
     // One flat surface, 4 x 2 input: red at u = 0, blue at u = 1..3. Block 0 was sampled red
     // at (0, 0), block 1 blue at (2, 0); pixel (1, 0) is blue but lies in block 0.
-    DepthImage in;
-    in.width = 4;
-    in.height = 2;
-    in.data = {1000, 1000, 1000, 1000, 1000, 1000, 1000, 1000};
+    const DepthImage in = depth_image(4, 2, std::vector<std::uint16_t>(8, 1000));
     ColorImage rgb;
     rgb.width = 4;
     rgb.height = 2;
@@ -141,8 +142,7 @@ TEST(DecimatedSource, AtEdgeBlocksTheColourPlacesTheOutline) {
     source.use_colour_at_edges(rgb, small.color, no_edges.data());
     EXPECT_EQ(source(1, 0), 0);  // not an edge block: its own
     // The colour never overrides the surface: the blue block 6 cm farther is not taken.
-    DepthImage stepped = in;
-    stepped.data = {1000, 1000, 1060, 1060, 1000, 1000, 1060, 1060};
+    const DepthImage stepped = depth_image(4, 2, {1000, 1000, 1060, 1060, 1000, 1000, 1060, 1060});
     RgbdFrame g = f;
     g.depth = stepped;
     decimate_frame(g, 2, small);

@@ -5,6 +5,7 @@
 /// the object stages: support plane -> segmentation -> objects (tracks and their weights).
 /// Holds the stages' buffers (no allocation after the first frame) and the two objects that
 /// live across frames, ClusterState and ObjectTracker.
+#include <algorithm>
 #include <vector>
 
 #include "wul3d/background.hpp"
@@ -117,6 +118,20 @@ private:
     struct PixelBox {
         int u_min, v_min, u_max, v_max;
         std::size_t pixels;
+        void add(int u, int v) {
+            ++pixels;
+            u_min = std::min(u_min, u);
+            v_min = std::min(v_min, v);
+            u_max = std::max(u_max, u);
+            v_max = std::max(v_max, v);
+        }
+        void merge(const PixelBox& b) {
+            pixels += b.pixels;
+            u_min = std::min(u_min, b.u_min);
+            v_min = std::min(v_min, b.v_min);
+            u_max = std::max(u_max, b.u_max);
+            v_max = std::max(v_max, b.v_max);
+        }
     };
     static constexpr int kExpandBands = 16;
     std::vector<int> object_index_;
