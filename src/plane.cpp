@@ -255,11 +255,14 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             gp.x[g] = cloud.x[p];
             gp.y[g] = cloud.y[p];
             gp.z[g] = cloud.z[p];
-            gp.nx[g] = normals.nx[p];
-            gp.ny[g] = normals.ny[p];
-            gp.nz[g] = normals.nz[p];
+            // A point without a usable normal gets the zero normal: it then fails every
+            // normal test (cos >= a positive threshold) with no branch (count_inliers).
+            const bool use = active[p] && normals.valid[p];
+            gp.nx[g] = use ? normals.nx[p] : 0.0f;
+            gp.ny[g] = use ? normals.ny[p] : 0.0f;
+            gp.nz[g] = use ? normals.nz[p] : 0.0f;
             gp.active[g] = active[p];
-            gp.usable[g] = active[p] && normals.valid[p];
+            gp.usable[g] = use;
         }
     }
     auto usable = [&](int g) { return gp.usable[static_cast<std::size_t>(g)] != 0; };
@@ -282,16 +285,24 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             const std::size_t p = static_cast<std::size_t>(g);
             detail::add_moments(s, gp.x[p], gp.y[p], gp.z[p]);
             s[10] += gp.nx[p]; s[11] += gp.ny[p]; s[12] += gp.nz[p];
-            const double nlen = std::sqrt(s[10] * s[10] + s[11] * s[11] + s[12] * s[12]);
-            const float mnx = static_cast<float>(s[10] / nlen), mny = static_cast<float>(s[11] / nlen),
-                        mnz = static_cast<float>(s[12] / nlen);
-            const float cx = static_cast<float>(s[1] / s[0]), cy = static_cast<float>(s[2] / s[0]),
-                        cz = static_cast<float>(s[3] / s[0]);
             const int gu = g % grid.w, gv = g / grid.w;
             const int nb[4] = {gu > 0 ? g - 1 : -1, gu + 1 < grid.w ? g + 1 : -1,
                                gv > 0 ? g - grid.w : -1, gv + 1 < grid.h ? g + grid.w : -1};
-            for (int q : nb) {
-                if (q < 0 || ws.region[q] != -1 || !usable(q)) continue;
+            // Most points popped have no free neighbour left: the region's mean is only
+            // worked out (a square root, six divisions) when one has.
+            int free_nb[4], n_free = 0;
+            for (int q : nb)
+                if (q >= 0 && ws.region[q] == -1 && usable(q)) free_nb[n_free++] = q;
+            if (n_free == 0) continue;
+            // Two divisions, not six: they were most of this loop's time.
+            const double inv_nlen = 1.0 / std::sqrt(s[10] * s[10] + s[11] * s[11] + s[12] * s[12]);
+            const double inv_count = 1.0 / s[0];
+            const float mnx = static_cast<float>(s[10] * inv_nlen), mny = static_cast<float>(s[11] * inv_nlen),
+                        mnz = static_cast<float>(s[12] * inv_nlen);
+            const float cx = static_cast<float>(s[1] * inv_count), cy = static_cast<float>(s[2] * inv_count),
+                        cz = static_cast<float>(s[3] * inv_count);
+            for (int i = 0; i < n_free; ++i) {
+                const int q = free_nb[i];
                 const std::size_t pq = static_cast<std::size_t>(q);
                 const float cosq = gp.nx[pq] * mnx + gp.ny[pq] * mny + gp.nz[pq] * mnz;
                 if (cosq < cos_grow) continue;
@@ -360,19 +371,37 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         return gp.nx[p] * pl.nx + gp.ny[p] * pl.ny + gp.nz[p] * pl.nz >= cos_inlier;
     };
 
-    // 3. Candidates: merged planes covering min_extent of the grid points with a normal.
-    //    Inliers are counted over the whole grid (distance and normal agree).
-    for (int r : roots) {
-        Plane pl = fit(ws.sums.data() + static_cast<std::size_t>(r) * kSums);
-        std::size_t inliers = 0;
+    // is_inlier over the whole grid, without branches (the zero normals of the points
+    // without one fail the normal test): the compiler vectorizes it.
+    auto count_inliers = [&](const Plane& pl) {
+        const float *x = gp.x.data(), *y = gp.y.data(), *z = gp.z.data();
+        const float *nx = gp.nx.data(), *ny = gp.ny.data(), *nz = gp.nz.data();
+        const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
+        unsigned inliers = 0;
         for (int g = 0; g < G; ++g) {
-            if (!is_inlier(pl, g)) continue;
-            ++inliers;
+            const float h = pl.nx * x[g] + pl.ny * y[g] + pl.nz * z[g] + pl.d;
+            const bool on = std::fabs(h) <= band_m + band_rel * z[g] * z[g];
+            const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
+            inliers += static_cast<unsigned>(on & facing);
         }
-        pl.inliers = inliers;
-        if (static_cast<double>(inliers) >= params.min_extent * static_cast<double>(with_normal))
-            result.candidates.push_back(pl);
+        return static_cast<std::size_t>(inliers);
+    };
+
+    // 3. Candidates: merged planes covering min_extent of the grid points with a normal.
+    //    Inliers are counted over the whole grid (distance and normal agree), the planes
+    //    split across cores and kept in order.
+    auto& fitted = ws.fitted;
+    fitted.resize(roots.size());
+    const auto n_roots = static_cast<std::ptrdiff_t>(roots.size());
+#pragma omp parallel for schedule(dynamic)
+    for (std::ptrdiff_t i = 0; i < n_roots; ++i) {
+        Plane& pl = fitted[static_cast<std::size_t>(i)];
+        pl = fit(ws.sums.data() + static_cast<std::size_t>(roots[static_cast<std::size_t>(i)]) * kSums);
+        pl.inliers = count_inliers(pl);
     }
+    for (const Plane& pl : fitted)
+        if (static_cast<double>(pl.inliers) >= params.min_extent * static_cast<double>(with_normal))
+            result.candidates.push_back(pl);
 
     // The support's extent: the image-space convex hull of its inliers on the grid, widened
     // by the margin; a point belongs over the support when its foot (the point moved down
@@ -436,7 +465,8 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         hull_of = c;
         const HullMask hull = hull_of_plane(pl);
         std::size_t above = 0;
-        for (std::size_t p = 0; p < static_cast<std::size_t>(G); ++p) {
+#pragma omp parallel for schedule(static) reduction(+ : above)
+        for (int p = 0; p < G; ++p) {
             if (!gp.active[p]) continue;
             const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
             if (h <= on_band(gp.z[p]) || h > params.max_object_height_m) continue;

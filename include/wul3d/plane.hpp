@@ -84,6 +84,7 @@ struct PlaneWorkspace {
     std::vector<double> sums;         ///< per region: count, sum x, y, z, xx, xy, xz, yy, yz, zz
     std::vector<std::uint8_t> hull;   ///< grid-resolution mask of the support's extent
     std::vector<int> hull_points;     ///< (gu, gv) pairs: each grid row's outermost inliers
+    std::vector<Plane> fitted;        ///< the merged planes, fitted, inliers counted
     std::vector<int> by_extent;       ///< candidate indices, largest extent first
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
