@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "param_check.hpp"
@@ -162,20 +163,52 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
     return added;
 }
 
-/// Drops labels with fewer than min_points pixels and renumbers the rest 1..n in order of
-/// first appearance (raster order). Returns n.
-int compact(SegmentWorkspace& ws, int n, int min_points) {
-    ws.sizes.assign(static_cast<std::size_t>(n) + 1, 0);
-    for (int l : ws.label) ++ws.sizes[static_cast<std::size_t>(l)];
-    ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
-    ws.remap[0] = 0;
-    int next = 0;
-    for (int& l : ws.label) {
-        if (l == 0) continue;
-        int& m = ws.remap[static_cast<std::size_t>(l)];
-        if (m < 0) m = ws.sizes[static_cast<std::size_t>(l)] >= min_points ? ++next : 0;
-        l = m;
+/// Drops labels with fewer than min_points pixels and writes the rest to `out` renumbered
+/// 1..n in order of first appearance (raster order); ws.label keeps the old numbers. Returns
+/// n. Each half of the image (in parallel) counts its labels' pixels and first pixel, the
+/// labels are numbered, then `out` is written in parallel. Two halves only: the labels run
+/// up to the number of components, tiny fragments included, and each half keeps a row of
+/// them.
+int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
+    constexpr int kBands = 2;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    const std::size_t B = (L + 15) / 16 * 16;  // a band's row, whole cache lines (no false sharing)
+    const auto N = static_cast<std::ptrdiff_t>(ws.label.size());
+    ws.sizes.assign(kBands * B, 0);  // per band: pixels
+    ws.offsets.resize(kBands * B);   // per band: first pixel, valid where it has pixels
+    int* const label = ws.label.data();
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kBands; ++band) {
+        int* const count = ws.sizes.data() + static_cast<std::size_t>(band) * B;
+        int* const first = ws.offsets.data() + static_cast<std::size_t>(band) * B;
+        for (std::ptrdiff_t p = N * band / kBands; p < N * (band + 1) / kBands; ++p) {
+            const auto l = static_cast<std::size_t>(label[p]);
+            if (count[l]++ == 0) first[l] = static_cast<int>(p);
+        }
     }
+    // Labels in order of their first pixel; the large enough ones numbered in that order.
+    ws.order.clear();
+    for (std::size_t l = 1; l < L; ++l) {
+        int size = 0, first = std::numeric_limits<int>::max();
+        for (int band = 0; band < kBands; ++band) {
+            const int count = ws.sizes[static_cast<std::size_t>(band) * B + l];
+            if (count == 0) continue;
+            size += count;
+            first = std::min(first, ws.offsets[static_cast<std::size_t>(band) * B + l]);
+        }
+        ws.sizes[l] = size;  // band 0's row now holds the totals
+        ws.offsets[l] = first;
+        if (size >= min_points) ws.order.push_back(static_cast<int>(l));
+    }
+    std::sort(ws.order.begin(), ws.order.end(), [&](int a, int b) {
+        return ws.offsets[static_cast<std::size_t>(a)] < ws.offsets[static_cast<std::size_t>(b)];
+    });
+    ws.remap.assign(L, 0);
+    int next = 0;
+    for (const int l : ws.order) ws.remap[static_cast<std::size_t>(l)] = ++next;
+    const int* const remap = ws.remap.data();
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < N; ++p) out[p] = static_cast<std::uint16_t>(std::min(remap[label[p]], 65535));
     return next;
 }
 
@@ -813,9 +846,15 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     stats.ms.cuts = ms_since();
     int n = components(x, seedable, ws);
     // Fragments too small to seed an object go back to the unassigned pool.
-    for (std::size_t p = 0; p < N; ++p)
-        if (ws.label[p] && ws.sizes[static_cast<std::size_t>(ws.label[p])] < params.min_seed_points)
-            ws.label[p] = 0;
+    {
+        int* const label = ws.label.data();
+        const int* const sizes = ws.sizes.data();
+        const int min_seed = params.min_seed_points;
+        const auto n_px = static_cast<std::ptrdiff_t>(N);
+#pragma omp parallel for schedule(static)
+        for (std::ptrdiff_t p = 0; p < n_px; ++p)
+            if (label[p] && sizes[label[p]] < min_seed) label[p] = 0;
+    }
     stats.ms.components = ms_since();
     stats.reattached = reattach(x, ws, params.reattach_px);
     stats.reattached += reattach(x, ws, W + H, true);
@@ -837,13 +876,11 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
         stats.gaps_filled = fill_container_gaps(x, ws);
         stats.ms.gaps = ms_since();
     }
-    n = compact(ws, n, params.min_points);
-    stats.segments = n;
-
     out.width = W;
     out.height = H;
     out.labels.resize(N);
-    for (std::size_t p = 0; p < N; ++p) out.labels[p] = static_cast<std::uint16_t>(std::min(ws.label[p], 65535));
+    n = compact(ws, n, params.min_points, out.labels.data());
+    stats.segments = n;
     stats.ms.compact += ms_since();
     return stats;
 }
