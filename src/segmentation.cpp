@@ -597,14 +597,23 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     }
     const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
     const int s = prm.crease_step_px;
-    // Each segment is tried on its own (in parallel); split ids are given out in segment
-    // order afterwards so the labels do not depend on the threads.
+    // Each segment large enough to split is tried on its own (in parallel, the largest
+    // first so that no thread is left with a big one at the end); split ids are given out
+    // in segment order afterwards so the labels do not depend on the threads.
+    auto size_of = [&](int l) {
+        return ws.offsets[static_cast<std::size_t>(l) + 1] - ws.offsets[static_cast<std::size_t>(l)];
+    };
+    ws.by_size.clear();
+    for (int l = 1; l <= n; ++l)
+        if (size_of(l) >= 2 * prm.min_points) ws.by_size.push_back(l);
+    std::stable_sort(ws.by_size.begin(), ws.by_size.end(), [&](int a, int b) { return size_of(a) > size_of(b); });
+    const auto n_tried = static_cast<std::ptrdiff_t>(ws.by_size.size());
 #pragma omp parallel for schedule(dynamic, 1)
-    for (int l = 1; l <= n; ++l) {
+    for (std::ptrdiff_t t = 0; t < n_tried; ++t) {
+        const int l = ws.by_size[static_cast<std::size_t>(t)];
         const int o = ws.offsets[static_cast<std::size_t>(l)];
         const int* px = ws.order.data() + o;
-        const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
-        if (m < 2 * prm.min_points) continue;
+        const int m = size_of(l);
         const int fo = o - first;  // the segment's first position in the feature planes
         std::uint8_t* part = ws.part.data();
         // Seeds: the pixel farthest in colour from the mean, then the one farthest from it.

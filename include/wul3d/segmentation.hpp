@@ -104,6 +104,7 @@ struct SegmentWorkspace {
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
     std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
     std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
+    std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
     // Containers:
