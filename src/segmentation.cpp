@@ -130,18 +130,35 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
     int head = 0, tail = 0;
     // Only labelled pixels with a neighbour they may grow into start the search, in raster
     // order: the others would find nothing to label, so leaving them out changes no label.
+    // Found per band of rows in parallel (each band's seeds at its own rows' offset in the
+    // queue), then packed in band order.
     auto grows_into = [&](std::size_t q) {
         return !ws.label[q] && x.cls[q] != kPlaneRemoved && (!inside_only || x.cls[q] == kPlaneInside);
     };
-    for (int v = 0; v < H; ++v)
-        for (int u = 0; u < W; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            ws.dist[p] = ws.label[p] ? 0 : -1;
-            if (!ws.label[p]) continue;
-            if ((u > 0 && grows_into(p - 1)) || (u + 1 < W && grows_into(p + 1)) ||
-                (v > 0 && grows_into(p - W)) || (v + 1 < H && grows_into(p + W)))
-                ws.queue[tail++] = static_cast<int>(p);
-        }
+    constexpr int kBands = 8;
+    int band_seeds[kBands];
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kBands; ++band) {
+        const int v0 = H * band / kBands, v1 = H * (band + 1) / kBands;
+        int* const seeds = ws.queue.data() + static_cast<std::size_t>(v0) * W;
+        int count = 0;
+        for (int v = v0; v < v1; ++v)
+            for (int u = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                ws.dist[p] = ws.label[p] ? 0 : -1;
+                if (!ws.label[p]) continue;
+                if ((u > 0 && grows_into(p - 1)) || (u + 1 < W && grows_into(p + 1)) ||
+                    (v > 0 && grows_into(p - W)) || (v + 1 < H && grows_into(p + W)))
+                    seeds[count++] = static_cast<int>(p);
+            }
+        band_seeds[band] = count;
+    }
+    for (int band = 0; band < kBands; ++band) {
+        // Packed forwards: the destination never lies past the source.
+        const int* const seeds = ws.queue.data() + static_cast<std::size_t>(H * band / kBands) * W;
+        if (seeds != ws.queue.data() + tail) std::copy(seeds, seeds + band_seeds[band], ws.queue.data() + tail);
+        tail += band_seeds[band];
+    }
     std::size_t added = 0;
     while (head < tail) {
         const int p = ws.queue[head++];
