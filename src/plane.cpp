@@ -219,6 +219,42 @@ std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& clo
     return restored;
 }
 
+/// Slivers: candidates most of whose inliers (over half) are also the inliers of a larger
+/// candidate. Such a plane cuts through the larger surface at a small angle (fitted to a few
+/// points at an object's foot, or to noise on a carpet), and counting the points above it
+/// would count half of that surface as standing on it: it won the support from the table it
+/// cuts. `ws.sliver[rank]` for the candidates in ws.by_extent order (largest first; the 32
+/// largest are tested: each covers min_extent of the grid, so there are rarely more than a
+/// few). Inlier sets are one bit per candidate per grid point.
+template <class InlierTest>
+void mark_slivers(const std::vector<Plane>& candidates, InlierTest&& for_each_inlier_test, int G,
+                  PlaneWorkspace& ws) {
+    const std::size_t C = std::min<std::size_t>(ws.by_extent.size(), 32);
+    ws.sliver.assign(C, 0);
+    if (C < 2) return;
+    ws.candidate_bits.assign(static_cast<std::size_t>(G), 0);
+    std::uint32_t* const bits = ws.candidate_bits.data();
+    for (std::size_t rank = 0; rank < C; ++rank) {
+        const Plane& pl = candidates[static_cast<std::size_t>(ws.by_extent[rank])];
+        for_each_inlier_test(pl, [&](int g, bool in) { bits[g] |= static_cast<std::uint32_t>(in) << rank; });
+    }
+    // shared[i * C + j]: inliers of rank i that are also inliers of rank j < i.
+    ws.shared.assign(C * C, 0);
+    for (int g = 0; g < G; ++g) {
+        const std::uint32_t b = bits[g];
+        if ((b & (b - 1)) == 0) continue;  // on at most one candidate
+        for (std::size_t i = 1; i < C; ++i) {
+            if (!(b >> i & 1u)) continue;
+            for (std::size_t j = 0; j < i; ++j) ws.shared[i * C + j] += b >> j & 1u;
+        }
+    }
+    for (std::size_t i = 1; i < C; ++i) {
+        const std::size_t inliers = candidates[static_cast<std::size_t>(ws.by_extent[i])].inliers;
+        for (std::size_t j = 0; j < i; ++j)
+            if (2 * static_cast<std::size_t>(ws.shared[i * C + j]) > inliers) ws.sliver[i] = 1;
+    }
+}
+
 }  // namespace
 
 PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
@@ -372,18 +408,21 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     };
 
     // is_inlier over the whole grid, without branches (the zero normals of the points
-    // without one fail the normal test): the compiler vectorizes it.
-    auto count_inliers = [&](const Plane& pl) {
+    // without one fail the normal test): the compiler vectorizes it. take(g, inlier).
+    auto for_each_inlier_test = [&](const Plane& pl, auto&& take) {
         const float *x = gp.x.data(), *y = gp.y.data(), *z = gp.z.data();
         const float *nx = gp.nx.data(), *ny = gp.ny.data(), *nz = gp.nz.data();
         const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
-        unsigned inliers = 0;
         for (int g = 0; g < G; ++g) {
             const float h = pl.nx * x[g] + pl.ny * y[g] + pl.nz * z[g] + pl.d;
             const bool on = std::fabs(h) <= band_m + band_rel * z[g] * z[g];
             const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
-            inliers += static_cast<unsigned>(on & facing);
+            take(g, on & facing);
         }
+    };
+    auto count_inliers = [&](const Plane& pl) {
+        unsigned inliers = 0;
+        for_each_inlier_test(pl, [&](int, bool in) { inliers += static_cast<unsigned>(in); });
         return static_cast<std::size_t>(inliers);
     };
 
@@ -456,9 +495,11 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         return result.candidates[static_cast<std::size_t>(a)].inliers >
                result.candidates[static_cast<std::size_t>(b)].inliers;
     });
-    for (const int c : ws.by_extent) {
+    mark_slivers(result.candidates, for_each_inlier_test, G, ws);
+    for (std::size_t rank = 0; rank < ws.by_extent.size(); ++rank) {
+        const int c = ws.by_extent[rank];
         Plane& pl = result.candidates[static_cast<std::size_t>(c)];
-        if (pl.up < params.min_up) continue;
+        if (pl.up < params.min_up || (rank < ws.sliver.size() && ws.sliver[rank])) continue;
         const double extent = static_cast<double>(pl.inliers);
         if (extent + 0.1 * extent < best_score) break;  // the score's largest value, as computed
         build_hull(pl);

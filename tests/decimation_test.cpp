@@ -265,12 +265,10 @@ TEST(Pipeline, Decimated_BoxesFoundAtTheInputsSize) {
     }
 }
 
-// Real shipped frames: with --decimate 2 the support is the same plane as at full resolution,
-// and most objects of the full-resolution run larger than 3000 px are found again, overlapping
-// by at least 75 % (intersection over union). Known divergence: in image_0005 the decimated
-// run takes a part of the floor under the table as the support (the support score is close
-// there: points standing on the floor's part include the table top), so that frame is only
-// checked for its shapes.
+// Real shipped frames: with --decimate 2 the support is the same plane as at full resolution
+// (in image_0005 a sliver of the floor took it before slivers were left unscored, see
+// plane_test), and most objects of the full-resolution run larger than 3000 px are found
+// again, overlapping by at least 75 % (intersection over union).
 TEST(Pipeline, Decimated_RealTabletopObjectsMatchFullResolution) {
     auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
     PipelineParams full_params, half_params;
@@ -288,7 +286,6 @@ TEST(Pipeline, Decimated_RealTabletopObjectsMatchFullResolution) {
         const FrameResult& b = half.process(item.frame);
         expect_object_list_matches_image(b);
         ASSERT_TRUE(b.plane.found);
-        if (item.frame.name == "image_0005") continue;
         const Plane& s = b.plane.support;
         EXPECT_GT(s.nx * full_support.nx + s.ny * full_support.ny + s.nz * full_support.nz,
                   std::cos(2.0 * 3.14159265 / 180));
@@ -310,7 +307,7 @@ TEST(Pipeline, Decimated_RealTabletopObjectsMatchFullResolution) {
             matched += best >= 0.75;
         }
     }
-    // 15 of 17 when written: the box at the back of image_0002 is lost in the decimated run.
-    EXPECT_GE(compared, 15);
+    // 17 of 19 when written: the box at the back of image_0002 is lost in the decimated run.
+    EXPECT_GE(compared, 17);
     EXPECT_GE(matched, compared * 85 / 100) << matched << " of " << compared;
 }

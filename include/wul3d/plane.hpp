@@ -86,6 +86,9 @@ struct PlaneWorkspace {
     std::vector<int> hull_points;     ///< (gu, gv) pairs: each grid row's outermost inliers
     std::vector<Plane> fitted;        ///< the merged planes, fitted, inliers counted
     std::vector<int> by_extent;       ///< candidate indices, largest extent first
+    std::vector<std::uint32_t> candidate_bits;  ///< per grid point: bit r = inlier of rank r
+    std::vector<int> shared;          ///< inliers two candidates share (ranks i > j)
+    std::vector<std::uint8_t> sliver; ///< per rank: cuts through a larger candidate, not scored
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
     struct Run {
