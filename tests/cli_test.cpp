@@ -182,7 +182,7 @@ void check_summary(const fs::path& out, int frames) {
     ASSERT_TRUE(j.contains("stage_ms_median"));
     ASSERT_TRUE(j["stage_ms_median"].is_object());
     for (const char* stage :
-         {"registration", "backprojection", "normals", "background", "clustering", "output"}) {
+         {"registration", "backprojection", "normals", "background", "clustering", "output", "overlap"}) {
         ASSERT_TRUE(j["stage_ms_median"].contains(stage)) << stage;
         ASSERT_TRUE(j["stage_ms_median"][stage].is_number()) << stage;
         EXPECT_GE(j["stage_ms_median"][stage].get<double>(), 0.0) << stage;

@@ -1,6 +1,7 @@
 #include "wul3d/pipeline.hpp"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 
@@ -133,4 +134,64 @@ TEST(PipelineParams, ObjectStagesValidate) {
     p = PipelineParams{};
     p.objects.psi = 2;
     EXPECT_THROW(Pipeline{p}, ParamError);
+}
+
+// On two threads the clustering runs beside the plane and segmentation stages when the frame
+// is small (here the shipped tabletop frames decimated to 320 x 240): every result must be the
+// one the stages give one after the other, on one thread, over a whole sequence.
+TEST(Pipeline, ClusteringBesideTheObjectStages_SameResultsAsOneAfterTheOther) {
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    PipelineParams params;
+    params.decimation = 2;
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    Pipeline one(params);
+    omp_set_num_threads(2);
+    Pipeline two(params);
+    SourceItem item;
+    double overlap = 0;
+    for (std::size_t i = 0; i < source->size(); ++i) {
+        source->read(i, item);
+        SCOPED_TRACE(item.frame.name);
+        omp_set_num_threads(1);
+        const FrameResult a = one.process(item.frame);
+        EXPECT_EQ(a.times.overlap, 0.0);
+        omp_set_num_threads(2);
+        const FrameResult& b = two.process(item.frame);
+        overlap += b.times.overlap;
+        EXPECT_EQ(a.labels.labels, b.labels.labels);
+        EXPECT_EQ(a.colors.rgb, b.colors.rgb);
+        EXPECT_EQ(a.segments.labels, b.segments.labels);
+        EXPECT_EQ(a.objects.labels, b.objects.labels);
+        ASSERT_EQ(a.object_list.size(), b.object_list.size());
+        for (std::size_t o = 0; o < a.object_list.size(); ++o) {
+            EXPECT_EQ(a.object_list[o].track_id, b.object_list[o].track_id);
+            EXPECT_EQ(a.object_list[o].pixels, b.object_list[o].pixels);
+        }
+        EXPECT_NEAR(b.times.total(),
+                    b.times.decimation + b.times.backprojection + b.times.normals + b.times.background +
+                        b.times.clustering + b.times.colors + b.times.plane + b.times.segmentation +
+                        b.times.objects - b.times.overlap,
+                    1e-9);
+    }
+    omp_set_num_threads(threads);
+    EXPECT_GT(overlap, 0.0) << "the stages did not run side by side (test premise)";
+}
+
+// An error inside the stages that run side by side reaches the caller as itself (an exception
+// may not leave an OpenMP section): a first frame with fewer points in range than k.
+TEST(Pipeline, ErrorBesideTheObjectStagesReachesTheCaller) {
+    RgbdFrame f;
+    f.name = "far";
+    f.intrinsics = {320, 240, 300.0, 300.0, 160.0, 120.0};
+    f.depth.width = 320;
+    f.depth.height = 240;
+    f.depth.scale_m_per_unit = 0.001f;
+    f.depth.data.assign(320 * 240, 9000);  // 9 m: out of the default range
+    for (int i = 0; i < 3; ++i) f.depth.data[static_cast<std::size_t>(120 * 320 + 100 + i)] = 1000;
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(2);
+    Pipeline pipeline(PipelineParams{});
+    EXPECT_THROW(pipeline.process(f), InputError);
+    omp_set_num_threads(threads);
 }

@@ -241,6 +241,7 @@ void run(const RunOptions& o) {
         stage_ms["plane"].push_back(r.times.plane);
         stage_ms["segmentation"].push_back(r.times.segmentation);
         stage_ms["objects"].push_back(r.times.objects);
+        stage_ms["overlap"].push_back(r.times.overlap);
         stage_ms["output"].push_back(out_ms);
         compute_ms.push_back(r.times.total());
         nlohmann::json f = {{"name", name},

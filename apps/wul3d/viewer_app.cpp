@@ -500,7 +500,8 @@ void Viewer::draw_controls(const Rect& area) {
             {"registration", t.registration}, {"back-projection", t.backprojection},
             {"normals", t.normals},           {"background", t.background},
             {"clustering", t.clustering},     {"colours (eq. 9)", t.colors},
-            // Stages added after these (objects, ...): total() counts them.
+            // Stages added after these (objects, ...): total() counts them, less the time
+            // they ran beside the clustering (StageTimes::overlap).
             {"later stages", t.total() - t.registration - t.backprojection - t.normals -
                                  t.background - t.clustering - t.colors}};
         const double total = std::max(1e-9, t.total());
