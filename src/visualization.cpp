@@ -54,14 +54,11 @@ void render_weight_colors(const ClusterState& state, const LabelImage& labels,
             std::uint8_t* o = out.rgb.data() + 3 * p;
             if (labels.labels[p] != 0) {
                 // Paper eq. (9): C_p = sum_j C_j mu_j, over the kept weights (the others
-                // are 0 or negligible, see PixelWeights). A settled pixel has all its weight
-                // in slot 0 (update_weights keeps the arg-max there). Otherwise every slot is
-                // added, with no branch to mispredict: an empty one holds mu = 0 and a valid
-                // cluster, and adding 0 changes no sum.
+                // are 0 or negligible, see PixelWeights).
                 const PixelWeights& w = state.weights(grid_row + (stride == 1 ? u : u / stride));
                 float acc[3] = {0, 0, 0};
-                const int slots = w.mu[0] == static_cast<std::uint16_t>(PixelWeights::kOne) ? 1 : PixelWeights::kSlots;
-                for (int s = 0; s < slots; ++s) {
+                for (int s = 0; s < PixelWeights::kSlots; ++s) {
+                    if (w.mu[s] == 0) continue;  // most slots of a still scene are empty
                     const float m = static_cast<float>(w.mu[s]);
                     const float* c = &C[3 * w.cluster[s]];
                     acc[0] += c[0] * m;
