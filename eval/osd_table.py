@@ -7,7 +7,7 @@ Runs `wul3d run` on osd_mosd (78 frames) once per variant (default, --segmenter 
 --segmenter kmeans, --no-plane, --decimate 2, and the paper's clusters: labels.png at
 k = 10), scores each with `wul3d eval` on the learn* frames, the test* frames and all, then
 the two osd_moving sequences with the paper's weights on objects (--object-psi 0.5), without
-(1), and with --decimate 2. Prints
+(1), and both again with --decimate 2. Prints
 Markdown. OSD is research-only data: it is read from ../shared/data, never shipped.
 """
 import argparse
@@ -72,7 +72,8 @@ def main():
     print("| osd_moving sequence | object psi | Overlap F | Boundary F | id switches (max per object) | flicker % |")
     print("|---|---|---|---|---|---|")
     for seq in sorted(p for p in (data / "osd_moving").iterdir() if p.is_dir()):
-        for psi, flags in (("0.5", []), ("1", []), ("0.5, --decimate 2", ["--decimate", "2"])):
+        for psi, flags in (("0.5", []), ("1", []), ("0.5, --decimate 2", ["--decimate", "2"]),
+                           ("1, --decimate 2", ["--decimate", "2"])):
             pred = out / f"moving-{seq.name}-{psi.replace(', ', '-').replace(' ', '')}"
             run([args.wul3d, "run", str(seq), "--out", str(pred), "-q", "--object-psi",
                  psi.split(",")[0], *flags])

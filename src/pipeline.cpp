@@ -127,7 +127,8 @@ void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
     // On two threads the plane and segmentation stages leave one idle for half their time
     // (their flood fills are serial), so on small frames they run beside the clustering,
     // each on one thread (nested loops run on the thread that meets them): at --decimate 2
-    // (320x240) 6.7 -> 6.4 ms a frame on the busiest tabletop scenes. On 640x480 it lost
+    // (320x240) 6.7 -> 6.4 ms a frame on the busiest tabletop scenes (a frame repeated
+    // exactly, the clustering's cheapest case, loses: docs/DESIGN.md). On 640x480 it lost
     // 2 % (16.5 -> 16.9 ms: the two then contend for the cache), and with more threads every
     // stage's loops use them all: there the stages run one after the other.
     constexpr std::size_t kOverlapMaxPoints = 160000;
