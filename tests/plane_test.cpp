@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "synthetic_scene.hpp"
 #include "test_support.hpp"
@@ -21,12 +22,21 @@ struct Prepared {
     OrganizedCloud cloud;
     NormalMap normals;
     std::vector<std::uint8_t> active;
+
+    PlaneResult remove_plane(const PlaneParams& params, PlaneWorkspace& ws,
+                             std::vector<std::uint8_t>& classes) const {
+        return remove_support_plane(params, frame.intrinsics, cloud, normals, active, ws, classes);
+    }
 };
 
-void prepare(Prepared& f) {
+/// The frame back-projected, with its normals and depth-range mask (the pipeline's defaults).
+Prepared prepared(RgbdFrame frame) {
+    Prepared f;
+    f.frame = std::move(frame);
     back_project(f.frame, f.cloud);
     estimate_normals(NormalParams{}, f.cloud, f.normals);
     select_depth_range(DepthRange{}, f.cloud, f.active);
+    return f;
 }
 }  // namespace
 
@@ -64,13 +74,10 @@ TEST(RemoveSupportPlane, TiltedTable_RemovesTableKeepsBoxesAndTheirFeet) {
     b.r = 30; b.g = 60; b.b = 220;
     s.boxes = {a, b};
     std::vector<int> truth;
-    Prepared f;
-    f.frame = render_scene(s, &truth);
-    prepare(f);
+    Prepared f = prepared(render_scene(s, &truth));
     PlaneWorkspace ws;
     std::vector<std::uint8_t> classes;
-    const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
-                                               f.normals, f.active, ws, classes);
+    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
     ASSERT_TRUE(r.found);
     // The table's normal in the camera frame: up in the scene is -y; the camera pitched down
     // by theta sees it as (0, -cos theta, -sin theta).
@@ -103,13 +110,10 @@ TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
     Scene s;
     s.wall = true;
     s.table_half_width = 0.0f;
-    Prepared f;
-    f.frame = render_scene(s);
-    prepare(f);
+    Prepared f = prepared(render_scene(s));
     PlaneWorkspace ws;
     std::vector<std::uint8_t> classes;
-    const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
-                                               f.normals, f.active, ws, classes);
+    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
     EXPECT_FALSE(r.found);
     std::size_t active = 0;
     for (auto a : f.active) active += a;
@@ -136,11 +140,8 @@ TEST(RemoveSupportPlane, RealUncroppedTabletops_ChoosesTheTableUnderTheObjects) 
         source->read(i, item);
         SCOPED_TRACE(item.frame.name);
         ASSERT_EQ(item.frame.name, patches[i].frame);
-        Prepared f;
-        f.frame = item.frame;
-        prepare(f);
-        const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
-                                                   f.normals, f.active, ws, classes);
+        Prepared f = prepared(item.frame);
+        const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
         ASSERT_TRUE(r.found);
         EXPECT_GT(r.support.up, 0.5f);
         const int W = f.cloud.width;
@@ -183,20 +184,16 @@ TEST(RemoveSupportPlane, RealTabletopHalfResolution_SliverOfTheFloorIsNotTheSupp
     ASSERT_EQ(item.frame.name, "image_0005");
     PlaneWorkspace ws;
     std::vector<std::uint8_t> classes;
-    Prepared full;
-    full.frame = item.frame;
-    prepare(full);
-    const PlaneResult at_full = remove_support_plane(PlaneParams{}, full.frame.intrinsics, full.cloud,
-                                                     full.normals, full.active, ws, classes);
+    Prepared full = prepared(item.frame);
+    const PlaneResult at_full = full.remove_plane(PlaneParams{}, ws, classes);
     ASSERT_TRUE(at_full.found);
-    Prepared half;
-    decimate_frame(item.frame, 2, half.frame);
-    prepare(half);
+    RgbdFrame small;
+    decimate_frame(item.frame, 2, small);
+    const Prepared half = prepared(small);
     PlaneParams params;  // as the pipeline scales them at --decimate 2
     params.grid_stride_px = 2;
     params.hull_margin_px = 6;
-    const PlaneResult r = remove_support_plane(params, half.frame.intrinsics, half.cloud,
-                                               half.normals, half.active, ws, classes);
+    const PlaneResult r = half.remove_plane(params, ws, classes);
     ASSERT_TRUE(r.found);
     const Plane& s = r.support;
     EXPECT_GT(s.nx * at_full.support.nx + s.ny * at_full.support.ny + s.nz * at_full.support.nz,
@@ -229,13 +226,10 @@ TEST(RemoveSupportPlane, EnclosedPatchAboveThePlane_IsAContainersInside) {
         box.h = 0.1f;
         s.boxes = {box};
         std::vector<int> truth;
-        Prepared f;
-        f.frame = render_scene(s, &truth);
-        prepare(f);
+        Prepared f = prepared(render_scene(s, &truth));
         PlaneWorkspace ws;
         std::vector<std::uint8_t> classes;
-        const PlaneResult first = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud,
-                                                       f.normals, f.active, ws, classes);
+        const PlaneResult first = f.remove_plane(PlaneParams{}, ws, classes);
         ASSERT_TRUE(first.found);
         // The patch: box pixels at least 12 px inside the box's image region.
         const int W = f.cloud.width, H = f.cloud.height;
@@ -261,7 +255,7 @@ TEST(RemoveSupportPlane, EnclosedPatchAboveThePlane_IsAContainersInside) {
             }
         ASSERT_GT(patch_size, 300u);
         estimate_normals(NormalParams{}, f.cloud, f.normals);
-        remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud, f.normals, f.active, ws, classes);
+        f.remove_plane(PlaneParams{}, ws, classes);
         std::size_t inside = 0, removed = 0;
         for (std::size_t p = 0; p < patch.size(); ++p) {
             if (!patch[p]) continue;
