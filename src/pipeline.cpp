@@ -177,8 +177,8 @@ void Pipeline::cluster_and_colour(const RgbdFrame& frame, FrameResult& r) {
 
 void Pipeline::plane_and_segments(const RgbdFrame& frame, FrameResult& r) {
     const PipelineParams& params = stage_params_;
-    // Objects: the support plane goes (part of the paper's background step, done after the
-    // clustering so that labels.png keeps the paper's clusters), the rest is segmented.
+    // Objects: the support plane goes (part of the paper's background step, kept out of the
+    // clustering's mask so that labels.png keeps the paper's clusters), the rest is segmented.
     auto t = Clock::now();
     if (params.remove_plane) {
         r.plane = remove_support_plane(params.plane, frame.intrinsics, cloud_, normals_,
