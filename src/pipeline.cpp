@@ -215,20 +215,29 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
     const int w = outline.width, h = outline.height;
     const std::size_t n_small = outline.labels.size();
     // Separable: each pixel's row-wise minimum and maximum over three, then column-wise;
-    // an edge where the 3 x 3 minimum and maximum differ (plain loops that vectorize).
+    // an edge where the 3 x 3 minimum and maximum differ. Plain loops over rows through raw
+    // pointers, the borders clamped by the row pointers' choice, not per pixel: they vectorize.
     edge_blocks_.resize(n_small);
     edge_lo_.resize(n_small);
     edge_hi_.resize(n_small);
     const std::uint16_t* const l = outline.labels.data();
     std::uint16_t *const lo = edge_lo_.data(), *const hi = edge_hi_.data();
+    std::uint8_t* const edge = edge_blocks_.data();
+    auto min3 = [](std::uint16_t a, std::uint16_t b, std::uint16_t c) { return std::min(std::min(a, b), c); };
+    auto max3 = [](std::uint16_t a, std::uint16_t b, std::uint16_t c) { return std::max(std::max(a, b), c); };
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
-        const std::size_t row = static_cast<std::size_t>(v) * w;
-        for (int u = 0; u < w; ++u) {
-            const std::uint16_t a = l[row + std::max(u - 1, 0)], b = l[row + u],
-                                c = l[row + std::min(u + 1, w - 1)];
-            lo[row + u] = std::min({a, b, c});
-            hi[row + u] = std::max({a, b, c});
+        const std::uint16_t* const in = l + static_cast<std::size_t>(v) * w;
+        std::uint16_t *const row_lo = lo + static_cast<std::size_t>(v) * w, *const row_hi = hi + static_cast<std::size_t>(v) * w;
+        row_lo[0] = min3(in[0], in[0], in[std::min(1, w - 1)]);
+        row_hi[0] = max3(in[0], in[0], in[std::min(1, w - 1)]);
+        for (int u = 1; u < w - 1; ++u) {
+            row_lo[u] = min3(in[u - 1], in[u], in[u + 1]);
+            row_hi[u] = max3(in[u - 1], in[u], in[u + 1]);
+        }
+        if (w > 1) {
+            row_lo[w - 1] = min3(in[w - 2], in[w - 1], in[w - 1]);
+            row_hi[w - 1] = max3(in[w - 2], in[w - 1], in[w - 1]);
         }
     }
 #pragma omp parallel for schedule(static)
@@ -236,11 +245,11 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
         const std::size_t up = static_cast<std::size_t>(std::max(v - 1, 0)) * w,
                           row = static_cast<std::size_t>(v) * w,
                           down = static_cast<std::size_t>(std::min(v + 1, h - 1)) * w;
-        for (int u = 0; u < w; ++u) {
-            const std::uint16_t mn = std::min({lo[up + u], lo[row + u], lo[down + u]}),
-                                mx = std::max({hi[up + u], hi[row + u], hi[down + u]});
-            edge_blocks_[row + u] = mn != mx;
-        }
+        const std::uint16_t *const lo_up = lo + up, *const lo_row = lo + row, *const lo_down = lo + down;
+        const std::uint16_t *const hi_up = hi + up, *const hi_row = hi + row, *const hi_down = hi + down;
+        std::uint8_t* const out = edge + row;
+        for (int u = 0; u < w; ++u)
+            out[u] = min3(lo_up[u], lo_row[u], lo_down[u]) != max3(hi_up[u], hi_row[u], hi_down[u]);
     }
     source.use_colour_at_edges(frame.color, decimated_.color, edge_blocks_.data());
     r.stats = s.stats;
