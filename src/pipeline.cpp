@@ -125,16 +125,15 @@ void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
         return;
     }
     // On two threads the plane and segmentation stages leave one idle for half their time
-    // (their flood fills are serial), so on small frames they run beside the clustering,
-    // each on one thread (nested loops run on the thread that meets them): at --decimate 2
-    // (320x240) 6.7 -> 6.4 ms a frame on the busiest tabletop scenes (a frame repeated
-    // exactly, the clustering's cheapest case, loses: docs/DESIGN.md). On 640x480 it lost
-    // 2 % (16.5 -> 16.9 ms: the two then contend for the cache), and with more threads every
-    // stage's loops use them all: there the stages run one after the other.
-    constexpr std::size_t kOverlapMaxPoints = 160000;
-    if (params.segmentation.segmenter != Segmenter::Kmeans && omp_get_max_threads() == 2 &&
-        !omp_in_parallel() && cloud_.size() <= kOverlapMaxPoints) {
-        t = Clock::now();
+    // (their flood fills are serial), so they may run beside the clustering, each on one
+    // thread (nested loops run on the thread that meets them). Whether that pays depends on
+    // the frame (SideBySideChoice). With more threads every stage's loops use them all: the
+    // stages run one after the other.
+    const bool may_overlap = params.segmentation.segmenter != Segmenter::Kmeans &&
+                             omp_get_max_threads() == 2 && !omp_in_parallel();
+    const bool side_by_side = may_overlap && side_by_side_.next();
+    t = Clock::now();
+    if (side_by_side) {
         std::exception_ptr failed[2];  // an exception may not leave an OpenMP section
 #pragma omp parallel sections num_threads(2)
         {
@@ -153,17 +152,35 @@ void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
         }
         for (const auto& e : failed)
             if (e) std::rethrow_exception(e);
-        r.times.overlap = std::max(0.0, r.times.clustering + r.times.colors + r.times.plane +
-                                            r.times.segmentation - ms_since(t));
     } else {
         cluster_and_colour(frame, r);
         plane_and_segments(frame, r);
     }
+    const double both_ms = ms_since(t);
+    if (may_overlap) side_by_side_.record(side_by_side, both_ms);
+    if (side_by_side)
+        r.times.overlap = std::max(0.0, r.times.clustering + r.times.colors + r.times.plane +
+                                            r.times.segmentation - both_ms);
 
     t = Clock::now();
     tracker_.step(cloud_, r.segments, r.segment_stats.segments, r.labels, r.objects,
                   r.object_list);
     r.times.objects = ms_since(t);
+}
+
+bool detail::SideBySideChoice::next() const {
+    const int i = frame_ % kPeriod;
+    return i < 2 * kTrials ? i % 2 == 0 : side_by_side_;
+}
+
+void detail::SideBySideChoice::record(bool side_by_side, double ms) {
+    const int i = frame_++ % kPeriod;
+    if (i >= 2 * kTrials) return;
+    // The fastest frame of each way: the first frame of a sequence (k-means++ seeding) and a
+    // frame another process slowed down do not decide.
+    double& best = best_ms_[side_by_side ? 1 : 0];
+    best = i < 2 ? ms : std::min(best, ms);
+    if (i == 2 * kTrials - 1) side_by_side_ = best_ms_[1] < best_ms_[0];
 }
 
 void Pipeline::cluster_and_colour(const RgbdFrame& frame, FrameResult& r) {

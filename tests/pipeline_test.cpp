@@ -136,9 +136,10 @@ TEST(PipelineParams, ObjectStagesValidate) {
     EXPECT_THROW(Pipeline{p}, ParamError);
 }
 
-// On two threads the clustering runs beside the plane and segmentation stages when the frame
-// is small (here the shipped tabletop frames decimated to 320 x 240): every result must be the
-// one the stages give one after the other, on one thread, over a whole sequence.
+// On two threads the clustering runs beside the plane and segmentation stages in the first,
+// third, ... frames of a sequence (SideBySideChoice's trials; here the shipped tabletop frames
+// decimated to 320 x 240): every result must be the one the stages give one after the other,
+// on one thread, over the whole sequence.
 TEST(Pipeline, ClusteringBesideTheObjectStages_SameResultsAsOneAfterTheOther) {
     auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
     PipelineParams params;
@@ -194,4 +195,30 @@ TEST(Pipeline, ErrorBesideTheObjectStagesReachesTheCaller) {
     Pipeline pipeline(PipelineParams{});
     EXPECT_THROW(pipeline.process(f), InputError);
     omp_set_num_threads(threads);
+}
+
+// The choice of the way to run the two parts: trial frames alternate (side by side first),
+// the fastest frame of each way decides for the rest of the period, and the next period
+// tries again.
+TEST(SideBySideChoice, TriesBothWaysThenKeepsTheFaster) {
+    using detail::SideBySideChoice;
+    SideBySideChoice choice;
+    // Side by side: 9 (a seeding frame), 5, 5; one after the other: 6, 5.5, 7.
+    const double trial_ms[] = {9, 6, 5, 5.5, 5, 7};
+    for (int i = 0; i < 2 * SideBySideChoice::kTrials; ++i) {
+        const bool way = choice.next();
+        EXPECT_EQ(way, i % 2 == 0) << i;
+        choice.record(way, trial_ms[i]);
+    }
+    for (int i = 2 * SideBySideChoice::kTrials; i < SideBySideChoice::kPeriod; ++i) {
+        ASSERT_TRUE(choice.next()) << i;
+        choice.record(true, 100);  // kept for the period, whatever these frames take
+    }
+    // Next period: tried again; now one after the other is faster.
+    for (int i = 0; i < 2 * SideBySideChoice::kTrials; ++i) {
+        const bool way = choice.next();
+        EXPECT_EQ(way, i % 2 == 0) << i;
+        choice.record(way, way ? 8.0 : 4.0);
+    }
+    EXPECT_FALSE(choice.next());
 }

@@ -48,8 +48,9 @@ struct PipelineParams {
 };
 
 /// Milliseconds spent in each stage on one frame (0 for a stage that did not run). On two
-/// threads the clustering (with its colours) and the plane and segmentation stages run side
-/// by side (Pipeline::run_on): each is timed as it ran, and `overlap` is the time they shared.
+/// threads the clustering (with its colours) and the plane and segmentation stages may run
+/// side by side (detail::SideBySideChoice): each is timed as it ran, and `overlap` is the time
+/// they shared.
 struct StageTimes {
     double registration = 0, decimation = 0, backprojection = 0, normals = 0, background = 0,
            clustering = 0, colors = 0, plane = 0, segmentation = 0, objects = 0;
@@ -78,6 +79,27 @@ struct FrameResult {
     std::vector<DetectedObject> object_list;   ///< one per object in `objects`
     StageTimes times;
 };
+
+namespace detail {
+/// Whether Pipeline::run_on's two parts (the clustering with its colours; the plane and
+/// segmentation stages) run side by side on two threads: each period of frames starts with
+/// a few frames each way, timed, and goes on the faster way. It pays on new scenes at
+/// --decimate 2, not when the clustering is cheap (a frame repeated) nor on 640x480 frames
+/// (docs/DESIGN.md). Results are the same either way; only the time differs.
+class SideBySideChoice {
+public:
+    static constexpr int kTrials = 3;    ///< frames each way per period (the fastest counts)
+    static constexpr int kPeriod = 300;  ///< frames per choice
+
+    bool next() const;  ///< the way for the coming frame: true = side by side
+    void record(bool side_by_side, double ms);  ///< the coming frame's time for the two parts
+
+private:
+    int frame_ = 0;
+    double best_ms_[2] = {0, 0};  ///< [0] one after the other, [1] side by side
+    bool side_by_side_ = false;
+};
+}  // namespace detail
 
 class Pipeline {
 public:
@@ -108,6 +130,8 @@ private:
     void plane_and_segments(const RgbdFrame& frame, FrameResult& r);
     /// `decimated_result_` carried back to `frame`'s pixels, into result_.
     void expand_result(const RgbdFrame& frame);
+
+    detail::SideBySideChoice side_by_side_;  ///< whether run_on's two parts run side by side
 
     PipelineParams params_;
     PipelineParams stage_params_;  ///< params_.stage_params()
