@@ -292,7 +292,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             gp.y[g] = cloud.y[p];
             gp.z[g] = cloud.z[p];
             // A point without a usable normal gets the zero normal: it then fails every
-            // normal test (cos >= a positive threshold) with no branch (count_inliers).
+            // normal test (cos >= a positive threshold) with no branch (is_inlier).
             const bool use = active[p] && normals.valid[p];
             gp.nx[g] = use ? normals.nx[p] : 0.0f;
             gp.ny[g] = use ? normals.ny[p] : 0.0f;
@@ -398,27 +398,20 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     }
 
     // A grid point is an inlier of a plane when it lies on the plane's band and its normal
-    // agrees with the plane's.
-    auto is_inlier = [&](const Plane& pl, int g) {
-        if (!usable(g)) return false;
-        const std::size_t p = static_cast<std::size_t>(g);
-        const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
-        if (std::fabs(h) > on_band(gp.z[p])) return false;
-        return gp.nx[p] * pl.nx + gp.ny[p] * pl.ny + gp.nz[p] * pl.nz >= cos_inlier;
+    // agrees with the plane's. No branch: a point without a usable normal holds the zero
+    // normal and fails the normal test, so loops over the grid vectorize.
+    const float *const gx = gp.x.data(), *const gy = gp.y.data(), *const gz = gp.z.data();
+    const float *const gnx = gp.nx.data(), *const gny = gp.ny.data(), *const gnz = gp.nz.data();
+    const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
+    auto is_inlier = [=](const Plane& pl, int g) {
+        const float h = pl.nx * gx[g] + pl.ny * gy[g] + pl.nz * gz[g] + pl.d;
+        const bool on = std::fabs(h) <= band_m + band_rel * gz[g] * gz[g];
+        const bool facing = gnx[g] * pl.nx + gny[g] * pl.ny + gnz[g] * pl.nz >= cos_inlier;
+        return on & facing;
     };
-
-    // is_inlier over the whole grid, without branches (the zero normals of the points
-    // without one fail the normal test): the compiler vectorizes it. take(g, inlier).
+    // take(g, is_inlier(pl, g)) over the whole grid.
     auto for_each_inlier_test = [&](const Plane& pl, auto&& take) {
-        const float *x = gp.x.data(), *y = gp.y.data(), *z = gp.z.data();
-        const float *nx = gp.nx.data(), *ny = gp.ny.data(), *nz = gp.nz.data();
-        const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
-        for (int g = 0; g < G; ++g) {
-            const float h = pl.nx * x[g] + pl.ny * y[g] + pl.nz * z[g] + pl.d;
-            const bool on = std::fabs(h) <= band_m + band_rel * z[g] * z[g];
-            const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
-            take(g, on & facing);
-        }
+        for (int g = 0; g < G; ++g) take(g, is_inlier(pl, g));
     };
     auto count_inliers = [&](const Plane& pl) {
         unsigned inliers = 0;
@@ -552,7 +545,6 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     // far as the compiler knows).
     const HullMask hull = hull_of_plane(pl);
     const float pnx = pl.nx, pny = pl.ny, pnz = pl.nz, pd = pl.d;
-    const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
 #pragma omp parallel for schedule(static) reduction(+ : kept)
     for (int v = 0; v < H; ++v) {
         int runs = 0;

@@ -100,6 +100,8 @@ struct SegmentWorkspace {
     std::vector<int> remap;
     std::vector<int> offsets;  ///< counting sort of pixels by label
     std::vector<int> order;
+    // The final renumbering (compact) reuses sizes, offsets and order for each label's pixel
+    // count, first pixel and the labels kept, in order of their first pixel.
     std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
     std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
