@@ -302,7 +302,10 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         }
     }
     auto usable = [&](int g) { return gp.usable[static_cast<std::size_t>(g)] != 0; };
-    auto on_band = [&](float z) { return params.on_plane_m + params.on_plane_rel * z * z; };
+    // The plane's band at depth z, from plain values (captured by value: the grid loops below
+    // vectorize, and a byte store there cannot change them as far as the compiler knows).
+    const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
+    auto on_band = [band_m, band_rel](float z) { return band_m + band_rel * z * z; };
 
     // 1. Region growing on the grid: a neighbour joins when its normal agrees with the
     //    region's mean normal and it lies on the region's mean plane.
@@ -325,7 +328,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             const int nb[4] = {gu > 0 ? g - 1 : -1, gu + 1 < grid.w ? g + 1 : -1,
                                gv > 0 ? g - grid.w : -1, gv + 1 < grid.h ? g + grid.w : -1};
             // Most points popped have no free neighbour left: the region's mean is only
-            // worked out (a square root, six divisions) when one has.
+            // worked out when one has.
             int free_nb[4], n_free = 0;
             for (int q : nb)
                 if (q >= 0 && ws.region[q] == -1 && usable(q)) free_nb[n_free++] = q;
@@ -402,10 +405,9 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     // normal and fails the normal test, so loops over the grid vectorize.
     const float *const gx = gp.x.data(), *const gy = gp.y.data(), *const gz = gp.z.data();
     const float *const gnx = gp.nx.data(), *const gny = gp.ny.data(), *const gnz = gp.nz.data();
-    const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
     auto is_inlier = [=](const Plane& pl, int g) {
         const float h = pl.nx * gx[g] + pl.ny * gy[g] + pl.nz * gz[g] + pl.d;
-        const bool on = std::fabs(h) <= band_m + band_rel * gz[g] * gz[g];
+        const bool on = std::fabs(h) <= on_band(gz[g]);
         const bool facing = gnx[g] * pl.nx + gny[g] * pl.ny + gnz[g] * pl.nz >= cos_inlier;
         return on & facing;
     };
@@ -541,8 +543,8 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     const std::uint8_t *const act = active.data(), *const has_normal = normals.valid.data();
     std::uint8_t* const cls = classes.data();
     std::uint8_t* const band_out = ws.on_band.data();
-    // ... and the plane and the band as plain values (a byte store could change them too, as
-    // far as the compiler knows).
+    // ... and the plane as plain values (a byte store could change it too, as far as the
+    // compiler knows).
     const HullMask hull = hull_of_plane(pl);
     const float pnx = pl.nx, pny = pl.ny, pnz = pl.nz, pd = pl.d;
 #pragma omp parallel for schedule(static) reduction(+ : kept)
@@ -555,7 +557,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             std::uint8_t on_band_removed = 0;
             if (act[p]) {
                 const float x = xs[p], y = ys[p], z = zs[p];
-                const float h = pnx * x + pny * y + pnz * z + pd, band = band_m + band_rel * z * z;
+                const float h = pnx * x + pny * y + pnz * z + pd, band = on_band(z);
                 if (h > band) {
                     if (hull.has_foot(x, y, z, h)) c = kPlaneObject;
                 } else if (h > -band && has_normal[p] &&
