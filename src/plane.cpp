@@ -520,19 +520,101 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         }
     }
 
+    // 5. The chosen plane, refined. Merges chain (each pair within merge_dist_m) from a
+    //    table's pieces to the tops of flat objects lying on it (books, magazines), and the
+    //    plane fitted to them all lies between the layers: 6 mm above the table on a cluttered
+    //    OSD frame, 7.6 mm in a synthetic scene of books, where half the books' points fell
+    //    into its band. On a band half as wide the layers part: the densest such band of
+    //    heights over the chosen plane (a histogram of heights in half bands, as the band
+    //    widens with depth) is the layer that carries most, the table; least squares on its
+    //    points, then on the points on the new plane's half band, fit it alone. (A chain
+    //    across stacked layers that also tilts the plane is only halved: 2 cm to 1 cm on that
+    //    OSD frame at half resolution.)
+    auto on_layer = [=](const Plane& pl, int g) {
+        const float h = pl.nx * gx[g] + pl.ny * gy[g] + pl.nz * gz[g] + pl.d;
+        const bool on = std::fabs(h) <= 0.5f * on_band(gz[g]);
+        const bool facing = gnx[g] * pl.nx + gny[g] * pl.ny + gnz[g] * pl.nz >= cos_inlier;
+        return on & facing;
+    };
+    auto refine_support = [&](const Plane& chosen) {
+        // Heights over the chosen plane in half bands (far off the histogram where the normal
+        // does not face like the plane's), binned kPerBand to the unit over [-kRange, kRange).
+        constexpr int kPerBand = 8, kRange = 6, kBins = 2 * kRange * kPerBand;
+        ws.layer_t.resize(static_cast<std::size_t>(G));
+        float* const t = ws.layer_t.data();
+        const float cnx = chosen.nx, cny = chosen.ny, cnz = chosen.nz, cd = chosen.d;
+#pragma omp parallel for simd schedule(static)
+        for (int g = 0; g < G; ++g) {
+            const float h = cnx * gx[g] + cny * gy[g] + cnz * gz[g] + cd;
+            const bool facing = gnx[g] * cnx + gny[g] * cny + gnz[g] * cnz >= cos_inlier;
+            t[g] = facing ? h / (0.5f * on_band(gz[g])) : 1e9f;
+        }
+        int histogram[kBins] = {};
+        for (int g = 0; g < G; ++g) {
+            const float bin = (t[g] + kRange) * kPerBand;
+            if (bin >= 0.0f && bin < static_cast<float>(kBins)) ++histogram[static_cast<int>(bin)];
+        }
+        // The window of one half band either side with most points; the lowest on a tie.
+        int best_bin = 0, most = -1;
+        for (int c = 0; c < kBins; ++c) {
+            int n = 0;
+            for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b) n += histogram[b];
+            if (n > most) {
+                most = n;
+                best_bin = c;
+            }
+        }
+        const float layer = static_cast<float>(best_bin) / kPerBand - kRange;
+        // The least-squares plane (as `fit`) of the grid points that in(g) takes, split across
+        // cores; the moments as masked sums that vectorize.
+        auto fit_layer = [&](auto&& in, Plane& out) {
+            double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+#pragma omp parallel for simd schedule(static) reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
+            for (int g = 0; g < G; ++g) {
+                const double m = in(g) ? 1.0 : 0.0;
+                const double px = m * gx[g], py = m * gy[g], pz = m * gz[g];
+                n += m;
+                x += px; y += py; z += pz;
+                xx += px * gx[g]; xy += px * gy[g]; xz += px * gz[g];
+                yy += py * gy[g]; yz += py * gz[g]; zz += pz * gz[g];
+            }
+            if (n < params.min_region_points) return false;
+            const double s[kSums] = {n, x, y, z, xx, xy, xz, yy, yz, zz, 0, 0, 0};
+            out = fit(s);
+            return true;
+        };
+        // First the histogram's window, then the new plane's half band.
+        Plane pl = chosen;
+        if (fit_layer([=](int g) { return std::fabs(t[g] - layer) <= 1.0f; }, pl)) {
+            const Plane first = pl;
+            fit_layer([=](int g) { return on_layer(first, g); }, pl);
+        }
+        pl.inliers = count_inliers(pl);
+        pl.above = chosen.above;
+        return pl;
+    };
+
     if (best < 0) {
         for (std::size_t p = 0; p < N; ++p) classes[p] = active[p] ? kPlaneObject : kPlaneRemoved;
         result.kept = static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
         return result;
     }
     result.found = true;
-    result.support = result.candidates[static_cast<std::size_t>(best)];
+    result.support = refine_support(result.candidates[static_cast<std::size_t>(best)]);
     const Plane pl = result.support;
-    if (hull_of != best) build_hull(pl);
+    // The support's extent: the chosen plane's serves unless the refinement moved the plane
+    // (most frames: by under a millimetre).
+    {
+        const Plane& chosen = result.candidates[static_cast<std::size_t>(best)];
+        const float cos_moved = pl.nx * chosen.nx + pl.ny * chosen.ny + pl.nz * chosen.nz;
+        if (hull_of != best || std::fabs(pl.d - chosen.d) > 0.25f * params.on_plane_m ||
+            cos_moved < std::cos(1.0f * kDegToRad))
+            build_hull(pl);
+    }
     ws.on_band.resize(N);
     ws.row_first_run.assign(static_cast<std::size_t>(H) + 1, 0);
 
-    // 5. Classify every pixel: below or on the plane (and facing like it) is removed; on the
+    // 6. Classify every pixel: below or on the plane (and facing like it) is removed; on the
     //    band but facing otherwise is a candidate foot; above and over the support is object.
     //    The runs of removed on-band pixels are counted per row for restore_islands.
     std::size_t kept = 0;

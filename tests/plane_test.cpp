@@ -120,6 +120,48 @@ TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
     EXPECT_EQ(r.kept, active);
 }
 
+// Flat objects over much of the table (six books, 2 cm thick): their tops are within the
+// merge distance of the table's pieces, and the plane fitted to both lay 7.6 mm above the
+// table, in whose band 45 % of the books' points fell. The support is refined on the
+// table's own points: they lie on it, and the books stand on it.
+TEST(RemoveSupportPlane, BooksCoveringTheTable_SupportStaysOnTheTable) {
+    Scene s = pitched_tabletop_scene();
+    const float xs[3] = {-0.3f, 0.05f, 0.35f};
+    const float zs[2] = {0.8f, 1.15f};
+    for (float x : xs)
+        for (float z : zs) {
+            SceneBox book;
+            book.x = x;
+            book.z = z;
+            book.w = 0.26f;
+            book.d = 0.3f;
+            book.h = 0.02f;
+            s.boxes.push_back(book);
+        }
+    std::vector<int> truth;
+    Prepared f = prepared(render_scene(s, &truth));
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
+    ASSERT_TRUE(r.found);
+    double height = 0;
+    std::size_t table = 0, books = 0, books_kept = 0;
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        if (!f.active[p]) continue;
+        if (truth[p] == kTruthTable) {
+            ++table;
+            height += r.support.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p]);
+        } else if (truth[p] >= kTruthBox0 && truth[p] < kTruthBox0 + 6) {
+            ++books;
+            books_kept += classes[p] != kPlaneRemoved;
+        }
+    }
+    ASSERT_GT(table, 5000u);
+    ASSERT_GT(books, 10000u);
+    EXPECT_LT(std::fabs(height / static_cast<double>(table)), 0.001);
+    EXPECT_GT(static_cast<double>(books_kept) / static_cast<double>(books), 0.95);
+}
+
 // Real uncropped tabletop frames (data/samples/uois_tabletop, MIT): floor, walls, chairs
 // and other furniture are in view. The support must be the table under the objects: a
 // patch of that table, picked by eye in each frame, is removed and the support's normal is
@@ -146,7 +188,7 @@ TEST(RemoveSupportPlane, RealUncroppedTabletops_ChoosesTheTableUnderTheObjects) 
         EXPECT_GT(r.support.up, 0.5f);
         const int W = f.cloud.width;
         std::size_t patch = 0, removed = 0;
-        double mx = 0, my = 0, mz = 0;
+        double mx = 0, my = 0, mz = 0, height = 0;
         for (int v = patches[i].v - 10; v <= patches[i].v + 10; ++v)
             for (int u = patches[i].u - 10; u <= patches[i].u + 10; ++u) {
                 const std::size_t p = static_cast<std::size_t>(v) * W + u;
@@ -156,12 +198,18 @@ TEST(RemoveSupportPlane, RealUncroppedTabletops_ChoosesTheTableUnderTheObjects) 
                 mx += f.normals.nx[p];
                 my += f.normals.ny[p];
                 mz += f.normals.nz[p];
+                height += r.support.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p]);
             }
         ASSERT_GT(patch, 300u);
         EXPECT_GT(static_cast<double>(removed) / static_cast<double>(patch), 0.95);
+        // The patch lies on the support ...
+        EXPECT_LT(std::fabs(height / static_cast<double>(patch)), 0.003);
+        // ... and faces like it, within what the sensor's depth wobble leaves of a 21 x 21
+        // patch: image_0005's patch is 8 degrees off the plane of the whole table, and 2 off
+        // that of the 61 x 61 pixels around it.
         const double len = std::sqrt(mx * mx + my * my + mz * mz);
         const double cos_angle = (mx * r.support.nx + my * r.support.ny + mz * r.support.nz) / len;
-        EXPECT_GT(cos_angle, std::cos(8.0 * 3.14159265 / 180.0));
+        EXPECT_GT(cos_angle, std::cos(10.0 * 3.14159265 / 180.0));
         std::size_t kept = 0, active = 0;
         for (std::size_t p = 0; p < classes.size(); ++p) {
             active += f.active[p];

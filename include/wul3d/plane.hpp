@@ -85,6 +85,8 @@ struct PlaneWorkspace {
     std::vector<std::uint8_t> hull;   ///< grid-resolution mask of the support's extent
     std::vector<int> hull_points;     ///< (gu, gv) pairs: each grid row's outermost inliers
     std::vector<Plane> fitted;        ///< the merged planes, fitted, inliers counted
+    std::vector<float> layer_t;       ///< per grid point: height over the chosen support in
+                                      ///< half bands (1e9 if it does not face like it)
     std::vector<int> by_extent;       ///< candidate indices, largest extent first
     std::vector<std::uint32_t> candidate_bits;  ///< per grid point: bit r = inlier of rank r
     std::vector<int> shared;          ///< inliers two candidates share (ranks i > j)
