@@ -405,9 +405,10 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     // normal and fails the normal test, so loops over the grid vectorize.
     const float *const gx = gp.x.data(), *const gy = gp.y.data(), *const gz = gp.z.data();
     const float *const gnx = gp.nx.data(), *const gny = gp.ny.data(), *const gnz = gp.nz.data();
-    auto is_inlier = [=](const Plane& pl, int g) {
+    // `band_share` narrows the band: step 5 parts layers on half of it.
+    auto is_inlier = [=](const Plane& pl, int g, float band_share = 1.0f) {
         const float h = pl.nx * gx[g] + pl.ny * gy[g] + pl.nz * gz[g] + pl.d;
-        const bool on = std::fabs(h) <= on_band(gz[g]);
+        const bool on = std::fabs(h) <= band_share * on_band(gz[g]);
         const bool facing = gnx[g] * pl.nx + gny[g] * pl.ny + gnz[g] * pl.nz >= cos_inlier;
         return on & facing;
     };
@@ -530,12 +531,6 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     //    points, then on the points on the new plane's half band, fit it alone. (A chain
     //    across stacked layers that also tilts the plane is only halved: 2 cm to 1 cm on that
     //    OSD frame at half resolution.)
-    auto on_layer = [=](const Plane& pl, int g) {
-        const float h = pl.nx * gx[g] + pl.ny * gy[g] + pl.nz * gz[g] + pl.d;
-        const bool on = std::fabs(h) <= 0.5f * on_band(gz[g]);
-        const bool facing = gnx[g] * pl.nx + gny[g] * pl.ny + gnz[g] * pl.nz >= cos_inlier;
-        return on & facing;
-    };
     auto refine_support = [&](const Plane& chosen) {
         // Heights over the chosen plane in half bands (far off the histogram where the normal
         // does not face like the plane's), binned kPerBand to the unit over [-kRange, kRange).
@@ -587,7 +582,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         Plane pl = chosen;
         if (fit_layer([=](int g) { return std::fabs(t[g] - layer) <= 1.0f; }, pl)) {
             const Plane first = pl;
-            fit_layer([=](int g) { return on_layer(first, g); }, pl);
+            fit_layer([=](int g) { return is_inlier(first, g, 0.5f); }, pl);
         }
         pl.inliers = count_inliers(pl);
         pl.above = chosen.above;
