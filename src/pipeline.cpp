@@ -268,7 +268,7 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
         for (int u = 0; u < w; ++u)
             out[u] = min3(lo_up[u], lo_row[u], lo_down[u]) != max3(hi_up[u], hi_row[u], hi_down[u]);
     }
-    source.use_colour_at_edges(frame.color, decimated_.color, edge_blocks_.data());
+    source.use_colour_at_edges(frame.color, decimated_.color, edge_blocks_.data(), l, block_source_);
     r.stats = s.stats;
     r.plane = s.plane;
     r.segment_stats = s.segment_stats;
