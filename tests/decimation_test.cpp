@@ -265,7 +265,7 @@ TEST(PipelineParams, DecimationScalesObjectSizesNotNeighbourhoods) {
     EXPECT_EQ(s.segmentation.merge_min_boundary, 3);
     EXPECT_EQ(s.segmentation.rim_min_boundary, 5);
     EXPECT_EQ(s.objects.min_points, 25);
-    EXPECT_EQ(s.plane.grid_stride_px, 2);
+    EXPECT_EQ(s.plane.grid_stride_px, p.plane.grid_stride_px);
     EXPECT_EQ(s.plane.hull_margin_px, 6);
     EXPECT_EQ(s.normals.radius_px, p.normals.radius_px);
     EXPECT_EQ(s.segmentation.crease_step_px, p.segmentation.crease_step_px);

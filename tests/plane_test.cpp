@@ -238,7 +238,9 @@ TEST(RemoveSupportPlane, RealTabletopHalfResolution_SliverOfTheFloorIsNotTheSupp
     RgbdFrame small;
     decimate_frame(item.frame, 2, small);
     const Prepared half = prepared(small);
-    PlaneParams params;  // as the pipeline scales them at --decimate 2
+    // A grid of every 2nd pixel, where the sliver forms (the pipeline's grid at N = 2 is
+    // every 4th decimated pixel, too coarse for it to form at all).
+    PlaneParams params;
     params.grid_stride_px = 2;
     params.hull_margin_px = 6;
     const PlaneResult r = half.remove_plane(params, ws, classes);
