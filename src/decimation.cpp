@@ -131,9 +131,9 @@ void DecimatedSource::vote(const std::uint16_t* labels, std::int32_t* source) co
             const float z = small_[b], tolerance = same_ + same_rel_ * z * z;
             const std::uint8_t* const c = small_rgb_ + 3 * static_cast<std::size_t>(b);
             const std::uint16_t own = labels[b];
-            // The other labels vote together (an outline mostly parts two); the block nearest
-            // in colour among theirs speaks for them. Selects, not branches: which way a vote
-            // goes is what the loop cannot predict.
+            // The other labels vote together (an outline mostly parts two; counting each apart
+            // scored the same on osd_mosd), and the block nearest in colour among theirs
+            // speaks for them.
             float own_total = 0, other_total = 0;
             int nearest_d = std::numeric_limits<int>::max();
             std::int32_t nearest = b;

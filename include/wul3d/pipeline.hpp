@@ -172,7 +172,7 @@ private:
     std::vector<PixelBox> band_boxes_;
     std::vector<std::uint8_t> edge_blocks_;  ///< decimated pixels at an object's outline
     std::vector<std::uint16_t> edge_lo_, edge_hi_;  ///< their 3-wide row minima and maxima
-    std::vector<std::int32_t> block_source_;  ///< each decimated pixel's source after the colour vote
+    std::vector<std::int32_t> block_source_;  ///< each edge block's source after the colour vote
     FrameResult result_;
 };
 
