@@ -561,7 +561,8 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         }
         const float layer = static_cast<float>(best_bin) / kPerBand - kRange;
         // The least-squares plane (as `fit`) of the grid points that in(g) takes, split across
-        // cores; the moments as masked sums that vectorize.
+        // cores: detail::add_moments spelled out as masked sums, in its layout, because an
+        // OpenMP reduction needs them as scalars (and then they vectorize).
         auto fit_layer = [&](auto&& in, Plane& out) {
             double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
 #pragma omp parallel for simd schedule(static) reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
