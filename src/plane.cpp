@@ -525,12 +525,13 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     //    table's pieces to the tops of flat objects lying on it (books, magazines), and the
     //    plane fitted to them all lies between the layers: 6 mm above the table on a cluttered
     //    OSD frame, 7.6 mm in a synthetic scene of books, where half the books' points fell
-    //    into its band. On a band half as wide the layers part: the densest such band of
-    //    heights over the chosen plane (a histogram of heights in half bands, as the band
-    //    widens with depth) is the layer that carries most, the table; least squares on its
-    //    points, then on the points on the new plane's half band, fit it alone. (A chain
-    //    across stacked layers that also tilts the plane is only halved: 2 cm to 1 cm on that
-    //    OSD frame at half resolution.)
+    //    into its band. On a band half as wide the layers part (a histogram of heights over
+    //    the chosen plane, in half bands, as the band widens with depth). The support is the
+    //    lowest layer that holds many points, not the densest: what lies on the table is
+    //    above it, and when the chain also tilts the plane the table's points spread over
+    //    several bands, where the densest can be a ramp from the table to the books' tops
+    //    (OSD's test59 at half resolution: 10 mm off the table). Least squares on that layer's
+    //    points, then on the points on the new plane's half band, fit it alone.
     auto refine_support = [&](const Plane& chosen) {
         // Heights over the chosen plane in half bands (far off the histogram where the normal
         // does not face like the plane's), binned kPerBand to the unit over [-kRange, kRange).
@@ -549,16 +550,19 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             const float bin = (t[g] + kRange) * kPerBand;
             if (bin >= 0.0f && bin < static_cast<float>(kBins)) ++histogram[static_cast<int>(bin)];
         }
-        // The window of one half band either side with most points; the lowest on a tie.
-        int best_bin = 0, most = -1;
+        // Points in the window of one half band either side of each bin.
+        int window[kBins], most = 0;
         for (int c = 0; c < kBins; ++c) {
-            int n = 0;
-            for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b) n += histogram[b];
-            if (n > most) {
-                most = n;
-                best_bin = c;
-            }
+            window[c] = 0;
+            for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b)
+                window[c] += histogram[b];
+            most = std::max(most, window[c]);
         }
+        // The lowest window with kLayerShare of the densest one's points.
+        constexpr float kLayerShare = 0.3f;
+        int best_bin = 0;
+        while (best_bin + 1 < kBins && static_cast<float>(window[best_bin]) < kLayerShare * static_cast<float>(most))
+            ++best_bin;
         const float layer = static_cast<float>(best_bin) / kPerBand - kRange;
         // The least-squares plane (as `fit`) of the grid points that in(g) takes, split across
         // cores: detail::add_moments spelled out as masked sums, in its layout, because an
