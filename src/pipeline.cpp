@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <exception>
 
 #include "param_check.hpp"
@@ -315,6 +316,27 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
     std::uint8_t *const colors = r.colors.rgb.data(), *const active_out = r.active.data(),
                  *const classes = r.plane_classes.data();
     const int* const object_index = object_index_.data();
+    // A pixel is in the depth range by its own depth, as at every pixel (select_depth_range):
+    // its block's sample can lie on the other side of a limit. In range, on a block that is
+    // not, it takes the nearest in depth of the 3 x 3 blocks that are; out of range, none.
+    const float scale = frame.depth.scale_m_per_unit, zmin = params_.range.zmin_m,
+                zmax = params_.range.zmax_m;
+    const std::uint16_t *const depth = frame.depth.data.data(), *const block_depth = decimated_.depth.data.data();
+    const int bw = decimated_.width(), bh = decimated_.height();
+    auto nearest_active_block = [&](int bu, int bv, std::uint16_t d) {
+        std::int32_t best = -1;
+        int best_gap = 1 << 30;
+        for (int y = std::max(0, bv - 1); y <= std::min(bh - 1, bv + 1); ++y)
+            for (int x = std::max(0, bu - 1); x <= std::min(bw - 1, bu + 1); ++x) {
+                const std::int32_t b = y * bw + x;
+                const int gap = std::abs(static_cast<int>(block_depth[b]) - static_cast<int>(d));
+                if (in_active[b] && gap < best_gap) {
+                    best_gap = gap;
+                    best = b;
+                }
+            }
+        return best;
+    };
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kExpandBands; ++band) {
         PixelBox* const boxes = band_boxes_.data() + static_cast<std::size_t>(band) * n_obj;
@@ -324,7 +346,14 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
             for (int u = 0, bu = 0, in_block = 0; u < W; ++u) {
                 const std::size_t p = static_cast<std::size_t>(v) * W + u;
                 std::uint8_t* const rgb = colors + 3 * p;
-                const std::int32_t q = source.in_block(u, v, bu, bv);
+                std::int32_t q = source.in_block(u, v, bu, bv);
+                if (q >= 0) {
+                    const float z = static_cast<float>(depth[p]) * scale;
+                    if (!(z >= zmin && z <= zmax))
+                        q = -1;
+                    else if (!in_active[q])
+                        q = nearest_active_block(bu, bv, depth[p]);
+                }
                 if (++in_block == source.factor()) {
                     in_block = 0;
                     ++bu;
