@@ -165,10 +165,10 @@ TEST(RemoveSupportPlane, BooksCoveringTheTable_SupportStaysOnTheTable) {
 
 // Books over the far half of the table only: the plane fitted to the chain of the near
 // table and the books' tops is tilted, a ramp from one to the other. Over it the table's
-// points spread across several half bands and the densest band held the ramp: the support
-// lay 2 mm under the table on average, 5 mm apart from it at either end (standard
-// deviation), and a third of the books' points went with it (two thirds at N = 2). The
-// lowest band with many points is the table.
+// points spread across several half bands and the densest band held the ramp: the table
+// lay 2 mm under the support on average with a spread of 5 mm (standard deviation), and a
+// third of the books' points went with it (two thirds at N = 2). The lowest band with many
+// points is the table.
 TEST(RemoveSupportPlane, BooksOnTheFarHalf_SupportIsTheTableNotARamp) {
     Scene s = pitched_tabletop_scene();
     for (float x : {-0.3f, 0.05f, 0.35f})
