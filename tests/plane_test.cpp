@@ -39,6 +39,56 @@ Prepared prepared(RgbdFrame frame) {
     select_depth_range(DepthRange{}, f.cloud, f.active);
     return f;
 }
+
+/// Six books 2 cm thick lying flat, 0.3 m deep and `width` wide, at x in `xs` and z in `zs`
+/// (ground-truth ids kTruthBox0 to kTruthBox0 + 5).
+void add_books(Scene& s, const float (&xs)[3], const float (&zs)[2], float width) {
+    for (float x : xs)
+        for (float z : zs) {
+            SceneBox book;
+            book.x = x;
+            book.z = z;
+            book.w = width;
+            book.d = 0.3f;
+            book.h = 0.02f;
+            s.boxes.push_back(book);
+        }
+}
+
+/// The table's active points, their heights over the support, and the books' points kept.
+struct TableAndBooks {
+    std::size_t table = 0, books = 0, books_kept = 0;
+    double height_sum = 0, height_sum2 = 0;
+    double mean_height() const { return height_sum / static_cast<double>(table); }
+    double height_spread() const {
+        const double m = mean_height();
+        return std::sqrt(height_sum2 / static_cast<double>(table) - m * m);
+    }
+    double books_kept_share() const {
+        return static_cast<double>(books_kept) / static_cast<double>(books);
+    }
+};
+
+/// Tallies `f` after plane removal; `truth_of(p)` gives pixel p's ground-truth id.
+template <class TruthOf>
+TableAndBooks tally(const Prepared& f, const PlaneResult& r, const std::vector<std::uint8_t>& classes,
+                    TruthOf&& truth_of) {
+    TableAndBooks t;
+    for (std::size_t p = 0; p < f.cloud.size(); ++p) {
+        if (!f.active[p]) continue;
+        const int truth = truth_of(p);
+        if (truth == kTruthTable) {
+            ++t.table;
+            const double h = r.support.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p]);
+            t.height_sum += h;
+            t.height_sum2 += h * h;
+        } else if (truth >= kTruthBox0 && truth < kTruthBox0 + 6) {
+            ++t.books;
+            t.books_kept += classes[p] != kPlaneRemoved;
+        }
+    }
+    return t;
+}
 }  // namespace
 
 TEST(PlaneParams, Validate_RejectsOutOfRangeFields) {
@@ -127,40 +177,18 @@ TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
 // table's own points: they lie on it, and the books stand on it.
 TEST(RemoveSupportPlane, BooksCoveringTheTable_SupportStaysOnTheTable) {
     Scene s = pitched_tabletop_scene();
-    const float xs[3] = {-0.3f, 0.05f, 0.35f};
-    const float zs[2] = {0.8f, 1.15f};
-    for (float x : xs)
-        for (float z : zs) {
-            SceneBox book;
-            book.x = x;
-            book.z = z;
-            book.w = 0.26f;
-            book.d = 0.3f;
-            book.h = 0.02f;
-            s.boxes.push_back(book);
-        }
+    add_books(s, {-0.3f, 0.05f, 0.35f}, {0.8f, 1.15f}, 0.26f);
     std::vector<int> truth;
     Prepared f = prepared(render_scene(s, &truth));
     PlaneWorkspace ws;
     std::vector<std::uint8_t> classes;
     const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
     ASSERT_TRUE(r.found);
-    double height = 0;
-    std::size_t table = 0, books = 0, books_kept = 0;
-    for (std::size_t p = 0; p < truth.size(); ++p) {
-        if (!f.active[p]) continue;
-        if (truth[p] == kTruthTable) {
-            ++table;
-            height += r.support.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p]);
-        } else if (truth[p] >= kTruthBox0 && truth[p] < kTruthBox0 + 6) {
-            ++books;
-            books_kept += classes[p] != kPlaneRemoved;
-        }
-    }
-    ASSERT_GT(table, 5000u);
-    ASSERT_GT(books, 10000u);
-    EXPECT_LT(std::fabs(height / static_cast<double>(table)), 0.001);
-    EXPECT_GT(static_cast<double>(books_kept) / static_cast<double>(books), 0.95);
+    const TableAndBooks t = tally(f, r, classes, [&](std::size_t p) { return truth[p]; });
+    ASSERT_GT(t.table, 5000u);
+    ASSERT_GT(t.books, 10000u);
+    EXPECT_LT(std::fabs(t.mean_height()), 0.001);
+    EXPECT_GT(t.books_kept_share(), 0.95);
 }
 
 // Books over the far half of the table only: the plane fitted to the chain of the near
@@ -171,16 +199,7 @@ TEST(RemoveSupportPlane, BooksCoveringTheTable_SupportStaysOnTheTable) {
 // points is the table.
 TEST(RemoveSupportPlane, BooksOnTheFarHalf_SupportIsTheTableNotARamp) {
     Scene s = pitched_tabletop_scene();
-    for (float x : {-0.3f, 0.05f, 0.35f})
-        for (float z : {1.0f, 1.4f}) {
-            SceneBox book;
-            book.x = x;
-            book.z = z;
-            book.w = 0.3f;
-            book.d = 0.3f;
-            book.h = 0.02f;
-            s.boxes.push_back(book);
-        }
+    add_books(s, {-0.3f, 0.05f, 0.35f}, {1.0f, 1.4f}, 0.3f);
     std::vector<int> full_truth;
     const RgbdFrame full = render_scene(s, &full_truth);
     for (int n : {1, 2}) {
@@ -192,28 +211,15 @@ TEST(RemoveSupportPlane, BooksOnTheFarHalf_SupportIsTheTableNotARamp) {
         std::vector<std::uint8_t> classes;
         const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
         ASSERT_TRUE(r.found);
-        double sum = 0, sum2 = 0;
-        std::size_t table = 0, books = 0, books_kept = 0;
-        const int W = f.frame.width();
-        for (std::size_t p = 0; p < f.cloud.size(); ++p) {
-            if (!f.active[p]) continue;
-            const int truth = full_truth[(p / W) * n * full.width() + (p % W) * n];
-            if (truth == kTruthTable) {
-                ++table;
-                const double h = r.support.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p]);
-                sum += h;
-                sum2 += h * h;
-            } else if (truth >= kTruthBox0 && truth < kTruthBox0 + 6) {
-                ++books;
-                books_kept += classes[p] != kPlaneRemoved;
-            }
-        }
-        ASSERT_GT(table, 20000u / (n * n));
-        ASSERT_GT(books, 10000u / (n * n));
-        const double mean = sum / static_cast<double>(table);
-        EXPECT_LT(std::fabs(mean), 0.001);
-        EXPECT_LT(std::sqrt(sum2 / static_cast<double>(table) - mean * mean), 0.001);
-        EXPECT_GT(static_cast<double>(books_kept) / static_cast<double>(books), 0.95);
+        const std::size_t W = static_cast<std::size_t>(f.frame.width());
+        const TableAndBooks t = tally(f, r, classes, [&](std::size_t p) {
+            return full_truth[(p / W) * n * full.width() + (p % W) * n];
+        });
+        ASSERT_GT(t.table, 20000u / (n * n));
+        ASSERT_GT(t.books, 10000u / (n * n));
+        EXPECT_LT(std::fabs(t.mean_height()), 0.001);
+        EXPECT_LT(t.height_spread(), 0.001);
+        EXPECT_GT(t.books_kept_share(), 0.95);
     }
 }
 
