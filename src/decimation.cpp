@@ -31,7 +31,7 @@ const std::array<float, kWeights>& vote_weights() {
 
 }  // namespace
 
-void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out) {
+void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out, const DepthRange* range) {
     detail::require_param(factor >= 1 && factor <= 8, "", "decimate", factor, "in [1, 8]");
     const int W = in.width(), H = in.height();
     const bool color = in.has_color();
@@ -57,20 +57,28 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out) {
     const std::uint16_t* const depth = in.depth.data.data();
     const std::uint8_t* const rgb = color ? in.color.rgb.data() : nullptr;
 
+    // In range as select_depth_range decides it: z = depth * scale in float.
+    const float scale = in.depth.scale_m_per_unit;
+    const float zmin = range ? range->zmin_m : 0.0f;
+    const float zmax = range ? range->zmax_m : std::numeric_limits<float>::infinity();
+
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
         for (int u = 0; u < w; ++u) {
-            // The block's first pixel with depth, row-major; the top-left one if none has.
-            std::size_t pick = static_cast<std::size_t>(v) * factor * W + static_cast<std::size_t>(u) * factor;
+            // The block's first pixel in range, row-major; else its first with depth; else
+            // its top-left one.
+            const std::size_t top_left = static_cast<std::size_t>(v) * factor * W + static_cast<std::size_t>(u) * factor;
+            std::size_t pick = top_left;
             const int rows = std::min(factor, H - v * factor), cols = std::min(factor, W - u * factor);
-            bool found = false;
-            for (int dv = 0; dv < rows && !found; ++dv)
-                for (int du = 0; du < cols && !found; ++du) {
-                    const std::size_t q = static_cast<std::size_t>(v * factor + dv) * W + u * factor + du;
-                    if (depth[q] != 0) {
-                        pick = q;
-                        found = true;
-                    }
+            bool with_depth = false, in_range = false;
+            for (int dv = 0; dv < rows && !in_range; ++dv)
+                for (int du = 0; du < cols && !in_range; ++du) {
+                    const std::size_t q = top_left + static_cast<std::size_t>(dv) * W + du;
+                    if (depth[q] == 0) continue;
+                    const float z = static_cast<float>(depth[q]) * scale;
+                    in_range = z >= zmin && z <= zmax;
+                    if (in_range || !with_depth) pick = q;
+                    with_depth = true;
                 }
             const std::size_t o = static_cast<std::size_t>(v) * w + u;
             out.depth.data[o] = depth[pick];

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <exception>
+#include <utility>
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
@@ -17,6 +18,7 @@ PipelineParams PipelineParams::paper() {
     p.cluster = ClusterParams::paper();
     p.range.zmin_m = 0.5f;  // Kinect v2's working range (paper, section II.A)
     p.range.zmax_m = 4.5f;
+    p.decimation = 1;  // every point, as the paper clusters them
     return p;
 }
 
@@ -87,7 +89,7 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
         run_on(frame, result_);
     } else {
         auto t = Clock::now();
-        decimate_frame(frame, n, decimated_);
+        decimate_frame(frame, n, decimated_, &params_.range);
         double ms = ms_since(t);
         run_on(decimated_, decimated_result_);
         t = Clock::now();
@@ -317,8 +319,9 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
                  *const classes = r.plane_classes.data();
     const int* const object_index = object_index_.data();
     // A pixel is in the depth range by its own depth, as at every pixel (select_depth_range):
-    // its block's sample can lie on the other side of a limit. In range, on a block that is
-    // not, it takes the nearest in depth of the 3 x 3 blocks that are; out of range, none.
+    // the block it takes can lie on the other side of a limit. In range, on a block that is
+    // not, it takes the nearest in depth of the 3 x 3 blocks that are (its own is: the frame
+    // was decimated to blocks in range where they could be); out of range, none.
     const float scale = frame.depth.scale_m_per_unit, zmin = params_.range.zmin_m,
                 zmax = params_.range.zmax_m;
     const std::uint16_t *const depth = frame.depth.data.data(), *const block_depth = decimated_.depth.data.data();
@@ -397,6 +400,24 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
         d.u_max = total.u_max;
         d.v_max = total.v_max;
     }
+    // The tracker's minimum (ObjectParams::min_points) counts the input's pixels: the stages
+    // checked it divided by N^2 on blocks, and an object can come back a few pixels short.
+    const auto min_pixels = static_cast<std::size_t>(params_.objects.min_points);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n_obj; ++i) {
+        DetectedObject& d = r.object_list[i];
+        if (d.pixels >= min_pixels) {
+            if (kept != i) r.object_list[kept] = std::move(d);
+            ++kept;
+            continue;
+        }
+        for (int v = d.v_min; v <= d.v_max; ++v)
+            for (int u = d.u_min; u <= d.u_max; ++u) {
+                std::uint16_t& id = objects_out[static_cast<std::size_t>(v) * W + u];
+                if (id == d.id) id = 0;
+            }
+    }
+    r.object_list.resize(kept);
 }
 
 }  // namespace wul3d

@@ -81,6 +81,30 @@ TEST(DecimateFrame, EachBlockTakesItsFirstPixelWithDepthAndThatPixelsColour) {
     EXPECT_EQ(same.color.rgb, f.color.rgb);
 }
 
+// With the depth range, a block takes its first pixel in range, so that a pixel in range
+// always has a block in range (the coverage rule at --decimate N); a block with none in range
+// keeps its first pixel with depth.
+TEST(DecimateFrame, WithTheDepthRangeEachBlockTakesItsFirstPixelInRange) {
+    const RgbdFrame f = small_frame({0});
+    DepthRange range;
+    range.zmin_m = 103.5f * f.depth.scale_m_per_unit;  // pixels 104 and up are in range
+    range.zmax_m = 1000.0f;
+    RgbdFrame d;
+    decimate_frame(f, 2, d, &range);
+    // Blocks (0,1,5,6) (2,3,7,8) (4,9) / (10,11) (12,13) (14): block 0's 1 is out of range,
+    // 5 in; block 1's 2 and 3 out, 7 in; the rest start in range.
+    const std::vector<int> picked = {5, 7, 4, 10, 12, 14};
+    for (std::size_t o = 0; o < picked.size(); ++o) {
+        SCOPED_TRACE(o);
+        EXPECT_EQ(d.depth.data[o], 100 + picked[o]);
+        EXPECT_EQ(d.color.rgb[3 * o + 1], 2 * picked[o]);
+    }
+    range.zmin_m = 200.0f * f.depth.scale_m_per_unit;  // none in range: first with depth
+    decimate_frame(f, 2, d, &range);
+    EXPECT_EQ(d.depth.data[0], 101);
+    EXPECT_EQ(d.depth.data[1], 102);
+}
+
 TEST(DecimateFrame, RejectsBadFactorsAndMismatchedColour) {
     RgbdFrame f = small_frame({}), d;
     EXPECT_THROW(decimate_frame(f, 0, d), ParamError);
@@ -369,6 +393,7 @@ TEST(Pipeline, Decimated_BoxesFoundAtTheInputsSize) {
 TEST(Pipeline, Decimated_RealTabletopObjectsMatchFullResolution) {
     auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
     PipelineParams full_params, half_params;
+    full_params.decimation = 1;
     half_params.decimation = 2;
     Pipeline full(full_params), half(half_params);
     SourceItem item;

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <set>
 
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
@@ -13,11 +14,16 @@ using namespace wul3d;
 using namespace wul3d::test;
 
 // Real frames shipped in the repository (data/samples, MIT and BSD licensed).
-TEST(Pipeline, RealTabletopFramesGetLabelsOnEveryValidInRangePixel) {
+// At every pixel and at the default --decimate 2, where each pixel's results come from a
+// block.
+class RealTabletop : public ::testing::TestWithParam<int> {};
+
+TEST_P(RealTabletop, FramesGetLabelsOnEveryValidInRangePixel) {
     auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
     ASSERT_EQ(source->size(), 4u);
     PipelineParams params;
     params.cluster.k = 10;
+    params.decimation = GetParam();
     Pipeline pipeline(params);
     SourceItem item;
     for (std::size_t i = 0; i < source->size(); ++i) {
@@ -87,15 +93,18 @@ TEST(PipelineParams, PaperPresetValidates) {
     EXPECT_NO_THROW(p.validate());
     EXPECT_FLOAT_EQ(p.range.zmin_m, 0.5f);
     EXPECT_FLOAT_EQ(p.range.zmax_m, 4.5f);
+    EXPECT_EQ(p.decimation, 1);  // the paper clusters every point
 }
 
 // The object stages on the real tabletop frames: a support plane in every frame, objects
 // that cover a part of the scene (not the room), ids that are the labels of objects.png,
 // and a time for every object stage.
-TEST(Pipeline, RealTabletopFrames_ObjectsOnTheSupport) {
+TEST_P(RealTabletop, Frames_ObjectsOnTheSupport) {
     auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
-    Pipeline pipeline(PipelineParams{});
-    PipelineParams no_plane_params;
+    PipelineParams params;
+    params.decimation = GetParam();
+    Pipeline pipeline(params);
+    PipelineParams no_plane_params = params;
     no_plane_params.remove_plane = false;
     Pipeline no_plane(no_plane_params);
     SourceItem item;
@@ -126,6 +135,39 @@ TEST(Pipeline, RealTabletopFrames_ObjectsOnTheSupport) {
         EXPECT_GT(rn.plane.kept, r.plane.kept);
     }
 }
+
+// --min-points counts the input's pixels at every N: at N = 2 the stages check a quarter
+// of it on blocks, and an object can come back from the blocks a few pixels short of it.
+TEST_P(RealTabletop, ObjectsHaveAtLeastMinPointsPixels) {
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    SourceItem item;
+    int objects = 0;
+    for (int min_points = 150; min_points <= 2250; min_points += 150) {
+        PipelineParams params;
+        params.decimation = GetParam();
+        params.segmentation.min_points = params.objects.min_points = min_points;
+        Pipeline pipeline(params);
+        for (std::size_t i = 0; i < source->size(); ++i) {
+            source->read(i, item);
+            const FrameResult& r = pipeline.process(item.frame);
+            for (const DetectedObject& d : r.object_list) {
+                SCOPED_TRACE(item.frame.name + ", --min-points " + std::to_string(min_points));
+                EXPECT_GE(d.pixels, static_cast<std::size_t>(min_points));
+                EXPECT_EQ(static_cast<std::size_t>(std::count(r.objects.labels.begin(), r.objects.labels.end(),
+                                                              static_cast<std::uint16_t>(d.id))),
+                          d.pixels);
+                ++objects;
+            }
+            std::set<std::uint16_t> ids(r.objects.labels.begin(), r.objects.labels.end());
+            ids.erase(0);
+            EXPECT_EQ(ids.size(), r.object_list.size());
+        }
+    }
+    EXPECT_GT(objects, 30);
+}
+
+INSTANTIATE_TEST_SUITE_P(Pipeline, RealTabletop, ::testing::Values(1, 2),
+                         [](const ::testing::TestParamInfo<int>& p) { return "Decimate" + std::to_string(p.param); });
 
 TEST(PipelineParams, ObjectStagesValidate) {
     PipelineParams p;

@@ -9,19 +9,24 @@
 #include <cstdint>
 #include <vector>
 
+#include "wul3d/background.hpp"
 #include "wul3d/frame.hpp"
 
 namespace wul3d {
 
 /// Each N x N block of `in` becomes one pixel of `out` ((W + N - 1) / N x (H + N - 1) / N):
-/// the block's first pixel with valid depth in row-major order, its depth and colour both
-/// (never an average: a block across an object's edge would get a depth between the two
-/// surfaces). A block without depth takes its top-left colour. The intrinsics scale to the
-/// top-left samples (fx / N, cx / N); a block whose top-left pixel has no depth is back-
-/// projected up to N - 1 pixels off, a sub-pixel error at the decimated resolution.
+/// the block's first pixel in row-major order with depth in `range` (when given), else its
+/// first with valid depth; its depth and colour both (never an average: a block across an
+/// object's edge would get a depth between the two surfaces). With the range, a block is in
+/// it whenever one of its pixels is, so that every input pixel in range has a block in range
+/// to take its results from. A block without depth takes its top-left colour. The
+/// intrinsics scale to the top-left samples (fx / N, cx / N); a block whose top-left pixel
+/// is not the one kept is back-projected up to N - 1 pixels off, a sub-pixel error at the
+/// decimated resolution.
 /// N = 1 copies. Throws ParamError for N outside [1, 8] and InputError for a colour image
 /// whose size differs from the depth's.
-void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out);
+void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out,
+                    const DepthRange* range = nullptr);
 
 /// Which pixel of the decimated frame an input pixel takes its results from (the pipeline
 /// copies every per-pixel result through it: Pipeline::expand_result). An input pixel
