@@ -4,11 +4,10 @@
 Usage: eval/osd_table.py [--wul3d build/wul3d] [--data ../shared/data] [--out /tmp/wul3d-osd]
 
 Runs `wul3d run` on osd_mosd (78 frames) once per variant (default, --segmenter geometric,
---segmenter kmeans, --no-plane, --decimate 2, and the paper's clusters: labels.png at
-k = 10), scores each with `wul3d eval` on the learn* frames, the test* frames and all, then
-the two osd_moving sequences with the paper's weights on objects (--object-psi 0.5), without
-(1), and both again with --decimate 2. Prints
-Markdown. OSD is research-only data: it is read from ../shared/data, never shipped.
+--segmenter kmeans, --no-plane, every pixel: --decimate 1, and the paper's clusters:
+labels.png at k = 10 over every pixel), scores each with `wul3d eval` on the learn* frames,
+the test* frames and all, then the two osd_moving sequences with the paper's weights on
+objects (--object-psi 0.5), without (1), and both again at every pixel. Prints Markdown. OSD is research-only data: it is read from ../shared/data, never shipped.
 """
 import argparse
 import json
@@ -44,13 +43,14 @@ def main():
         sys.exit(f"osd_table.py: {mosd} not found (OSD is research-only and not in the repository)")
 
     variants = [
-        ("wul3d default (hybrid, plane removal, object psi 0.5)", [], "objects.png"),
+        ("wul3d default (hybrid, plane removal, object psi 0.5, --decimate 2)", [], "objects.png"),
         ("wul3d --segmenter geometric", ["--segmenter", "geometric"], "objects.png"),
         ("wul3d --segmenter kmeans (the paper's clusters as objects, plane removed)",
          ["--segmenter", "kmeans"], "objects.png"),
         ("wul3d --no-plane", ["--no-plane"], "objects.png"),
-        ("wul3d --decimate 2 (stages on a quarter of the pixels)", ["--decimate", "2"], "objects.png"),
-        ("the paper's method as published (clusters, labels.png, k = 10)", ["--k", "10"], "labels.png"),
+        ("wul3d --decimate 1 (every pixel)", ["--decimate", "1"], "objects.png"),
+        ("the paper's method as published (clusters, labels.png, k = 10, every pixel)",
+         ["--k", "10", "--decimate", "1"], "labels.png"),
     ]
     rows = []
     for i, (name, flags, pred_file) in enumerate(variants):
@@ -72,8 +72,8 @@ def main():
     print("| osd_moving sequence | object psi | Overlap F | Boundary F | id switches (max per object) | flicker % |")
     print("|---|---|---|---|---|---|")
     for seq in sorted(p for p in (data / "osd_moving").iterdir() if p.is_dir()):
-        for psi, flags in (("0.5", []), ("1", []), ("0.5, --decimate 2", ["--decimate", "2"]),
-                           ("1, --decimate 2", ["--decimate", "2"])):
+        for psi, flags in (("0.5", []), ("1", []), ("0.5, --decimate 1", ["--decimate", "1"]),
+                           ("1, --decimate 1", ["--decimate", "1"])):
             pred = out / f"moving-{seq.name}-{psi.replace(', ', '-').replace(' ', '')}"
             run([args.wul3d, "run", str(seq), "--out", str(pred), "-q", "--object-psi",
                  psi.split(",")[0], *flags])

@@ -37,7 +37,9 @@ TEST(CliBench, OneRowPerKWithMemoryAndSpeed) {
         EXPECT_EQ(cols[0], k);
         EXPECT_EQ(cols[1], "640");
         EXPECT_EQ(cols[2], "480");
-        EXPECT_GT(std::stod(cols[3]), 100000.0);  // points
+        // points: the decimated frame's (320 x 240 at the default --decimate 2)
+        EXPECT_GT(std::stod(cols[3]), 25000.0);
+        EXPECT_LE(std::stod(cols[3]), 320.0 * 240.0);
         EXPECT_GT(std::stod(cols[4]), 0.0);       // fps
         EXPECT_GT(std::stod(cols[6]), 10.0);      // peak MB of that process
     }
@@ -54,18 +56,28 @@ TEST(CliBench, ResamplesToTheRequestedResolution) {
 TEST(CliBench, PaperPipelineStopsAfterTheColoursAndHoldsLessMemory) {
     // The paper's steps alone keep no plane, segment or track buffers: at 640x480 that is
     // tens of MB (the tracker's weights alone are 24 bytes a pixel), far above noise.
-    auto row = [](const std::string& pipeline) {
-        const auto r = run_cli({"bench", (sample_dir() / "uois_tabletop").string(), "--k", "5",
-                                "--frames", "1", "--passes", "1", "--pipeline", pipeline});
+    auto row = [](const std::string& pipeline, std::vector<std::string> more) {
+        std::vector<std::string> args = {"bench", (sample_dir() / "uois_tabletop").string(), "--k", "5",
+                                          "--frames", "1", "--passes", "1", "--pipeline", pipeline};
+        args.insert(args.end(), more.begin(), more.end());
+        const auto r = run_cli(args);
         EXPECT_EQ(r.exit_code, 0) << r.err;
         const auto lines = split(r.out, '\n');
         return lines.size() == 2 ? split(lines[1], ',') : std::vector<std::string>{};
     };
-    const auto paper = row("paper"), objects = row("objects");
+    const auto paper = row("paper", {"--decimate", "1"}), objects = row("objects", {"--decimate", "1"});
     ASSERT_EQ(paper.size(), 7u);
     ASSERT_EQ(objects.size(), 7u);
     EXPECT_EQ(paper[3], objects[3]);  // the same points clustered
     EXPECT_LT(std::stod(paper[6]) + 10.0, std::stod(objects[6]));
+    // By default the paper's steps run on every pixel, as the paper does, and the object
+    // pipeline on a quarter of them (--decimate 2).
+    const auto paper_default = row("paper", {}), objects_default = row("objects", {});
+    ASSERT_EQ(paper_default.size(), 7u);
+    ASSERT_EQ(objects_default.size(), 7u);
+    EXPECT_EQ(paper_default[3], paper[3]);
+    EXPECT_GT(std::stod(paper_default[3]), 3.5 * std::stod(objects_default[3]));
+    EXPECT_LT(std::stod(paper_default[3]), 4.5 * std::stod(objects_default[3]));
 }
 
 TEST(CliBench, BadArgumentsAreOneLineErrors) {

@@ -35,9 +35,16 @@ struct BenchOptions {
     std::string pipeline = "objects";  // objects: the default object pipeline; paper: its steps only
     std::string segmenter;             // empty: the default
     int threads = 0;                   // 0: all cores
-    int decimate = 1;                  // PipelineParams::decimation
+    int decimate = 0;                  // PipelineParams::decimation; 0: decimation_of()
     int single_k = 0;        // internal: measure this k in this process and print one row
 };
+
+/// --decimate, or its default: the library's for the object pipeline, every pixel for the
+/// paper's steps (the paper clusters every point).
+int decimation_of(const BenchOptions& o) {
+    if (o.decimate > 0) return o.decimate;
+    return o.pipeline == "objects" ? PipelineParams{}.decimation : 1;
+}
 
 /// "native" or "WxH".
 void parse_resolution(const std::string& text, int& w, int& h) {
@@ -104,7 +111,7 @@ void measure_one(const BenchOptions& o) {
     params.cluster.k = o.single_k;
     params.detect_objects = o.pipeline == "objects";
     if (!o.segmenter.empty()) params.segmentation.segmenter = parse_segmenter(o.segmenter);
-    params.decimation = o.decimate;
+    params.decimation = decimation_of(o);
     if (o.threads > 0) omp_set_num_threads(o.threads);
     Pipeline pipeline(params);
     pipeline.process(frames.front());  // seeding is a one-off: not timed
@@ -140,7 +147,7 @@ std::string run_child(const BenchOptions& o, int k) {
                                          std::to_string(o.frames), "--passes",
                                          std::to_string(o.passes), "--pipeline", o.pipeline,
                                          "--threads", std::to_string(o.threads),
-                                         "--decimate", std::to_string(o.decimate)};
+                                         "--decimate", std::to_string(decimation_of(o))};
         if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
@@ -229,8 +236,8 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(0, 1 << 16));
     cmd->add_option("--decimate", opts->decimate,
-                    "Run the stages on every N-th pixel in u and v, results at the input's size")
-        ->capture_default_str()
+                    "Run the stages on every N-th pixel in u and v, results at the input's size "
+                    "(default: 2 with --pipeline objects, 1 with paper)")
         ->check(CLI::Range(1, 8));
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");

@@ -63,7 +63,7 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_option("--decimate", o.decimate,
                     "N in [1, 8]: run the stages on every N-th pixel in u and v (N^2 times fewer "
-                    "points), results at the input's size (default 1)");
+                    "points), results at the input's size (default 2; 1 with --preset paper)");
     cmd->add_option("--tum-camera", o.tum_camera,
                     "TUM intrinsics preset: kinect_v1|tum_fr1|tum_fr2|tum_fr3 (default: from folder name)");
     cmd->add_option("--intrinsics", o.intrinsics, "fx,fy,cx,cy: override every frame's intrinsics");

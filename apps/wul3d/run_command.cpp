@@ -304,6 +304,7 @@ void run(const RunOptions& o) {
                              {"remove_plane", params.remove_plane},
                              {"min_points", params.segmentation.min_points},
                              {"object_psi", params.objects.psi},
+                             {"decimate", params.decimation},
                              {"preset", o.pipeline.preset.empty() ? "default" : o.pipeline.preset}};
     summary["frames"] = n_frames;
     summary["threads"] = omp_get_max_threads();
