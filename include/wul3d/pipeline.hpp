@@ -35,7 +35,7 @@ struct PipelineParams {
     /// 1: every pixel. N in [2, 8]: the stages run on the frame decimated N x N
     /// (decimation.hpp) and the per-pixel results come back at the input's size. The
     /// parameters above stay in the input's pixels; stage_params() scales them. The default
-    /// 2 is 2.2-2.6 times as fast as every pixel at 640x480 and scores as well on OSD but
+    /// 2 is 2.2-2.8 times as fast as every pixel at 640x480 and scores as well on OSD but
     /// for its most cluttered frames (README, "Decimation").
     int decimation = 2;
 
