@@ -20,12 +20,11 @@ std::size_t select_depth_range(const DepthRange& range, const OrganizedCloud& cl
                                std::vector<std::uint8_t>& active) {
     const std::size_t n = cloud.size();
     active.resize(n);
-    const float lo = range.zmin_m, hi = range.zmax_m;
     std::size_t count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count)
     for (std::size_t p = 0; p < n; ++p) {
         const float z = cloud.z[p];
-        const std::uint8_t keep = (cloud.valid[p] && z >= lo && z <= hi) ? 1 : 0;
+        const std::uint8_t keep = (cloud.valid[p] && range.contains(z)) ? 1 : 0;
         active[p] = keep;
         count += keep;
     }

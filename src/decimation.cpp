@@ -57,10 +57,7 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out, const Depth
     const std::uint16_t* const depth = in.depth.data.data();
     const std::uint8_t* const rgb = color ? in.color.rgb.data() : nullptr;
 
-    // In range as select_depth_range decides it: z = depth * scale in float.
-    const float scale = in.depth.scale_m_per_unit;
-    const float zmin = range ? range->zmin_m : 0.0f;
-    const float zmax = range ? range->zmax_m : std::numeric_limits<float>::infinity();
+    const float scale = in.depth.scale_m_per_unit;  // z = depth * scale, as back-projected
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
@@ -75,8 +72,7 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out, const Depth
                 for (int du = 0; du < cols && !in_range; ++du) {
                     const std::size_t q = top_left + static_cast<std::size_t>(dv) * W + du;
                     if (depth[q] == 0) continue;
-                    const float z = static_cast<float>(depth[q]) * scale;
-                    in_range = z >= zmin && z <= zmax;
+                    in_range = !range || range->contains(static_cast<float>(depth[q]) * scale);
                     if (in_range || !with_depth) pick = q;
                     with_depth = true;
                 }
@@ -171,8 +167,6 @@ void DecimatedSource::vote(const std::uint16_t* labels, std::int32_t* source) co
 }
 
 std::int32_t DecimatedSource::search(int u, int v, int bu, int bv, float z, bool on_own) const {
-    const int v0 = std::max(0, bv - 1), v1 = std::min(h_ - 1, bv + 1);
-    const int u0 = std::max(0, bu - 1), u1 = std::min(w_ - 1, bu + 1);
     const std::int32_t own = bv * w_ + bu;
     if (edges_ && edges_[own]) {
         // Its own block and the three beside the quarter it lies in, on its surface: the
@@ -200,19 +194,25 @@ std::int32_t DecimatedSource::search(int u, int v, int bu, int bv, float z, bool
         }
         if (best >= 0) return edges_[best] ? voted_[best] : best;
     }
-    std::int32_t best = -1;  // no block on its surface: the nearest in depth
+    // No block on its surface: the nearest in depth.
+    const std::int32_t best = nearest_in_depth(bu, bv, z, nullptr);
+    return best >= 0 && voted_ && edges_[best] ? voted_[best] : best;
+}
+
+std::int32_t DecimatedSource::nearest_in_depth(int bu, int bv, float z, const std::uint8_t* among) const {
+    std::int32_t best = -1;
     float best_dz = std::numeric_limits<float>::infinity();
-    for (int nv = v0; nv <= v1; ++nv)
-        for (int nu = u0; nu <= u1; ++nu) {
+    for (int nv = std::max(0, bv - 1); nv <= std::min(h_ - 1, bv + 1); ++nv)
+        for (int nu = std::max(0, bu - 1); nu <= std::min(w_ - 1, bu + 1); ++nu) {
             const std::int32_t q = nv * w_ + nu;
-            if (small_[q] == 0) continue;
+            if (small_[q] == 0 || (among && !among[q])) continue;
             const float dz = std::fabs(small_[q] - z);
             if (dz < best_dz) {
                 best_dz = dz;
                 best = q;
             }
         }
-    return best >= 0 && voted_ && edges_[best] ? voted_[best] : best;
+    return best;
 }
 
 }  // namespace wul3d

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <exception>
 #include <utility>
 
@@ -322,24 +321,9 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
     // the block it takes can lie on the other side of a limit. In range, on a block that is
     // not, it takes the nearest in depth of the 3 x 3 blocks that are (its own is: the frame
     // was decimated to blocks in range where they could be); out of range, none.
-    const float scale = frame.depth.scale_m_per_unit, zmin = params_.range.zmin_m,
-                zmax = params_.range.zmax_m;
-    const std::uint16_t *const depth = frame.depth.data.data(), *const block_depth = decimated_.depth.data.data();
-    const int bw = decimated_.width(), bh = decimated_.height();
-    auto nearest_active_block = [&](int bu, int bv, std::uint16_t d) {
-        std::int32_t best = -1;
-        int best_gap = 1 << 30;
-        for (int y = std::max(0, bv - 1); y <= std::min(bh - 1, bv + 1); ++y)
-            for (int x = std::max(0, bu - 1); x <= std::min(bw - 1, bu + 1); ++x) {
-                const std::int32_t b = y * bw + x;
-                const int gap = std::abs(static_cast<int>(block_depth[b]) - static_cast<int>(d));
-                if (in_active[b] && gap < best_gap) {
-                    best_gap = gap;
-                    best = b;
-                }
-            }
-        return best;
-    };
+    const float scale = frame.depth.scale_m_per_unit;
+    const DepthRange& range = params_.range;
+    const std::uint16_t* const depth = frame.depth.data.data();
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kExpandBands; ++band) {
         PixelBox* const boxes = band_boxes_.data() + static_cast<std::size_t>(band) * n_obj;
@@ -351,11 +335,10 @@ void Pipeline::expand_result(const RgbdFrame& frame) {
                 std::uint8_t* const rgb = colors + 3 * p;
                 std::int32_t q = source.in_block(u, v, bu, bv);
                 if (q >= 0) {
-                    const float z = static_cast<float>(depth[p]) * scale;
-                    if (!(z >= zmin && z <= zmax))
+                    if (!range.contains(static_cast<float>(depth[p]) * scale))
                         q = -1;
                     else if (!in_active[q])
-                        q = nearest_active_block(bu, bv, depth[p]);
+                        q = source.nearest_in_depth(bu, bv, depth[p], in_active);
                 }
                 if (++in_block == source.factor()) {
                     in_block = 0;

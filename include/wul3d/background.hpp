@@ -13,6 +13,9 @@ struct DepthRange {
     float zmax_m = 4.5f;  ///< metres; > zmin_m (Kinect v2 reaches about 4.5 m)
 
     void validate() const;  ///< throws ParamError
+    /// Whether depth z (metres, float as back-projected) is kept; every stage that asks, asks
+    /// this.
+    bool contains(float z) const { return z >= zmin_m && z <= zmax_m; }
 };
 
 /// active[p] = 1 where the point is valid and zmin <= z <= zmax, else 0. Returns the count.

@@ -81,6 +81,10 @@ public:
         if (on_own && !(edges_ && edges_[own])) return own;
         return search(u, v, bu, bv, z, on_own);
     }
+    /// Of the 3 x 3 blocks around block (bu, bv) that have depth (and a flag in `among`, one
+    /// per block, when given), the one nearest to depth z (the image's units), or -1: a
+    /// first-found on ties, rows top to bottom.
+    std::int32_t nearest_in_depth(int bu, int bv, float z, const std::uint8_t* among) const;
 
 private:
     bool same_surface(std::int32_t q, float z) const {
