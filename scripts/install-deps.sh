@@ -21,6 +21,12 @@
 #   libfreenect-dev libopenni2-dev                 live cameras: Kinect v1 (libfreenect), OpenNI2 devices
 #                                                  and .oni files; each backend built only when found
 #   libfreenect-bin                                fakenect: the capture tests replay a Kinect v1 dump
+#   pybind11-dev python3-dev python3-numpy         the Python module (python/, docs/PYTHON.md), built
+#                                                  for Debian's /usr/bin/python3
+#   python3-pytest                                 its test suite (tests/python, scripts/run-tests.sh)
+#   python3-open3d                                 examples/python/to_open3d.py and its test
+#   python3-dask python3-distributed               batch runs over many sequences (wul3d.batch,
+#                                                  docs/SCALE.md)
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -51,6 +57,13 @@ packages=(
   libfreenect-dev
   libfreenect-bin
   libopenni2-dev
+  pybind11-dev
+  python3-dev
+  python3-numpy
+  python3-pytest
+  python3-open3d
+  python3-dask
+  python3-distributed
 )
 
 missing=()

@@ -1,0 +1,184 @@
+#include "convert.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace wul3d::python {
+
+namespace {
+
+std::string shape_text(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+        if (i) s += ", ";
+        s += std::to_string(a.shape(i));
+    }
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+std::string dtype_text(const py::array& a) { return py::str(a.dtype()).cast<std::string>(); }
+
+py::array as_array(const py::object& o, const char* what) {
+    if (!py::isinstance<py::array>(o))
+        throw py::type_error(std::string(what) + ": expected a numpy array, got " +
+                             py::str(py::type::of(o).attr("__name__")).cast<std::string>());
+    return py::reinterpret_borrow<py::array>(o);
+}
+
+void require_c_order(const py::array& a, const char* what) {
+    if (!(a.flags() & py::array::c_style))
+        throw py::value_error(std::string(what) +
+                              ": array is not C-contiguous (pass numpy.ascontiguousarray(" +
+                              what + "))");
+}
+
+}  // namespace
+
+FrameArrays check_frame_arrays(const py::object& color, const py::object& depth) {
+    FrameArrays a;
+    a.depth = as_array(depth, "depth");
+    if (py::isinstance<py::array_t<std::uint16_t>>(a.depth)) {
+        a.depth_is_float = false;
+    } else if (py::isinstance<py::array_t<float>>(a.depth)) {
+        a.depth_is_float = true;
+    } else {
+        throw py::type_error("depth: dtype " + dtype_text(a.depth) +
+                             ", expected uint16 (units of depth_scale) or float32 (metres)");
+    }
+    if (a.depth.ndim() != 2)
+        throw py::value_error("depth: shape " + shape_text(a.depth) + ", expected (H, W)");
+    if (a.depth.shape(0) == 0 || a.depth.shape(1) == 0)
+        throw py::value_error("depth: empty image " + shape_text(a.depth));
+    if (a.depth.shape(0) > std::numeric_limits<int>::max() / 4 ||
+        a.depth.shape(1) > std::numeric_limits<int>::max() / 4)
+        throw py::value_error("depth: image too large " + shape_text(a.depth));
+    require_c_order(a.depth, "depth");
+    a.height = static_cast<int>(a.depth.shape(0));
+    a.width = static_cast<int>(a.depth.shape(1));
+
+    if (!color.is_none()) {
+        a.color = as_array(color, "color");
+        if (!py::isinstance<py::array_t<std::uint8_t>>(a.color))
+            throw py::type_error("color: dtype " + dtype_text(a.color) +
+                                 ", expected uint8 (H, W, 3) RGB");
+        if (a.color.ndim() != 3 || a.color.shape(2) != 3)
+            throw py::value_error("color: shape " + shape_text(a.color) +
+                                  ", expected (H, W, 3) RGB");
+        if (a.color.shape(0) != a.height || a.color.shape(1) != a.width)
+            throw py::value_error("color " + shape_text(a.color) + " and depth " +
+                                  shape_text(a.depth) + " differ in size");
+        require_c_order(a.color, "color");
+        a.has_color = true;
+    }
+    return a;
+}
+
+PinholeIntrinsics to_intrinsics(const py::object& intrinsics, int width, int height) {
+    PinholeIntrinsics K;
+    if (py::isinstance<PinholeIntrinsics>(intrinsics)) {
+        K = intrinsics.cast<PinholeIntrinsics>();
+    } else if (py::isinstance<py::dict>(intrinsics)) {
+        const auto d = py::reinterpret_borrow<py::dict>(intrinsics);
+        for (const char* key : {"fx", "fy", "cx", "cy"}) {
+            if (!d.contains(key))
+                throw py::value_error(std::string("intrinsics: dict has no '") + key +
+                                      "' (needs fx, fy, cx, cy)");
+        }
+        K.fx = d["fx"].cast<double>();
+        K.fy = d["fy"].cast<double>();
+        K.cx = d["cx"].cast<double>();
+        K.cy = d["cy"].cast<double>();
+        if (d.contains("width")) K.width = d["width"].cast<int>();
+        if (d.contains("height")) K.height = d["height"].cast<int>();
+    } else {
+        throw py::type_error("intrinsics: expected wul3d.Intrinsics or a dict with fx, fy, "
+                             "cx, cy, got " +
+                             py::str(py::type::of(intrinsics).attr("__name__")).cast<std::string>());
+    }
+    if ((K.width != 0 || K.height != 0) && !K.same_size(width, height))
+        throw py::value_error("intrinsics: for a " + std::to_string(K.width) + "x" +
+                              std::to_string(K.height) + " image, the arrays are " +
+                              std::to_string(width) + "x" + std::to_string(height));
+    K.width = width;
+    K.height = height;
+    K.validate("intrinsics");  // ParamError -> ValueError (module.cpp)
+    return K;
+}
+
+void fill_frame(const FrameArrays& a, float depth_scale, RgbdFrame& frame) {
+    const std::size_t n = static_cast<std::size_t>(a.width) * static_cast<std::size_t>(a.height);
+    frame.depth.width = a.width;
+    frame.depth.height = a.height;
+    frame.depth.data.resize(n);
+    if (!a.depth_is_float) {
+        frame.depth.scale_m_per_unit = depth_scale;
+        std::memcpy(frame.depth.data.data(), a.depth.data(), n * sizeof(std::uint16_t));
+    } else {
+        const float* z = static_cast<const float*>(a.depth.data());
+        float z_max = 0;
+        for (std::size_t i = 0; i < n; ++i)
+            if (std::isfinite(z[i])) z_max = std::max(z_max, z[i]);
+        // 0.1 mm steps keep sensor precision to 6.5 m; farther scenes get coarser steps.
+        const float scale = std::max(1e-4f, z_max / 65535.0f);
+        frame.depth.scale_m_per_unit = scale;
+        for (std::size_t i = 0; i < n; ++i) {
+            const float units = z[i] / scale;
+            frame.depth.data[i] = std::isfinite(units) && units > 0.5f
+                                      ? static_cast<std::uint16_t>(std::min(65535.0f, std::round(units)))
+                                      : std::uint16_t{0};
+        }
+    }
+    if (a.has_color) {
+        frame.color.width = a.width;
+        frame.color.height = a.height;
+        frame.color.rgb.resize(3 * n);
+        std::memcpy(frame.color.rgb.data(), a.color.data(), 3 * n);
+    } else {
+        frame.color = ColorImage{};
+    }
+}
+
+py::array_t<std::uint16_t> to_array(const LabelImage& image) {
+    py::array_t<std::uint16_t> out({image.height, image.width});
+    std::memcpy(out.mutable_data(), image.labels.data(), image.labels.size() * sizeof(std::uint16_t));
+    return out;
+}
+
+py::array_t<std::uint16_t> to_array(const DepthImage& image) {
+    py::array_t<std::uint16_t> out({image.height, image.width});
+    std::memcpy(out.mutable_data(), image.data.data(), image.data.size() * sizeof(std::uint16_t));
+    return out;
+}
+
+py::array_t<std::uint8_t> to_array(const ColorImage& image) {
+    py::array_t<std::uint8_t> out({image.height, image.width, 3});
+    std::memcpy(out.mutable_data(), image.rgb.data(), image.rgb.size());
+    return out;
+}
+
+LabelImage to_label_image(const py::object& object, const char* what) {
+    const py::array a = as_array(object, what);
+    const char kind = a.dtype().kind();
+    if (kind != 'u' && kind != 'i')
+        throw py::type_error(std::string(what) + ": dtype " + dtype_text(a) +
+                             ", expected an integer label image");
+    if (a.ndim() != 2)
+        throw py::value_error(std::string(what) + ": shape " + shape_text(a) + ", expected (H, W)");
+    const auto wide = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    LabelImage out;
+    out.height = static_cast<int>(a.shape(0));
+    out.width = static_cast<int>(a.shape(1));
+    out.labels.resize(static_cast<std::size_t>(wide.size()));
+    const std::int64_t* v = wide.data();
+    for (std::size_t i = 0; i < out.labels.size(); ++i) {
+        if (v[i] < 0 || v[i] > 65535)
+            throw py::value_error(std::string(what) + ": label " + std::to_string(v[i]) +
+                                  " outside [0, 65535]");
+        out.labels[i] = static_cast<std::uint16_t>(v[i]);
+    }
+    return out;
+}
+
+}  // namespace wul3d::python

@@ -1,0 +1,50 @@
+#pragma once
+// Between numpy arrays and wul3d's images: the checks a caller's arrays must pass (one-line
+// messages naming the argument), and the copies out of a FrameResult. Used by module.cpp.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "wul3d/camera.hpp"
+#include "wul3d/frame.hpp"
+#include "wul3d/pipeline.hpp"
+
+namespace wul3d::python {
+namespace py = pybind11;
+
+/// The caller's colour and depth arrays, checked (dtype, shape, C order, sizes agree); the
+/// pointers stay valid while the arrays are held. Checked with the GIL held; read without.
+struct FrameArrays {
+    bool has_color = false;  ///< false: depth only (`color` is then an empty array)
+    py::array color;
+    py::array depth;
+    bool depth_is_float = false;  ///< float32 metres, else uint16 units of depth_scale
+    int width = 0, height = 0;
+};
+
+/// Throws TypeError (dtype, not an array) or ValueError (shape, order, empty) naming the
+/// argument.
+FrameArrays check_frame_arrays(const py::object& color, const py::object& depth);
+
+/// wul3d.Intrinsics, or a dict with fx, fy, cx, cy (as in intrinsics.json; width and height
+/// there must match the arrays when given). Finite values, fx, fy > 0, else ValueError.
+PinholeIntrinsics to_intrinsics(const py::object& intrinsics, int width, int height);
+
+/// Copies the arrays into `frame`'s reused buffers (no allocation after the first frame of a
+/// size). float32 metres are stored in units of 0.1 mm, or coarser when the farthest depth
+/// would not fit 16 bits; NaN, infinite and non-positive depths become 0 (no depth). Runs
+/// without the GIL.
+void fill_frame(const FrameArrays& a, float depth_scale, RgbdFrame& frame);
+
+/// (H, W) uint16 and (H, W, 3) uint8 copies of an image of the result.
+py::array_t<std::uint16_t> to_array(const LabelImage& image);
+py::array_t<std::uint8_t> to_array(const ColorImage& image);
+py::array_t<std::uint16_t> to_array(const DepthImage& image);
+
+/// A (H, W) uint16 label image from any integer array in [0, 65535] (TypeError, ValueError).
+LabelImage to_label_image(const py::object& array, const char* what);
+
+}  // namespace wul3d::python

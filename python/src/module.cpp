@@ -1,0 +1,589 @@
+// wul3d._wul3d: the compiled part of the Python module (docs/PYTHON.md). The pipeline,
+// its result, frame reading and scoring; python/wul3d/__init__.py re-exports them with the
+// pure-Python helpers. Errors: ParamError -> ValueError, InputError -> wul3d.InputError
+// (a ValueError), IoError -> wul3d.IoError (an OSError).
+#include <omp.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "convert.hpp"
+#include "params.hpp"
+#include "run_binding.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/eval.hpp"
+#include "wul3d/io.hpp"
+#include "wul3d/pipeline.hpp"
+#include "wul3d/registration.hpp"
+
+namespace wul3d::python {
+namespace {
+
+/// One object of a result; the mask is cut from the result's objects image on demand.
+struct Instance {
+    DetectedObject object;
+    py::array_t<std::uint16_t> objects;  ///< the result's objects image (shared, not copied)
+};
+
+template <std::size_t N>
+py::array_t<float> floats(const std::array<float, N>& a) {
+    py::array_t<float> out(static_cast<py::ssize_t>(N));
+    std::copy(a.begin(), a.end(), out.mutable_data());
+    return out;
+}
+
+/// Everything process() returns; owns copies of the frame's images.
+struct Result {
+    py::array_t<std::uint16_t> labels, objects;
+    py::array_t<std::uint8_t> colors;
+    py::list instances;
+    py::object plane;
+    py::dict times, stats;
+};
+
+Result make_result(const FrameResult& r) {
+    Result out;
+    out.labels = to_array(r.labels);
+    out.colors = to_array(r.colors);
+    out.objects = r.objects.labels.empty() ? py::array_t<std::uint16_t>({r.labels.height, r.labels.width})
+                                           : to_array(r.objects);
+    if (r.objects.labels.empty()) std::fill_n(out.objects.mutable_data(), out.objects.size(), 0);
+    for (const DetectedObject& d : r.object_list) out.instances.append(Instance{d, out.objects});
+    if (r.plane.found) {
+        const Plane& pl = r.plane.support;
+        py::dict plane;
+        plane["normal"] = py::make_tuple(pl.nx, pl.ny, pl.nz);
+        plane["d_m"] = pl.d;
+        out.plane = plane;
+    } else {
+        out.plane = py::none();
+    }
+    const StageTimes& t = r.times;
+    const std::pair<const char*, double> stages[] = {
+        {"registration", t.registration}, {"decimation", t.decimation},
+        {"backprojection", t.backprojection}, {"normals", t.normals},
+        {"background", t.background}, {"clustering", t.clustering}, {"colors", t.colors},
+        {"plane", t.plane}, {"segmentation", t.segmentation}, {"objects", t.objects},
+        {"overlap", t.overlap}, {"total", t.total()}};
+    for (const auto& [name, ms] : stages) out.times[name] = ms;
+    out.stats["points"] = r.stats.points;
+    out.stats["active_points"] = r.active_points;
+    out.stats["seeded"] = r.stats.seeded;
+    out.stats["reseeded"] = r.stats.reseeded;
+    out.stats["mean_f"] = r.stats.mean_f;
+    out.stats["segments"] = r.segment_stats.segments;
+    out.stats["merges"] = r.segment_stats.merges;
+    out.stats["containers"] = r.segment_stats.containers;
+    out.stats["gaps_filled"] = r.segment_stats.gaps_filled;
+    out.stats["color_splits"] = r.segment_stats.color_splits;
+    return out;
+}
+
+/// process() calls running now without the GIL, and the most seen at once: shows in tests
+/// (tests/python) that pipelines in two threads run at the same time.
+std::atomic<int> g_running{0};
+std::atomic<int> g_max_running{0};
+
+struct RunningScope {
+    RunningScope() {
+        const int now = ++g_running;
+        int seen = g_max_running.load();
+        while (now > seen && !g_max_running.compare_exchange_weak(seen, now)) {
+        }
+    }
+    ~RunningScope() { --g_running; }
+    RunningScope(const RunningScope&) = delete;
+    RunningScope& operator=(const RunningScope&) = delete;
+};
+
+/// wul3d.Pipeline: the C++ Pipeline, its reused input frame, and a lock so that two Python
+/// threads sharing one pipeline take turns (its state carries from frame to frame).
+class PyPipeline {
+public:
+    explicit PyPipeline(const ParamArgs& args) : pipeline_(make_params(args)) {}
+
+    Result process(const py::object& color, const py::object& depth,
+                   const py::object& intrinsics, float depth_scale) {
+        if (!(depth_scale > 0) || !std::isfinite(depth_scale))
+            throw py::value_error("depth_scale = " + std::to_string(depth_scale) +
+                                  ": must be a positive number of metres per unit");
+        const FrameArrays arrays = check_frame_arrays(color, depth);
+        const PinholeIntrinsics K = to_intrinsics(intrinsics, arrays.width, arrays.height);
+        const FrameResult* r = nullptr;
+        // Held until the result is copied: it is valid until the next process(). A thread
+        // waiting for the lock waits without the GIL, so this thread can take it back.
+        std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
+        {
+            py::gil_scoped_release release;
+            lock.lock();
+            const RunningScope running;
+            frame_.name = "frame";
+            frame_.intrinsics = K;
+            fill_frame(arrays, depth_scale, frame_);
+            r = &pipeline_.process(frame_);
+        }
+        return make_result(*r);
+    }
+
+    const PipelineParams& params() const { return pipeline_.params(); }
+
+private:
+    Pipeline pipeline_;
+    RgbdFrame frame_;
+    std::mutex mutex_;
+};
+
+/// One frame read from disk (wul3d.read), registered when the input is unregistered.
+struct PyFrame {
+    std::string name;
+    py::object color;  ///< (H, W, 3) uint8 or None
+    py::array_t<std::uint16_t> depth;
+    float depth_scale = 0.001f;
+    PinholeIntrinsics intrinsics;
+};
+
+/// wul3d.read: the frames of a recording, as `wul3d run` reads them (open_source).
+class Reader {
+public:
+    Reader(const std::string& path, const SourceOptions& options)
+        : source_(open_source(path, options)), registration_(options.registration) {}
+
+    std::size_t size() const { return source_->size(); }
+
+    PyFrame get(py::ssize_t index) {
+        const auto n = static_cast<py::ssize_t>(size());
+        if (index < 0) index += n;
+        if (index < 0 || index >= n) throw py::index_error("frame index out of range");
+        {
+            py::gil_scoped_release release;
+            source_->read(static_cast<std::size_t>(index), item_);
+            if (item_.is_raw) {
+                if (registration_ == RegistrationMode::DepthToColor)
+                    register_depth_to_color(*source_->calibration(), item_.raw, ws_, registered_);
+                else
+                    register_color_to_depth(*source_->calibration(), item_.raw, ws_, registered_);
+                registered_.name = item_.raw.name;
+            }
+        }
+        const RgbdFrame& f = item_.is_raw ? registered_ : item_.frame;
+        PyFrame out;
+        out.name = source_->name(static_cast<std::size_t>(index));
+        out.color = f.has_color() ? py::object(to_array(f.color)) : py::none();
+        out.depth = to_array(f.depth);
+        out.depth_scale = f.depth.scale_m_per_unit;
+        out.intrinsics = f.intrinsics;
+        return out;
+    }
+
+    std::string format() const { return input_format_name(source_->format()); }
+
+private:
+    std::unique_ptr<FrameSource> source_;
+    RegistrationMode registration_;
+    SourceItem item_;
+    RegistrationWorkspace ws_;
+    RgbdFrame registered_;
+};
+
+py::dict score_dict(const ImageScore& s) {
+    py::dict d;
+    d["overlap_p"] = s.overlap_p;
+    d["overlap_r"] = s.overlap_r;
+    d["overlap_f"] = s.overlap_f;
+    d["boundary_p"] = s.boundary_p;
+    d["boundary_r"] = s.boundary_r;
+    d["boundary_f"] = s.boundary_f;
+    d["detected_share"] = s.detected_share;
+    d["gt_objects"] = s.gt_objects;
+    d["pred_objects"] = s.pred_objects;
+    d["detected"] = s.detected;
+    d["boundary_tolerance_px"] = s.boundary_tolerance_px;
+    py::list matches;
+    for (const MatchedPair& m : s.matches)
+        matches.append(py::dict(py::arg("gt_id") = m.gt_id, py::arg("pred_id") = m.pred_id,
+                                py::arg("true_positives") = m.true_positives,
+                                py::arg("overlap_f") = m.overlap_f));
+    d["matches"] = matches;
+    return d;
+}
+
+py::dict summary_dict(const EvalSummary& s) {
+    py::dict d;
+    d["overlap_p"] = s.overlap_p;
+    d["overlap_r"] = s.overlap_r;
+    d["overlap_f"] = s.overlap_f;
+    d["boundary_p"] = s.boundary_p;
+    d["boundary_r"] = s.boundary_r;
+    d["boundary_f"] = s.boundary_f;
+    d["detected_share"] = s.detected_share;
+    d["images"] = s.images;
+    d["gt_objects"] = s.gt_objects;
+    d["pred_objects"] = s.pred_objects;
+    d["detected"] = s.detected;
+    return d;
+}
+
+EvalParams eval_params(double boundary_fraction, int boundary_tolerance_px, double detected_f) {
+    EvalParams p;
+    p.boundary_fraction = boundary_fraction;
+    p.boundary_tolerance_px = boundary_tolerance_px;
+    p.detected_f = detected_f;
+    p.validate();
+    return p;
+}
+
+void bind_errors(py::module_& m) {
+    static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+    static py::exception<IoError> io_error(m, "IoError", PyExc_OSError);
+    input_error.doc() = "Input data that cannot be used (missing or unreadable file, wrong size).";
+    io_error.doc() = "Writing an output failed (disk full, permission denied).";
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const ParamError& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        } catch (const InputError& e) {
+            PyErr_SetString(input_error.ptr(), e.what());
+        } catch (const IoError& e) {
+            PyErr_SetString(io_error.ptr(), e.what());
+        } catch (const Error& e) {
+            PyErr_SetString(PyExc_RuntimeError, e.what());
+        }
+    });
+}
+
+void bind_intrinsics(py::module_& m) {
+    py::class_<PinholeIntrinsics>(m, "Intrinsics", R"doc(
+Pinhole intrinsics of an undistorted camera, in pixels.
+
+Projection: u = fx * x / z + cx, v = fy * y / z + cy (x right, y down, z forward, metres).
+
+Args:
+    fx (float): focal length along u, pixels (> 0).
+    fy (float): focal length along v, pixels (> 0).
+    cx (float): principal point u.
+    cy (float): principal point v.
+    width (int, optional): image width; 0 = the arrays' size.
+    height (int, optional): image height; 0 = the arrays' size.
+)doc")
+        .def(py::init([](double fx, double fy, double cx, double cy, int width, int height) {
+                 PinholeIntrinsics K;
+                 K.fx = fx;
+                 K.fy = fy;
+                 K.cx = cx;
+                 K.cy = cy;
+                 K.width = width;
+                 K.height = height;
+                 return K;
+             }),
+             py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width") = 0,
+             py::arg("height") = 0)
+        .def_readwrite("fx", &PinholeIntrinsics::fx, "Focal length along u, pixels.")
+        .def_readwrite("fy", &PinholeIntrinsics::fy, "Focal length along v, pixels.")
+        .def_readwrite("cx", &PinholeIntrinsics::cx, "Principal point u, pixels.")
+        .def_readwrite("cy", &PinholeIntrinsics::cy, "Principal point v, pixels.")
+        .def_readwrite("width", &PinholeIntrinsics::width, "Image width (0 = any).")
+        .def_readwrite("height", &PinholeIntrinsics::height, "Image height (0 = any).")
+        .def("to_dict",
+             [](const PinholeIntrinsics& K) {
+                 return py::dict(py::arg("fx") = K.fx, py::arg("fy") = K.fy,
+                                 py::arg("cx") = K.cx, py::arg("cy") = K.cy,
+                                 py::arg("width") = K.width, py::arg("height") = K.height);
+             },
+             "The intrinsics as a dict (the keys of intrinsics.json).")
+        .def("__repr__", [](const PinholeIntrinsics& K) {
+            return "Intrinsics(fx=" + std::to_string(K.fx) + ", fy=" + std::to_string(K.fy) +
+                   ", cx=" + std::to_string(K.cx) + ", cy=" + std::to_string(K.cy) +
+                   ", width=" + std::to_string(K.width) + ", height=" +
+                   std::to_string(K.height) + ")";
+        });
+}
+
+void bind_result(py::module_& m) {
+    py::class_<Instance>(m, "Instance", R"doc(
+One object of a frame. Positions in metres in the camera frame, colours 0-255; the same
+fields as an entry of objects.json.
+)doc")
+        .def_property_readonly("id", [](const Instance& i) { return i.object.id; },
+                               "Its value in Result.objects; equal to track_id.")
+        .def_property_readonly("track_id", [](const Instance& i) { return i.object.track_id; },
+                               "Stable across frames: 1, 2, ... in order of first appearance.")
+        .def_property_readonly("pixels", [](const Instance& i) { return i.object.pixels; },
+                               "Its pixel count.")
+        .def_property_readonly("centroid", [](const Instance& i) { return floats(i.object.centroid); },
+                               "(3,) float32: mean position, metres.")
+        .def_property_readonly(
+            "aabb",
+            [](const Instance& i) {
+                py::array_t<float> out({2, 3});
+                std::copy(i.object.aabb_min.begin(), i.object.aabb_min.end(), out.mutable_data());
+                std::copy(i.object.aabb_max.begin(), i.object.aabb_max.end(), out.mutable_data() + 3);
+                return out;
+            },
+            "(2, 3) float32: axis-aligned box, rows min and max, metres.")
+        .def_property_readonly(
+            "obb",
+            [](const Instance& i) {
+                py::array_t<float> axes({3, 3});
+                std::copy(i.object.obb_axes.begin(), i.object.obb_axes.end(), axes.mutable_data());
+                return py::dict(py::arg("centre") = floats(i.object.obb_centre),
+                                py::arg("axes") = axes,
+                                py::arg("half_extent") = floats(i.object.obb_half_extent));
+            },
+            "Oriented box: dict with 'centre' (3,), 'axes' (3, 3), unit principal directions "
+            "as rows, and 'half_extent' (3,) along them; metres.")
+        .def_property_readonly(
+            "box_px",
+            [](const Instance& i) {
+                return py::make_tuple(i.object.u_min, i.object.v_min, i.object.u_max, i.object.v_max);
+            },
+            "2D box (u_min, v_min, u_max, v_max), inclusive pixels.")
+        .def_property_readonly("mean_rgb", [](const Instance& i) { return floats(i.object.mean_rgb); },
+                               "(3,) float32: mean colour, 0-255.")
+        .def_property_readonly("source_clusters", [](const Instance& i) { return i.object.source_clusters; },
+                               "Clusters (Result.labels) covering >= 5 % of its pixels.")
+        .def_property_readonly("source_segments", [](const Instance& i) { return i.object.source_segments; },
+                               "This frame's segments that fed it.")
+        .def("mask",
+             [](const Instance& i) {
+                 py::array_t<bool> out({i.objects.shape(0), i.objects.shape(1)});
+                 const std::uint16_t* o = i.objects.data();
+                 bool* dst = out.mutable_data();
+                 const auto id = static_cast<std::uint16_t>(i.object.id);
+                 for (py::ssize_t p = 0; p < i.objects.size(); ++p) dst[p] = o[p] == id;
+                 return out;
+             },
+             "(H, W) bool: its pixels, cut from Result.objects on each call.")
+        .def("__repr__", [](const Instance& i) {
+            return "Instance(id=" + std::to_string(i.object.id) +
+                   ", pixels=" + std::to_string(i.object.pixels) + ")";
+        });
+
+    py::class_<Result>(m, "Result", R"doc(
+Everything one frame produced, at the input's size. Owns its arrays: it stays valid after
+the next process().
+)doc")
+        .def_readonly("labels", &Result::labels,
+                      "(H, W) uint16: the paper's clusters, 0 = no point, 1..k (labels.png).")
+        .def_readonly("objects", &Result::objects,
+                      "(H, W) uint16: objects, 0 = background, else the track id (objects.png).")
+        .def_readonly("colors", &Result::colors,
+                      "(H, W, 3) uint8 RGB: eq. (9) display colours over the scene (colors.png).")
+        .def_readonly("instances", &Result::instances, "list of Instance, one per object.")
+        .def_readonly("plane", &Result::plane,
+                      "The support plane n . X + d = 0 as {'normal': (nx, ny, nz), 'd_m': d}, "
+                      "or None when none was found (objects.json's support_plane).")
+        .def_readonly("times", &Result::times,
+                      "Milliseconds per stage, 'overlap' (counted twice) and 'total'.")
+        .def_readonly("stats", &Result::stats,
+                      "What the frame did: points clustered, active points, seeding, segments "
+                      "(summary.json's per-frame entry).")
+        .def("__repr__", [](const Result& r) {
+            return "Result(" + std::to_string(r.labels.shape(1)) + "x" +
+                   std::to_string(r.labels.shape(0)) + ", " + std::to_string(r.instances.size()) +
+                   " objects)";
+        });
+}
+
+void bind_pipeline(py::module_& m) {
+    py::class_<PyPipeline>(m, "Pipeline", R"doc(
+The wul3d pipeline: the paper's weighted clustering of an RGB-D stream, then the support
+plane, object segments and object tracks. Holds state across frames (clusters and tracks):
+use one Pipeline per stream, feed its frames in order.
+
+Every argument is a flag of `wul3d run` (docs/CLI.md) and None keeps the preset's value;
+values outside their range raise ValueError with the same message as the command.
+
+Args:
+    preset (str): "default" or "paper" (the paper's parameters, every pixel).
+    k (int): number of clusters (default 7).
+    alpha (float): colour scale, eq. 4, [0.002, 0.1] (default 0.0033); without delta, delta
+        becomes 1 - alpha.
+    delta (float): position scale, eq. 4, alpha + delta <= 1.
+    gamma (float): normal scale, eq. 6, [0.0001, 0.01] (default 0.0001).
+    psi (float): weight increment, eq. 2, (0, 1] (default 1).
+    iters (int): k-means iterations per frame (default 1).
+    stride (int): sampling stride in pixels (default 1).
+    seed (int): k-means++ seed (default 1).
+    zmin (float): nearest depth kept, metres (default 0.2).
+    zmax (float): farthest depth kept, metres (default 4.5).
+    normal_radius (int): normal neighbour distance, pixels (default 2).
+    segmenter (str): "geometric", "kmeans" or "hybrid" (default).
+    remove_plane (bool): False keeps the support plane (`--no-plane`).
+    min_points (int): smallest object, pixels (default 300).
+    object_psi (float): eq. 2's increment for object tracks, (0, 1] (default 0.5).
+    decimate (int): N in [1, 8], run the stages on every N-th pixel (default 2).
+
+Example:
+    >>> p = wul3d.Pipeline(k=7, decimate=2)
+    >>> r = p.process(color, depth, wul3d.Intrinsics(525, 525, 319.5, 239.5))
+    >>> [(i.id, i.pixels) for i in r.instances]
+)doc")
+        .def(py::init([](std::optional<std::string> preset, std::optional<int> k,
+                         std::optional<float> alpha, std::optional<float> delta,
+                         std::optional<float> gamma, std::optional<float> psi,
+                         std::optional<int> iters, std::optional<int> stride,
+                         std::optional<std::uint64_t> seed, std::optional<float> zmin,
+                         std::optional<float> zmax, std::optional<int> normal_radius,
+                         std::optional<std::string> segmenter, bool remove_plane,
+                         std::optional<int> min_points, std::optional<float> object_psi,
+                         std::optional<int> decimate) {
+                 ParamArgs a;
+                 a.preset = preset;
+                 a.k = k;
+                 a.alpha = alpha;
+                 a.delta = delta;
+                 a.gamma = gamma;
+                 a.psi = psi;
+                 a.iters = iters;
+                 a.stride = stride;
+                 a.seed = seed;
+                 a.zmin = zmin;
+                 a.zmax = zmax;
+                 a.normal_radius = normal_radius;
+                 a.segmenter = segmenter;
+                 a.remove_plane = remove_plane;
+                 a.min_points = min_points;
+                 a.object_psi = object_psi;
+                 a.decimate = decimate;
+                 return std::make_unique<PyPipeline>(a);
+             }),
+             py::kw_only(), py::arg("preset") = py::none(), py::arg("k") = py::none(),
+             py::arg("alpha") = py::none(), py::arg("delta") = py::none(),
+             py::arg("gamma") = py::none(), py::arg("psi") = py::none(),
+             py::arg("iters") = py::none(), py::arg("stride") = py::none(),
+             py::arg("seed") = py::none(), py::arg("zmin") = py::none(),
+             py::arg("zmax") = py::none(), py::arg("normal_radius") = py::none(),
+             py::arg("segmenter") = py::none(), py::arg("remove_plane") = true,
+             py::arg("min_points") = py::none(), py::arg("object_psi") = py::none(),
+             py::arg("decimate") = py::none())
+        .def("process", &PyPipeline::process, py::arg("color"), py::arg("depth"),
+             py::arg("intrinsics"), py::arg("depth_scale") = 0.001f, R"doc(
+Runs every stage on one registered frame and returns a Result.
+
+Args:
+    color: (H, W, 3) uint8 RGB array, or None for depth only.
+    depth: (H, W) uint16 array in units of depth_scale (0 = no depth), or float32 metres
+        (NaN, inf and <= 0 = no depth).
+    intrinsics: wul3d.Intrinsics, or a dict with fx, fy, cx, cy (as intrinsics.json).
+    depth_scale (float): metres per unit of a uint16 depth (default 0.001, millimetres).
+
+C-contiguous arrays are required (TypeError for a wrong dtype, ValueError for a wrong shape
+or order). The GIL is released while the pipeline runs: pipelines in other threads run at
+the same time.
+)doc")
+        .def_property_readonly("params", [](const PyPipeline& p) { return params_dict(p.params()); },
+                               "The parameters in force, as a dict (summary.json's names).");
+}
+
+void bind_reading(py::module_& m) {
+    py::class_<PyFrame>(m, "Frame", "One registered RGB-D frame read from disk (wul3d.read).")
+        .def_readonly("name", &PyFrame::name, "Its name: OUT/<name>/ in `wul3d run`.")
+        .def_readonly("color", &PyFrame::color, "(H, W, 3) uint8 RGB, or None.")
+        .def_readonly("depth", &PyFrame::depth, "(H, W) uint16, units of depth_scale.")
+        .def_readonly("depth_scale", &PyFrame::depth_scale, "Metres per depth unit.")
+        .def_readonly("intrinsics", &PyFrame::intrinsics, "wul3d.Intrinsics of the frame.")
+        .def("__repr__", [](const PyFrame& f) {
+            return "Frame('" + f.name + "', " + std::to_string(f.depth.shape(1)) + "x" +
+                   std::to_string(f.depth.shape(0)) + (f.color.is_none() ? ", depth only)" : ")");
+        });
+
+    py::class_<Reader>(m, "_Reader")
+        .def(py::init([](const std::string& path, const std::string& format,
+                         const std::string& tum_camera, const py::object& intrinsics,
+                         const std::string& calibration, const std::string& registration) {
+                 SourceOptions o;
+                 o.format = parse_input_format(format);
+                 o.tum_camera = tum_camera;
+                 o.calibration = calibration;
+                 o.registration = parse_registration_mode(registration);
+                 if (!intrinsics.is_none()) {
+                     o.intrinsics = to_intrinsics(intrinsics, 1, 1);
+                     o.intrinsics->width = o.intrinsics->height = 0;  // each frame's own size
+                 }
+                 return std::make_unique<Reader>(path, o);
+             }),
+             py::arg("path"), py::arg("format"), py::arg("tum_camera"), py::arg("intrinsics"),
+             py::arg("calibration"), py::arg("registration"))
+        .def("__len__", &Reader::size)
+        .def("__getitem__", &Reader::get)
+        .def_property_readonly("format", &Reader::format);
+}
+
+void bind_eval(py::module_& m) {
+    m.def(
+        "_score_image",
+        [](const py::object& pred, const py::object& gt, double fraction, int tolerance,
+           double detected_f) {
+            const LabelImage p = to_label_image(pred, "pred");
+            const LabelImage g = to_label_image(gt, "gt");
+            const EvalParams params = eval_params(fraction, tolerance, detected_f);
+            ImageScore s;
+            {
+                py::gil_scoped_release release;
+                s = score_image(p, g, params);
+            }
+            return score_dict(s);
+        },
+        py::arg("pred"), py::arg("gt"), py::arg("boundary_fraction"),
+        py::arg("boundary_tolerance_px"), py::arg("detected_f"));
+    m.def(
+        "_summarize",
+        [](const py::list& scores) {
+            std::vector<ImageScore> v;
+            for (const auto& item : scores) {
+                const auto d = item.cast<py::dict>();
+                ImageScore s;
+                s.overlap_p = d["overlap_p"].cast<double>();
+                s.overlap_r = d["overlap_r"].cast<double>();
+                s.overlap_f = d["overlap_f"].cast<double>();
+                s.boundary_p = d["boundary_p"].cast<double>();
+                s.boundary_r = d["boundary_r"].cast<double>();
+                s.boundary_f = d["boundary_f"].cast<double>();
+                s.detected_share = d["detected_share"].cast<double>();
+                s.gt_objects = d["gt_objects"].cast<int>();
+                s.pred_objects = d["pred_objects"].cast<int>();
+                s.detected = d["detected"].cast<int>();
+                v.push_back(s);
+            }
+            return summary_dict(summarize(v));
+        },
+        py::arg("scores"));
+}
+
+}  // namespace
+}  // namespace wul3d::python
+
+PYBIND11_MODULE(_wul3d, m) {
+    using namespace wul3d::python;
+    m.doc() = "The compiled part of wul3d (see the package wul3d).";
+    bind_errors(m);
+    bind_intrinsics(m);
+    bind_result(m);
+    bind_pipeline(m);
+    bind_reading(m);
+    bind_eval(m);
+    bind_run(m);
+    m.def("read_label_image", [](const std::string& path) { return to_array(wul3d::read_label_png(path)); },
+          py::arg("path"), "A 16-bit label PNG (labels.png, objects.png, ground truth) as (H, W) uint16.");
+    m.def("read_color_image", [](const std::string& path) { return to_array(wul3d::read_color_image(path)); },
+          py::arg("path"), "An 8-bit PNG or JPEG as (H, W, 3) uint8 RGB.");
+    m.def("set_num_threads", [](int n) {
+              if (n < 1) throw py::value_error("threads = " + std::to_string(n) + ": must be >= 1");
+              omp_set_num_threads(n);
+          },
+          py::arg("n"), "Worker threads of every pipeline in this process (default: all cores).");
+    m.def("_concurrency", []() { return py::make_tuple(g_running.load(), g_max_running.load()); },
+          "(running now, most at once): Pipeline.process calls running without the GIL.");
+    m.def("_reset_concurrency", []() { g_max_running = g_running.load(); },
+          "Restarts the count of _concurrency's maximum.");
+    m.def("get_num_threads", []() { return omp_get_max_threads(); },
+          "Worker threads a pipeline uses.");
+}

@@ -1,0 +1,60 @@
+#include "params.hpp"
+
+#include "wul3d/error.hpp"
+#include "wul3d/segmentation.hpp"
+
+namespace wul3d::python {
+
+PipelineParams make_params(const ParamArgs& a) {
+    PipelineParams p;
+    if (a.preset && *a.preset == "paper") {
+        p = PipelineParams::paper();
+    } else if (a.preset && *a.preset != "default") {
+        throw ParamError("preset '" + *a.preset + "': unknown (known: default, paper)");
+    }
+    if (a.k) p.cluster.k = *a.k;
+    if (a.alpha) {
+        p.cluster.alpha = *a.alpha;
+        if (!a.delta) p.cluster.delta = 1.0f - *a.alpha;
+    }
+    if (a.delta) p.cluster.delta = *a.delta;
+    if (a.gamma) p.cluster.gamma = *a.gamma;
+    if (a.psi) p.cluster.psi = *a.psi;
+    if (a.iters) p.cluster.iters = *a.iters;
+    if (a.stride) p.cluster.stride = *a.stride;
+    if (a.seed) p.cluster.seed = *a.seed;
+    if (a.zmin) p.range.zmin_m = *a.zmin;
+    if (a.zmax) p.range.zmax_m = *a.zmax;
+    if (a.normal_radius) p.normals.radius_px = *a.normal_radius;
+    if (a.segmenter) p.segmentation.segmenter = parse_segmenter(*a.segmenter);
+    p.remove_plane = a.remove_plane;
+    if (a.min_points) p.segmentation.min_points = *a.min_points;
+    if (a.object_psi) p.objects.psi = *a.object_psi;
+    if (a.decimate) p.decimation = *a.decimate;
+    p.validate();
+    return p;
+}
+
+py::dict params_dict(const PipelineParams& p) {
+    const auto& c = p.cluster;
+    py::dict d;
+    d["k"] = c.k;
+    d["alpha"] = c.alpha;
+    d["delta"] = c.delta;
+    d["gamma"] = c.gamma;
+    d["psi"] = c.psi;
+    d["iters"] = c.iters;
+    d["stride"] = c.stride;
+    d["seed"] = c.seed;
+    d["zmin"] = p.range.zmin_m;
+    d["zmax"] = p.range.zmax_m;
+    d["normal_radius"] = p.normals.radius_px;
+    d["segmenter"] = segmenter_name(p.segmentation.segmenter);
+    d["remove_plane"] = p.remove_plane;
+    d["min_points"] = p.segmentation.min_points;
+    d["object_psi"] = p.objects.psi;
+    d["decimate"] = p.decimation;
+    return d;
+}
+
+}  // namespace wul3d::python

@@ -1,0 +1,8 @@
+#pragma once
+// wul3d._wul3d._run: the library's run loop (wul3d/run.hpp), `wul3d run` as one call.
+#include <pybind11/pybind11.h>
+
+namespace wul3d::python {
+/// Adds `_run` when the library has its run loop (include/wul3d/run.hpp).
+void bind_run(pybind11::module_& m);
+}  // namespace wul3d::python

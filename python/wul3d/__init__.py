@@ -1,0 +1,157 @@
+"""wul3d: objects in RGB-D frames on a CPU, from Python.
+
+Weighted unsupervised learning for 3D object detection (Kowsari & Alassaf) with object
+segmentation and tracking. The C++ library does the work; this module hands it numpy arrays
+and returns numpy arrays (docs/PYTHON.md).
+
+    >>> import wul3d
+    >>> pipeline = wul3d.Pipeline(k=7, decimate=2)
+    >>> for frame in wul3d.read("data/samples/uois_tabletop"):
+    ...     result = pipeline.process(frame.color, frame.depth, frame.intrinsics,
+    ...                               depth_scale=frame.depth_scale)
+    ...     print(frame.name, [(o.id, o.pixels) for o in result.instances])
+
+Contents:
+    Pipeline      the per-frame pipeline; process() returns a Result
+    Intrinsics    pinhole intrinsics (fx, fy, cx, cy)
+    Result        labels, objects, colors arrays; instances; plane; times
+    Instance      one object: id, track_id, pixels, centroid, aabb, obb, box_px, mean_rgb, mask()
+    read          the frames of any input `wul3d run` reads
+    run           `wul3d run` as a call: a whole recording into an output folder
+    evaluate      UOIS metrics of a prediction against ground truth
+    wul3d.batch   many sequences on Dask (python3 -m wul3d.batch)
+"""
+
+from collections.abc import Iterator, Sequence
+
+from ._wul3d import (  # noqa: F401  (re-exported)
+    Frame,
+    InputError,
+    Instance,
+    Intrinsics,
+    IoError,
+    Pipeline,
+    Result,
+    get_num_threads,
+    read_color_image,
+    read_label_image,
+    set_num_threads,
+)
+from . import _wul3d
+
+__all__ = [
+    "Frame", "InputError", "Instance", "Intrinsics", "IoError", "Pipeline", "Result",
+    "Reader", "evaluate", "get_num_threads", "read", "read_color_image", "read_label_image",
+    "run", "set_num_threads",
+]
+
+
+class Reader(Sequence):
+    """The frames of a recording, in order; a sequence of wul3d.Frame (len, index, iterate).
+
+    Made by wul3d.read. Frames are read from disk when indexed; each holds its own arrays.
+    """
+
+    def __init__(self, path, format="auto", tum_camera="", intrinsics=None, calibration="",
+                 registration="depth-to-color"):
+        self.path = str(path)
+        self._reader = _wul3d._Reader(self.path, format, tum_camera, intrinsics, calibration,
+                                      registration)
+
+    @property
+    def format(self) -> str:
+        """The format read: "frames", "tum" or "unregistered"."""
+        return self._reader.format
+
+    def __len__(self) -> int:
+        return len(self._reader)
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self._reader[i] for i in range(*index.indices(len(self)))]
+        return self._reader[index]
+
+    def __iter__(self) -> Iterator[Frame]:
+        for i in range(len(self)):
+            yield self._reader[i]
+
+    def __repr__(self) -> str:
+        return f"Reader({self.path!r}, {len(self)} frames, {self.format})"
+
+
+def read(path, format="auto", tum_camera="", intrinsics=None, calibration="",
+         registration="depth-to-color") -> Reader:
+    """Opens a recording as `wul3d run` does and returns its frames (a wul3d.Reader).
+
+    Args:
+        path: a frame folder (color.png, depth.png, intrinsics.json), a folder of frame
+            folders (a sequence, sorted by name), a TUM RGB-D sequence, or unregistered
+            frames with a calibration (docs/INPUTS.md).
+        format: "auto" (decided from the path), "frames", "tum" or "unregistered".
+        tum_camera: TUM intrinsics preset (kinect_v1, tum_fr1, tum_fr2, tum_fr3); "" picks
+            it from the folder name.
+        intrinsics: wul3d.Intrinsics or dict overriding every frame's intrinsics.
+        calibration: unregistered input: a calibration JSON or "kinect_v2".
+        registration: "depth-to-color" or "color-to-depth" (unregistered input).
+
+    Frames of unregistered input come back registered. Raises wul3d.InputError (a
+    ValueError) for a missing path or an empty sequence, ValueError for a bad option.
+    """
+    return Reader(path, format, tum_camera, intrinsics, calibration, registration)
+
+
+def evaluate(pred, gt, boundary_fraction=0.003, boundary_tolerance_px=-1, detected_f=0.75):
+    """UOIS metrics of predicted instances against ground truth, as `wul3d eval` computes them.
+
+    Args:
+        pred: (H, W) integer label image (0 = background, each other value one object), or a
+            list of them (one per frame).
+        gt: the ground truth, same shapes as pred.
+        boundary_fraction: boundary tolerance as a share of the image diagonal (3 px at
+            640x480).
+        boundary_tolerance_px: >= 0 overrides boundary_fraction; -1 uses it.
+        detected_f: an object counts as detected (%>=75) when its matched overlap F is above
+            this.
+
+    Returns:
+        For one image: a dict with overlap_p/r/f, boundary_p/r/f, detected_share (%>=75),
+        gt_objects, pred_objects, detected, boundary_tolerance_px and matches (the
+        Hungarian pairs). For a list: the macro average over images (docs/EVAL.md) with
+        "images" and the summed counts, and "per_image", the list of the per-image dicts.
+    """
+    if isinstance(pred, (list, tuple)) or isinstance(gt, (list, tuple)):
+        if not isinstance(pred, (list, tuple)) or not isinstance(gt, (list, tuple)):
+            raise TypeError("pred and gt: both lists of images, or both one image")
+        if len(pred) != len(gt):
+            raise ValueError(f"pred has {len(pred)} images, gt {len(gt)}")
+        scores = [_wul3d._score_image(p, g, boundary_fraction, boundary_tolerance_px, detected_f)
+                  for p, g in zip(pred, gt)]
+        summary = _wul3d._summarize(scores)
+        summary["per_image"] = scores
+        return summary
+    return _wul3d._score_image(pred, gt, boundary_fraction, boundary_tolerance_px, detected_f)
+
+
+
+def run(input, out, **options) -> dict:
+    """Runs a whole recording as `wul3d run INPUT --out OUT [options]` does, with the same
+    outputs (OUT/<frame>/ and OUT/summary.json, docs/OUTPUTS.md), in this process.
+
+    Args:
+        input: any input `wul3d run` reads (frame folders, TUM, unregistered frames).
+        out: the output folder (created if missing).
+        **options: the flags of `wul3d run`, with underscores: the Pipeline's parameters
+            (preset, k, alpha, ..., decimate, no_plane=True), format, tum_camera,
+            intrinsics ("fx,fy,cx,cy", wul3d.Intrinsics or dict), calibration,
+            registration, select ("u,v" or (u, v)), frames (stop after N), ply.
+
+    Returns:
+        dict: frames, stopped_by, ms_per_frame_median, fps, wall_s, peak_rss_mb (as in
+        summary.json). The GIL is released while it runs.
+
+    Raises ValueError (parameters), wul3d.InputError (input), wul3d.IoError (output),
+    TypeError (an unknown option).
+    """
+    if not hasattr(_wul3d, "_run"):
+        raise NotImplementedError("wul3d.run: this build's library has no run loop")
+    return _wul3d._run(str(input), str(out), dict(options))
