@@ -132,7 +132,7 @@ void bind_run(py::module_& m) {
     m.def(
         "_run",
         [](const std::string& input, const std::string& out, const py::dict& options) {
-            const RunOptions r = run_options(input, out, py::dict(options));  // a copy to consume
+            const RunOptions r = run_options(input, out, options.attr("copy")());  // a copy to consume
             RunSummary s;
             {
                 py::gil_scoped_release release;
@@ -144,6 +144,10 @@ void bind_run(py::module_& m) {
                             py::arg("peak_rss_mb") = s.peak_rss_mb);
         },
         py::arg("input"), py::arg("out"), py::arg("options"));
+    m.def(
+        "_check_run_options",
+        [](const py::dict& options) { run_options("", "", options.attr("copy")()); },
+        py::arg("options"), "Raises what _run would for these options, before any input is read.");
 }
 #else
 void bind_run(py::module_&) {}  // the library has no run loop yet
