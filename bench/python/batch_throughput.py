@@ -30,6 +30,7 @@ def main(argv=None):
     p.add_argument("--workers", default="1,2")
     p.add_argument("--threads-per-worker", type=int, default=1)
     p.add_argument("--decimate", type=int, default=2)
+    p.add_argument("--score", action="store_true", help="also the UOIS table (label.png)")
     args = p.parse_args(argv)
     from distributed import Client, LocalCluster
 
@@ -42,16 +43,18 @@ def main(argv=None):
         for workers in (int(w) for w in args.workers.split(",")):
             t0 = time.monotonic()
             with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                              dashboard_address=None) as cluster, Client(cluster) as client:
+                              dashboard_address=":0") as cluster, Client(cluster) as client:
                 startup = time.monotonic() - t0
                 out = pathlib.Path(tmp) / f"out{workers}"
                 report = batch.run_batch(root, out, client=client,
                                          threads_per_worker=args.threads_per_worker,
-                                         options={"decimate": args.decimate}, progress=False)
+                                         options={"decimate": args.decimate}, progress=False,
+                                         score=args.score)
             t = report["totals"]
             seq_fps = [s["fps"] for s in report["sequences"]]
             print(json.dumps({
                 "workers": workers, "threads_per_worker": args.threads_per_worker,
+                "score": args.score,
                 "sequences": n_seq, "frames": t["frames"], "failed": t["failed"],
                 "wall_s": round(t["wall_s"], 2),
                 "sequences_per_s": round(n_seq / t["wall_s"], 3),

@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -117,6 +118,7 @@ public:
         const FrameArrays arrays = check_frame_arrays(color, depth);
         const PinholeIntrinsics K = to_intrinsics(intrinsics, arrays.width, arrays.height);
         const FrameResult* r = nullptr;
+        double call_ms = 0;
         // Held until the result is copied: it is valid until the next process(). A thread
         // waiting for the lock waits without the GIL, so this thread can take it back.
         std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
@@ -127,9 +129,13 @@ public:
             frame_.name = "frame";
             frame_.intrinsics = K;
             fill_frame(arrays, depth_scale, frame_);
+            const auto t0 = std::chrono::steady_clock::now();
             r = &pipeline_.process(frame_);
+            call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
-        return make_result(*r);
+        Result out = make_result(*r);
+        out.times["call"] = call_ms;
+        return out;
     }
 
     const PipelineParams& params() const { return pipeline_.params(); }
@@ -381,7 +387,9 @@ the next process().
                       "The support plane n . X + d = 0 as {'normal': (nx, ny, nz), 'd_m': d}, "
                       "or None when none was found (objects.json's support_plane).")
         .def_readonly("times", &Result::times,
-                      "Milliseconds per stage, 'overlap' (counted twice) and 'total'.")
+                      "Milliseconds per stage, 'overlap' (counted twice), 'total' (the stages, as "
+                      "`wul3d run` reports them) and 'call' (the whole C++ Pipeline::process "
+                      "call; process() from Python costs this plus the binding's overhead).")
         .def_readonly("stats", &Result::stats,
                       "What the frame did: points clustered, active points, seeding, segments "
                       "(summary.json's per-frame entry).")

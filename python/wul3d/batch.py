@@ -130,7 +130,7 @@ def _frame_scores(input_dir: pathlib.Path, out_dir: pathlib.Path, names):
 
 
 def run_sequence_task(input_dir: str, out_root: str, rel_out: str, options: dict,
-                      threads: int) -> dict:
+                      threads: int, score: bool = True) -> dict:
     """One Dask task: `wul3d run` of one sequence into OUT/<rel_out>, staged and renamed.
 
     Returns the sequence's record for batch.json. Bad input is caught and reported (status
@@ -151,7 +151,7 @@ def run_sequence_task(input_dir: str, out_root: str, rel_out: str, options: dict
         staging.mkdir(parents=True)
         summary = wul3d.run(input_dir, str(staging), **options)
         names = sorted(p.name for p in staging.iterdir() if p.is_dir())
-        record["scores"] = _frame_scores(pathlib.Path(input_dir), staging, names)
+        record["scores"] = _frame_scores(pathlib.Path(input_dir), staging, names) if score else []
         _publish(staging, final)
         record.update(status="ok", frames=summary["frames"], fps=summary["fps"])
     except (ValueError, OSError, RuntimeError) as e:  # wul3d.InputError is a ValueError
@@ -208,7 +208,7 @@ def _uois_table(records):
 
 
 def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, options=None,
-              retries=1, progress=True, client=None, timeout_s=None) -> dict:
+              retries=1, progress=True, client=None, timeout_s=None, score=True) -> dict:
     """Runs every sequence under `root` (discover) into `out` on Dask; returns batch.json's
     content, also written to OUT/batch.json.
 
@@ -224,6 +224,8 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
             scheduler regardless, up to distributed.scheduler.allowed-failures).
         client: an existing distributed.Client to use instead of scheduler/workers.
         timeout_s: give up waiting after this many seconds (TimeoutError); None: no limit.
+        score: False skips the UOIS table (scoring a 640x480 frame costs more than
+            processing it, docs/SCALE.md).
     """
     from distributed import Client, LocalCluster, wait
 
@@ -248,7 +250,7 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
             threads_per_worker = threads_per_worker or max(1, cores // workers)
             # One task per worker at a time: a task's own threads use the cores.
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+                                   dashboard_address=":0")
             client = Client(cluster)
     start = time.monotonic()
     records, futures = {}, {}
@@ -256,10 +258,11 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
         for rel in sequences:
             rel_out = str(output_dir(out, root, rel).relative_to(out))
             if is_finished(out / rel_out):
-                records[rel_out] = _finished_record(root / rel, out / rel_out, rel_out)
+                records[rel_out] = _finished_record(root / rel, out / rel_out, rel_out, score)
                 continue
             fut = client.submit(run_sequence_task, str(root / rel), str(out), rel_out, options,
-                                threads_per_worker or 0, key=f"wul3d-{rel_out}-{uuid.uuid4().hex}",
+                                threads_per_worker or 0, score,
+                                key=f"wul3d-{rel_out}-{uuid.uuid4().hex}",
                                 retries=retries, pure=False)
             futures[fut] = rel_out
         bar = _Progress(len(sequences), progress)
@@ -324,14 +327,15 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
     return report
 
 
-def _finished_record(input_dir, out_dir, rel_out):
+def _finished_record(input_dir, out_dir, rel_out, score):
     """batch.json's record of a sequence a previous run finished (its scores recomputed)."""
     with open(out_dir / DONE_MARKER, encoding="utf-8") as f:
         summary = json.load(f)
     names = sorted(p.name for p in out_dir.iterdir() if p.is_dir() and (out_dir / p.name / "objects.png").is_file())
     return {"sequence": rel_out, "input": str(input_dir), "worker": None, "status": "skipped",
             "error": None, "frames": summary.get("frames", 0), "fps": summary.get("fps", 0.0),
-            "wall_s": 0.0, "scores": _frame_scores(pathlib.Path(input_dir), out_dir, names)}
+            "wall_s": 0.0,
+            "scores": _frame_scores(pathlib.Path(input_dir), out_dir, names) if score else []}
 
 
 # ---- command line -------------------------------------------------------------------------
@@ -349,6 +353,8 @@ def _parser():
                    help="wul3d threads in each task (default: cores / workers)")
     p.add_argument("--retries", type=int, default=1, help="extra tries of a task that raised")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-score", action="store_true",
+                   help="no UOIS table even where frames carry label.png")
     run = p.add_argument_group("run options (as `wul3d run`)")
     for name, kind in RUN_OPTIONS.items():
         run.add_argument("--" + name.replace("_", "-"), dest=name, type=kind)
@@ -369,7 +375,8 @@ def main(argv=None) -> int:
     try:
         report = run_batch(args.root, args.out, scheduler=args.scheduler, workers=args.workers,
                            threads_per_worker=args.threads_per_worker, options=options,
-                           retries=args.retries, progress=not args.quiet)
+                           retries=args.retries, progress=not args.quiet,
+                           score=not args.no_score)
     except (FileNotFoundError, ValueError, OSError) as e:
         print(f"wul3d.batch: {e}", file=sys.stderr)
         return 2

@@ -35,7 +35,7 @@ os.environ["PYTHONPATH"] = os.pathsep.join(
 def client():
     """A LocalCluster of 2 worker processes (1 task each at a time), shared by the tests."""
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as c:
+                      dashboard_address=":0") as cluster, Client(cluster) as c:
         yield c
 
 
