@@ -1,6 +1,6 @@
 // The decimation stage alone (--decimate 2) on a real 640x480 frame: shrinking the frame, and
 // finding each input pixel's source among the decimated pixels (the look-up that
-// Pipeline::expand_result does per pixel before copying the results).
+// expand_result (decimation.cpp) does per pixel before copying the results).
 #include <benchmark/benchmark.h>
 
 #include "bench_support.hpp"

@@ -7,6 +7,8 @@
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/pipeline.hpp"
+#include "wul3d/visualization.hpp"
 
 namespace wul3d {
 
@@ -214,5 +216,230 @@ std::int32_t DecimatedSource::nearest_in_depth(int bu, int bv, float z, const st
         }
     return best;
 }
+
+// ---- the way back: expand_result --------------------------------------------------------
+
+/// expand_result's scratch: track id -> object_list index, and per row band the active pixels
+/// and each object's pixels and box; the edge blocks and their colour vote.
+struct ExpandWorkspace::Buffers {
+    /// Pixels and 2D box of one object within one band of rows.
+    struct Box {
+        int u_min, v_min, u_max, v_max;
+        std::size_t pixels;
+        void add(int u, int v) {
+            ++pixels;
+            u_min = std::min(u_min, u);
+            v_min = std::min(v_min, v);
+            u_max = std::max(u_max, u);
+            v_max = std::max(v_max, v);
+        }
+        void merge(const Box& o) {
+            pixels += o.pixels;
+            u_min = std::min(u_min, o.u_min);
+            v_min = std::min(v_min, o.v_min);
+            u_max = std::max(u_max, o.u_max);
+            v_max = std::max(v_max, o.v_max);
+        }
+    };
+    /// Row bands, counted apart and reduced in band order: the same sums on any thread count.
+    static constexpr int kBands = 16;
+    std::vector<int> object_index;
+    std::vector<std::size_t> band_active;
+    std::vector<Box> band_boxes;
+    std::vector<std::uint8_t> edge_blocks;        ///< decimated pixels at an object's outline
+    std::vector<std::uint16_t> edge_lo, edge_hi;  ///< their 3-wide row minima and maxima
+    std::vector<std::int32_t> block_source;       ///< each edge block's source after the colour vote
+};
+
+ExpandWorkspace::ExpandWorkspace() : b_(std::make_unique<Buffers>()) {}
+ExpandWorkspace::~ExpandWorkspace() = default;
+ExpandWorkspace::ExpandWorkspace(ExpandWorkspace&&) noexcept = default;
+ExpandWorkspace& ExpandWorkspace::operator=(ExpandWorkspace&&) noexcept = default;
+
+void expand_result(const PipelineParams& params, const RgbdFrame& frame,
+                   const RgbdFrame& decimated, const FrameResult& s, ExpandWorkspace& ws,
+                   FrameResult& r) {
+    ExpandWorkspace::Buffers& buf = *ws.b_;
+    const int W = frame.width(), H = frame.height();
+    // An input pixel takes a neighbouring block's results across a depth step no larger
+    // than the segmentation's own connection rule over the block's width.
+    const float n = static_cast<float>(params.decimation);
+    DecimatedSource source(frame.depth, decimated.depth, params.decimation,
+                           n * params.segmentation.depth_jump_m,
+                           n * params.segmentation.depth_jump_rel);
+    // Edge blocks: an object (or, without the object stages, a cluster) other than the
+    // block's own in its 3 x 3 neighbourhood. There the input's colour places the outline.
+    const LabelImage& outline = params.detect_objects ? s.objects : s.labels;
+    const int w = outline.width, h = outline.height;
+    const std::size_t n_small = outline.labels.size();
+    // Separable: each pixel's row-wise minimum and maximum over three, then column-wise;
+    // an edge where the 3 x 3 minimum and maximum differ. Plain loops over rows through raw
+    // pointers, the borders clamped by the row pointers' choice, not per pixel: they vectorize.
+    buf.edge_blocks.resize(n_small);
+    buf.edge_lo.resize(n_small);
+    buf.edge_hi.resize(n_small);
+    const std::uint16_t* const l = outline.labels.data();
+    std::uint16_t *const lo = buf.edge_lo.data(), *const hi = buf.edge_hi.data();
+    std::uint8_t* const edge = buf.edge_blocks.data();
+    auto min3 = [](std::uint16_t a, std::uint16_t b, std::uint16_t c) { return std::min(std::min(a, b), c); };
+    auto max3 = [](std::uint16_t a, std::uint16_t b, std::uint16_t c) { return std::max(std::max(a, b), c); };
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < h; ++v) {
+        const std::uint16_t* const in = l + static_cast<std::size_t>(v) * w;
+        std::uint16_t *const row_lo = lo + static_cast<std::size_t>(v) * w, *const row_hi = hi + static_cast<std::size_t>(v) * w;
+        row_lo[0] = min3(in[0], in[0], in[std::min(1, w - 1)]);
+        row_hi[0] = max3(in[0], in[0], in[std::min(1, w - 1)]);
+        for (int u = 1; u < w - 1; ++u) {
+            row_lo[u] = min3(in[u - 1], in[u], in[u + 1]);
+            row_hi[u] = max3(in[u - 1], in[u], in[u + 1]);
+        }
+        if (w > 1) {
+            row_lo[w - 1] = min3(in[w - 2], in[w - 1], in[w - 1]);
+            row_hi[w - 1] = max3(in[w - 2], in[w - 1], in[w - 1]);
+        }
+    }
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < h; ++v) {
+        const std::size_t up = static_cast<std::size_t>(std::max(v - 1, 0)) * w,
+                          row = static_cast<std::size_t>(v) * w,
+                          down = static_cast<std::size_t>(std::min(v + 1, h - 1)) * w;
+        const std::uint16_t *const lo_up = lo + up, *const lo_row = lo + row, *const lo_down = lo + down;
+        const std::uint16_t *const hi_up = hi + up, *const hi_row = hi + row, *const hi_down = hi + down;
+        std::uint8_t* const out = edge + row;
+        for (int u = 0; u < w; ++u)
+            out[u] = min3(lo_up[u], lo_row[u], lo_down[u]) != max3(hi_up[u], hi_row[u], hi_down[u]);
+    }
+    source.use_colour_at_edges(frame.color, decimated.color, buf.edge_blocks.data(), l, buf.block_source);
+    r.stats = s.stats;
+    r.plane = s.plane;
+    r.segment_stats = s.segment_stats;
+    r.object_list = s.object_list;
+    const bool objects = params.detect_objects;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    // Without the object stages their images stay empty, as run_on leaves them.
+    auto shape = [](LabelImage& img, int width, int height) {
+        img.width = width;
+        img.height = height;
+        img.labels.resize(static_cast<std::size_t>(width) * height);
+    };
+    shape(r.labels, W, H);
+    shape(r.segments, objects ? W : 0, objects ? H : 0);
+    shape(r.objects, objects ? W : 0, objects ? H : 0);
+    r.colors.width = W;
+    r.colors.height = H;
+    r.colors.rgb.resize(3 * N);
+    r.active.resize(N);
+    r.plane_classes.resize(objects ? N : 0);
+
+    // Track id -> index in object_list, for each object's pixel count and 2D box.
+    int max_id = 0;
+    for (const DetectedObject& d : r.object_list) max_id = std::max(max_id, d.id);
+    buf.object_index.assign(static_cast<std::size_t>(max_id) + 1, -1);
+    for (std::size_t i = 0; i < r.object_list.size(); ++i)
+        buf.object_index[static_cast<std::size_t>(r.object_list[i].id)] = static_cast<int>(i);
+    const std::size_t n_obj = r.object_list.size();
+    buf.band_boxes.assign(ExpandWorkspace::Buffers::kBands * n_obj, ExpandWorkspace::Buffers::Box{W, H, -1, -1, 0});
+    buf.band_active.assign(ExpandWorkspace::Buffers::kBands, 0);
+
+    // One pass: every result of the pixel's source, or "no point" without one; the counts
+    // and boxes per fixed row band, reduced in band order below.
+    // Raw pointers: through the vectors, every byte store would make the compiler reload
+    // every data pointer.
+    const std::uint8_t* const frame_rgb = frame.color.rgb.size() == 3 * N ? frame.color.rgb.data() : nullptr;
+    const std::uint16_t *const in_labels = s.labels.labels.data(), *const in_segments = s.segments.labels.data(),
+                        *const in_objects = s.objects.labels.data();
+    const std::uint8_t *const in_rgb = s.colors.rgb.data(), *const in_active = s.active.data(),
+                       *const in_classes = s.plane_classes.data();
+    std::uint16_t *const labels = r.labels.labels.data(), *const segments = r.segments.labels.data(),
+                  *const objects_out = r.objects.labels.data();
+    std::uint8_t *const colors = r.colors.rgb.data(), *const active_out = r.active.data(),
+                 *const classes = r.plane_classes.data();
+    const int* const object_index = buf.object_index.data();
+    // A pixel is in the depth range by its own depth, as at every pixel (select_depth_range):
+    // the block it takes can lie on the other side of a limit. In range, on a block that is
+    // not, it takes the nearest in depth of the 3 x 3 blocks that are (its own is: the frame
+    // was decimated to blocks in range where they could be); out of range, none.
+    const float scale = frame.depth.scale_m_per_unit;
+    const DepthRange& range = params.range;
+    const std::uint16_t* const depth = frame.depth.data.data();
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < ExpandWorkspace::Buffers::kBands; ++band) {
+        ExpandWorkspace::Buffers::Box* const boxes = buf.band_boxes.data() + static_cast<std::size_t>(band) * n_obj;
+        std::size_t active = 0;
+        for (int v = band * H / ExpandWorkspace::Buffers::kBands; v < (band + 1) * H / ExpandWorkspace::Buffers::kBands; ++v) {
+            const int bv = v / source.factor();
+            for (int u = 0, bu = 0, in_block = 0; u < W; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                std::uint8_t* const rgb = colors + 3 * p;
+                std::int32_t q = source.in_block(u, v, bu, bv);
+                if (q >= 0) {
+                    if (!range.contains(static_cast<float>(depth[p]) * scale))
+                        q = -1;
+                    else if (!in_active[q])
+                        q = source.nearest_in_depth(bu, bv, depth[p], in_active);
+                }
+                if (++in_block == source.factor()) {
+                    in_block = 0;
+                    ++bu;
+                }
+                if (q < 0) {
+                    labels[p] = 0;
+                    rgb[0] = rgb[1] = rgb[2] = frame_rgb ? dimmed_grey(frame_rgb + 3 * p) : 0;
+                    active_out[p] = 0;
+                    if (!objects) continue;
+                    classes[p] = kPlaneRemoved;
+                    segments[p] = 0;
+                    objects_out[p] = 0;
+                    continue;
+                }
+                const auto sq = static_cast<std::size_t>(q);
+                labels[p] = in_labels[sq];
+                rgb[0] = in_rgb[3 * sq];
+                rgb[1] = in_rgb[3 * sq + 1];
+                rgb[2] = in_rgb[3 * sq + 2];
+                active += active_out[p] = in_active[sq];
+                if (!objects) continue;
+                classes[p] = in_classes[sq];
+                segments[p] = in_segments[sq];
+                const std::uint16_t id = objects_out[p] = in_objects[sq];
+                if (id == 0 || id > max_id || object_index[id] < 0) continue;
+                boxes[object_index[id]].add(u, v);
+            }
+        }
+        buf.band_active[static_cast<std::size_t>(band)] = active;
+    }
+    r.active_points = 0;
+    for (std::size_t a : buf.band_active) r.active_points += a;
+    for (std::size_t i = 0; i < n_obj; ++i) {
+        DetectedObject& d = r.object_list[i];
+        ExpandWorkspace::Buffers::Box total{W, H, -1, -1, 0};
+        for (int band = 0; band < ExpandWorkspace::Buffers::kBands; ++band)
+            total.merge(buf.band_boxes[static_cast<std::size_t>(band) * n_obj + i]);
+        d.pixels = total.pixels;
+        d.u_min = total.u_min;
+        d.v_min = total.v_min;
+        d.u_max = total.u_max;
+        d.v_max = total.v_max;
+    }
+    // The tracker's minimum (ObjectParams::min_points) counts the input's pixels: the stages
+    // checked it divided by N^2 on blocks, and an object can come back a few pixels short.
+    const auto min_pixels = static_cast<std::size_t>(params.objects.min_points);
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < n_obj; ++i) {
+        DetectedObject& d = r.object_list[i];
+        if (d.pixels >= min_pixels) {
+            if (kept != i) r.object_list[kept] = std::move(d);
+            ++kept;
+            continue;
+        }
+        for (int v = d.v_min; v <= d.v_max; ++v)
+            for (int u = d.u_min; u <= d.u_max; ++u) {
+                std::uint16_t& id = objects_out[static_cast<std::size_t>(v) * W + u];
+                if (id == d.id) id = 0;
+            }
+    }
+    r.object_list.resize(kept);
+}
+
 
 }  // namespace wul3d

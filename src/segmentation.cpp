@@ -9,7 +9,9 @@
 #include <sstream>
 
 #include "param_check.hpp"
+#include "wul3d/clustering.hpp"  // distance_f, ClusterParams: the kmeans segmenter
 #include "wul3d/error.hpp"
+#include "wul3d/normals.hpp"  // smooth_normals
 #include "wul3d/plane.hpp"
 
 namespace wul3d {

@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 
+#include "wul3d/camera.hpp"
 #include "wul3d/error.hpp"
 
 using namespace wul3d;

@@ -4,7 +4,9 @@
 
 #include "synthetic_scene.hpp"
 #include "wul3d/background.hpp"
+#include "wul3d/clustering.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/normals.hpp"
 
 using namespace wul3d;
 using namespace wul3d::test;

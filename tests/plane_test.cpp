@@ -12,6 +12,7 @@
 #include "wul3d/decimation.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/normals.hpp"
 #include "wul3d/segmentation.hpp"
 
 using namespace wul3d;

@@ -5,6 +5,7 @@
 #include "synthetic_scene.hpp"
 #include "wul3d/background.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/normals.hpp"
 #include "wul3d/plane.hpp"
 
 using namespace wul3d;

@@ -6,6 +6,7 @@
 
 #include "synthetic_scene.hpp"
 #include "wul3d/background.hpp"
+#include "wul3d/normals.hpp"
 
 using namespace wul3d;
 using namespace wul3d::test;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "wul3d/background.hpp"
@@ -29,7 +30,7 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out,
                     const DepthRange* range = nullptr);
 
 /// Which pixel of the decimated frame an input pixel takes its results from (the pipeline
-/// copies every per-pixel result through it: Pipeline::expand_result). An input pixel
+/// copies every per-pixel result through it: expand_result). An input pixel
 /// without depth has none (-1). One with depth z is on the surface of a block whose depth is
 /// within same_m + same_rel z^2 (metres) of z. It takes its own block when on its surface,
 /// else the one of the 3 x 3 neighbouring blocks nearest to z in depth (an edge pixel whose
@@ -104,5 +105,35 @@ private:
     const std::uint8_t* edges_ = nullptr;      ///< edge blocks
     const std::int32_t* voted_ = nullptr;      ///< each block's source after the vote
 };
+
+struct FrameResult;     // pipeline.hpp
+struct PipelineParams;  // pipeline.hpp
+
+/// expand_result's buffers, reused from frame to frame (opaque: decimation.cpp).
+class ExpandWorkspace {
+public:
+    ExpandWorkspace();
+    ~ExpandWorkspace();
+    ExpandWorkspace(ExpandWorkspace&&) noexcept;
+    ExpandWorkspace& operator=(ExpandWorkspace&&) noexcept;
+
+private:
+    struct Buffers;
+    std::unique_ptr<Buffers> b_;
+    friend void expand_result(const PipelineParams&, const RgbdFrame&, const RgbdFrame&,
+                              const struct FrameResult&, ExpandWorkspace&, struct FrameResult&);
+};
+
+/// The last stage with decimation: `small`, the results of the stages on `decimated` (`frame`
+/// decimated by params.decimation with decimate_frame and params.range), carried back to
+/// `frame`'s pixels into `out`. Each per-pixel result (labels, colours, active points, plane
+/// classes, segments, objects) comes from the pixel's source block (DecimatedSource, with
+/// the colour placement at object outlines); a pixel out of the depth range, or without a
+/// source, is no point. Each object's pixels and 2D box are counted again at the input's
+/// size, and objects left under params.objects.min_points input pixels are dropped.
+/// Everything else of `small` (stats, plane, object_list) is copied; `out.times` is not set.
+void expand_result(const PipelineParams& params, const RgbdFrame& frame,
+                   const RgbdFrame& decimated, const FrameResult& small, ExpandWorkspace& ws,
+                   FrameResult& out);
 
 }  // namespace wul3d

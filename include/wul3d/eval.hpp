@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "wul3d/clustering.hpp"  // LabelImage
+#include "wul3d/image.hpp"
 
 namespace wul3d {
 

@@ -1,32 +1,13 @@
 #pragma once
 /// @file frame.hpp
-/// Images and the registered RGB-D frame that every later stage consumes.
-#include <cstdint>
+/// The registered RGB-D frame that every later stage consumes, and the raw frame of a
+/// two-camera sensor.
 #include <string>
-#include <vector>
 
 #include "wul3d/camera.hpp"
+#include "wul3d/image.hpp"
 
 namespace wul3d {
-
-/// 16-bit depth, row-major. metres = value * scale_m_per_unit; 0 = invalid.
-struct DepthImage {
-    int width = 0;
-    int height = 0;
-    float scale_m_per_unit = 0.001f;
-    std::vector<std::uint16_t> data;  ///< width * height
-
-    bool empty() const { return data.empty(); }
-};
-
-/// 8-bit colour, row-major, interleaved R, G, B (not OpenCV's BGR).
-struct ColorImage {
-    int width = 0;
-    int height = 0;
-    std::vector<std::uint8_t> rgb;  ///< 3 * width * height
-
-    bool empty() const { return rgb.empty(); }
-};
 
 /// A registered RGB-D frame: colour and depth pixel-aligned, one intrinsics for both.
 /// A depth-only frame has an empty `color`. Unregistered input becomes this shape

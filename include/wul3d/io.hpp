@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "wul3d/backprojection.hpp"
-#include "wul3d/clustering.hpp"
+#include "wul3d/cloud.hpp"
 #include "wul3d/frame.hpp"
+#include "wul3d/image.hpp"
 #include "wul3d/registration.hpp"
 
 namespace wul3d {

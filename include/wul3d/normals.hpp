@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "wul3d/backprojection.hpp"
+#include "wul3d/cloud.hpp"
 
 namespace wul3d {
 
@@ -19,17 +19,6 @@ struct NormalParams {
     float max_depth_jump_rel = 0.02f;
 
     void validate() const;  ///< throws ParamError
-};
-
-/// Unit normals, structure of arrays, one per pixel; valid = 0 where none could be computed,
-/// and then n = (0, 0, 0) (smooth_normals relies on it).
-struct NormalMap {
-    int width = 0;
-    int height = 0;
-    std::vector<float> nx, ny, nz;
-    std::vector<std::uint8_t> valid;
-
-    void resize(int w, int h);
 };
 
 void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, NormalMap& out);

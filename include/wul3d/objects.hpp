@@ -11,8 +11,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "wul3d/backprojection.hpp"
-#include "wul3d/clustering.hpp"
+#include "wul3d/cloud.hpp"
+#include "wul3d/image.hpp"
+#include "wul3d/weights.hpp"
 
 namespace wul3d {
 

@@ -33,9 +33,9 @@ std::string objects_json(const FrameResult& result, int selected_id = 0);
 /// What write_frame writes beyond the four images and objects.json.
 struct FrameOutputs {
     /// selected.png: the followed cluster's mask (255 = in it), or nullptr for none.
-    const std::vector<std::uint8_t>* selected = nullptr;
+    const Mask* selected = nullptr;
     /// selected_object.png: the followed object's mask, or nullptr for none.
-    const std::vector<std::uint8_t>* selected_object = nullptr;
+    const Mask* selected_object = nullptr;
     int selected_id = 0;  ///< objects.json's "selected" (see objects_json)
     bool ply = false;     ///< cloud.ply: the labelled points, binary PLY
 };

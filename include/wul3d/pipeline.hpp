@@ -132,8 +132,6 @@ private:
     /// and the segments (which read no cluster label but with the kmeans segmenter).
     void cluster_and_colour(const RgbdFrame& frame, FrameResult& r);
     void plane_and_segments(const RgbdFrame& frame, FrameResult& r);
-    /// `decimated_result_` carried back to `frame`'s pixels, into result_.
-    void expand_result(const RgbdFrame& frame);
 
     detail::SideBySideChoice side_by_side_;  ///< whether run_on's two parts run side by side
 
@@ -149,33 +147,7 @@ private:
     RgbdFrame registered_;
     RgbdFrame decimated_;
     FrameResult decimated_result_;
-    // expand_result's scratch: track id -> object_list index, and per row band the active
-    // pixels and each object's pixels and box.
-    struct PixelBox {
-        int u_min, v_min, u_max, v_max;
-        std::size_t pixels;
-        void add(int u, int v) {
-            ++pixels;
-            u_min = std::min(u_min, u);
-            v_min = std::min(v_min, v);
-            u_max = std::max(u_max, u);
-            v_max = std::max(v_max, v);
-        }
-        void merge(const PixelBox& b) {
-            pixels += b.pixels;
-            u_min = std::min(u_min, b.u_min);
-            v_min = std::min(v_min, b.v_min);
-            u_max = std::max(u_max, b.u_max);
-            v_max = std::max(v_max, b.v_max);
-        }
-    };
-    static constexpr int kExpandBands = 16;
-    std::vector<int> object_index_;
-    std::vector<std::size_t> band_active_;
-    std::vector<PixelBox> band_boxes_;
-    std::vector<std::uint8_t> edge_blocks_;  ///< decimated pixels at an object's outline
-    std::vector<std::uint16_t> edge_lo_, edge_hi_;  ///< their 3-wide row minima and maxima
-    std::vector<std::int32_t> block_source_;  ///< each edge block's source after the colour vote
+    ExpandWorkspace expand_ws_;
     FrameResult result_;
 };
 

@@ -12,9 +12,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "wul3d/backprojection.hpp"
 #include "wul3d/camera.hpp"
-#include "wul3d/normals.hpp"
+#include "wul3d/cloud.hpp"
 
 namespace wul3d {
 

@@ -40,7 +40,7 @@ struct RunFrame {
     std::size_t total;         ///< frames this run will process; 0 = unknown (a camera)
     const RgbdFrame& frame;    ///< the (registered) input frame
     const FrameResult& result;
-    const std::vector<std::uint8_t>* selected;  ///< the followed cluster's mask, or nullptr
+    const Mask* selected;      ///< the followed cluster's mask, or nullptr
     double fps;                ///< the pipeline's rate so far (median frame time)
 };
 

@@ -14,9 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "wul3d/backprojection.hpp"
-#include "wul3d/clustering.hpp"
-#include "wul3d/normals.hpp"
+#include "wul3d/cloud.hpp"
+#include "wul3d/image.hpp"
 #include "wul3d/plane.hpp"
 
 namespace wul3d {
