@@ -111,8 +111,8 @@ public:
     explicit PyPipeline(const ParamArgs& args) : pipeline_(make_params(args)) {}
 
     Result process(const py::object& color, const py::object& depth,
-                   const py::object& intrinsics, float depth_scale) {
-        if (!(depth_scale > 0) || !std::isfinite(depth_scale))
+                   const py::object& intrinsics, double depth_scale) {
+        if (!(depth_scale > 0) || !std::isfinite(depth_scale) || depth_scale > 1e3)
             throw py::value_error("depth_scale = " + std::to_string(depth_scale) +
                                   ": must be a positive number of metres per unit");
         const FrameArrays arrays = check_frame_arrays(color, depth);
@@ -128,7 +128,7 @@ public:
             const RunningScope running;
             frame_.name = "frame";
             frame_.intrinsics = K;
-            fill_frame(arrays, depth_scale, frame_);
+            fill_frame(arrays, static_cast<float>(depth_scale), frame_);
             const auto t0 = std::chrono::steady_clock::now();
             r = &pipeline_.process(frame_);
             call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -406,7 +406,7 @@ The wul3d pipeline: the paper's weighted clustering of an RGB-D stream, then the
 plane, object segments and object tracks. Holds state across frames (clusters and tracks):
 use one Pipeline per stream, feed its frames in order.
 
-Every argument is a flag of `wul3d run` (docs/CLI.md) and None keeps the preset's value;
+Every argument is a flag of `wul3d run` (`wul3d run --help`) and None keeps the preset's value;
 values outside their range raise ValueError with the same message as the command.
 
 Args:
@@ -473,7 +473,7 @@ Example:
              py::arg("min_points") = py::none(), py::arg("object_psi") = py::none(),
              py::arg("decimate") = py::none())
         .def("process", &PyPipeline::process, py::arg("color"), py::arg("depth"),
-             py::arg("intrinsics"), py::arg("depth_scale") = 0.001f, R"doc(
+             py::arg("intrinsics"), py::arg("depth_scale") = 0.001, R"doc(
 Runs every stage on one registered frame and returns a Result.
 
 Args:
