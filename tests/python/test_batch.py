@@ -7,6 +7,7 @@ import filecmp
 import json
 import os
 import pathlib
+import select
 import shutil
 import signal
 import socket
@@ -264,3 +265,48 @@ def test_scheduler_and_workers_as_processes_survive_a_killed_worker(tmp_path):
         assert not (out / batch.STAGING).exists()  # the killed try's folder is gone too
     finally:
         procs.stop()
+
+
+def test_progress_bar_on_a_terminal_only(tmp_path):
+    import pty
+
+    root = tmp_path / "root"
+    root.mkdir()
+    os.symlink(SAMPLES / "uois_tabletop", root / "tabletop")
+    os.symlink(SAMPLES / "pcl_kinect" / "pairwise_seq", root / "pairwise")
+    leader, follower = pty.openpty()
+    try:
+        proc = subprocess.Popen([sys.executable, "-m", "wul3d.batch", str(root), "--out",
+                                 str(tmp_path / "out"), "--workers", "1",
+                                 "--threads-per-worker", "1"],
+                                stdout=subprocess.PIPE, stderr=follower, text=True)
+        os.close(follower)
+        follower = None
+        chunks = []
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:  # read the terminal until the process closes it
+            ready, _, _ = select.select([leader], [], [], max(0.0, deadline - time.monotonic()))
+            if not ready:
+                break
+            try:
+                data = os.read(leader, 4096)
+            except OSError:  # EIO: no writer left
+                break
+            if not data:
+                break
+            chunks.append(data)
+        if proc.poll() is None and time.monotonic() >= deadline:
+            proc.kill()
+        assert proc.wait(timeout=30) == 0
+        proc.stdout.close()
+    finally:
+        os.close(leader)
+        if follower is not None:
+            os.close(follower)
+    terminal = b"".join(chunks).decode(errors="replace")
+    assert "] 2/2 sequences" in terminal and "[" + "#" * 30 + "]" in terminal
+    # On a pipe: no bar.
+    quiet = subprocess.run([sys.executable, "-m", "wul3d.batch", str(root), "--out",
+                            str(tmp_path / "out2"), "--workers", "1"], capture_output=True,
+                           text=True, timeout=120, check=False)
+    assert quiet.returncode == 0 and "sequences\r" not in quiet.stderr and "[#" not in quiet.stderr
