@@ -42,3 +42,15 @@ def test_to_open3d_writes_a_cloud_coloured_by_object(tmp_path):
     colours = np.unique(np.round(np.asarray(cloud.colors), 3), axis=0)
     assert len(colours) == len(result.instances) + 1  # each object and the background
     assert sum(line.startswith("object ") for line in proc.stdout.splitlines()) == len(result.instances)
+
+
+def test_quickstart_prints_every_object():
+    proc = run_example("quickstart.py", SAMPLES / "uois_tabletop")
+    assert proc.returncode == 0, proc.stderr
+    pipeline = wul3d.Pipeline()
+    expected = [f"{f.name} object {i.id}: {i.pixels} px"
+                for f in wul3d.read(SAMPLES / "uois_tabletop")
+                for i in pipeline.process(f.color, f.depth, f.intrinsics, f.depth_scale).instances]
+    lines = proc.stdout.splitlines()
+    assert len(lines) == len(expected) > 0
+    assert all(line.startswith(e + " at (") for line, e in zip(lines, expected))
