@@ -349,7 +349,7 @@ def _parser():
     where = p.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a running Dask scheduler")
     where.add_argument("--workers", type=int, help="local worker processes (default: cores / 2)")
-    p.add_argument("--threads-per-worker", type=int,
+    p.add_argument("--threads-per-worker", "--threads", dest="threads_per_worker", type=int,
                    help="wul3d threads in each task (default: cores / workers)")
     p.add_argument("--retries", type=int, default=1, help="extra tries of a task that raised")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -357,9 +357,11 @@ def _parser():
                    help="no UOIS table even where frames carry label.png")
     run = p.add_argument_group("run options (as `wul3d run`)")
     for name, kind in RUN_OPTIONS.items():
-        run.add_argument("--" + name.replace("_", "-"), dest=name, type=kind)
-    run.add_argument("--no-plane", action="store_true")
-    run.add_argument("--ply", action="store_true")
+        flag = "--" + name.replace("_", "-")
+        run.add_argument(flag, dest=name, type=kind, metavar=kind.__name__.upper(),
+                         help=f"as `wul3d run {flag}`")
+    run.add_argument("--no-plane", action="store_true", help="as `wul3d run --no-plane`")
+    run.add_argument("--ply", action="store_true", help="as `wul3d run --ply`")
     return p
 
 
