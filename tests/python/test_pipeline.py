@@ -181,3 +181,13 @@ def test_help_reads_like_a_reference():
     for obj in (wul3d.Intrinsics, wul3d.Result, wul3d.Instance, wul3d.read, wul3d.evaluate,
                 wul3d.Reader, wul3d.Frame):
         assert obj.__doc__ and len(obj.__doc__.strip()) > 20, obj
+
+
+def test_paper_preset_and_no_plane_equal_wul3d_run(cli, tmp_path):
+    frame = SAMPLES / "uois_tabletop" / "image_0007"
+    proc = run_cli(cli, "run", frame, "--out", tmp_path, "-q", "--preset", "paper",
+                   "--no-plane", "--object-psi", 1)
+    assert proc.returncode == 0, proc.stderr
+    results = process_sequence(frame, preset="paper", remove_plane=False, object_psi=1.0)
+    assert wul3d.Pipeline(preset="paper").params["decimate"] == 1
+    assert_same_as_cli(results, tmp_path)
