@@ -15,21 +15,21 @@ void OrganizedCloud::resize(int w, int h) {
     valid.resize(n);
 }
 
-std::size_t back_project(const RgbdFrame& frame, OrganizedCloud& cloud) {
-    const int W = frame.width(), H = frame.height();
-    if (frame.has_color() && (frame.color.width != W || frame.color.height != H))
-        throw InputError(frame.name + ": colour is " + std::to_string(frame.color.width) + "x" +
-                         std::to_string(frame.color.height) + " but depth is " +
+std::size_t back_project(const RgbdView& frame, OrganizedCloud& cloud) {
+    const int W = frame.width, H = frame.height;
+    if (frame.has_color() && !frame.color_matches())
+        throw InputError(std::string(frame.name) + ": colour is " + std::to_string(frame.color_width) + "x" +
+                         std::to_string(frame.color_height) + " but depth is " +
                          std::to_string(W) + "x" + std::to_string(H));
     cloud.resize(W, H);
     cloud.has_color = frame.has_color();
 
     const auto& K = frame.intrinsics;
-    const float scale = frame.depth.scale_m_per_unit;
+    const float scale = frame.depth_scale_m_per_unit;
     const float inv_fx = static_cast<float>(1.0 / K.fx), inv_fy = static_cast<float>(1.0 / K.fy);
     const float cx = static_cast<float>(K.cx), cy = static_cast<float>(K.cy);
-    const std::uint16_t* depth = frame.depth.data.data();
-    const std::uint8_t* rgb = frame.has_color() ? frame.color.rgb.data() : nullptr;
+    const std::uint16_t* depth = frame.depth;
+    const std::uint8_t* rgb = frame.rgb;
 
     // Raw pointers: a byte store (valid, colour) may alias anything, so through the vectors
     // the compiler would reload every data pointer per pixel and not vectorize.

@@ -33,12 +33,12 @@ const std::array<float, kWeights>& vote_weights() {
 
 }  // namespace
 
-void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out, const DepthRange* range) {
+void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthRange* range) {
     detail::require_param(factor >= 1 && factor <= 8, "", "decimate", factor, "in [1, 8]");
-    const int W = in.width(), H = in.height();
+    const int W = in.width, H = in.height;
     const bool color = in.has_color();
-    if (color && (in.color.width != W || in.color.height != H))
-        throw InputError(in.name + ": colour and depth sizes differ");
+    if (color && !in.color_matches())
+        throw InputError(std::string(in.name) + ": colour and depth sizes differ");
     const int w = (W + factor - 1) / factor, h = (H + factor - 1) / factor;
     out.name = in.name;
     out.intrinsics = in.intrinsics;
@@ -51,15 +51,15 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out, const Depth
     out.intrinsics.cy /= factor;
     out.depth.width = w;
     out.depth.height = h;
-    out.depth.scale_m_per_unit = in.depth.scale_m_per_unit;
+    out.depth.scale_m_per_unit = in.depth_scale_m_per_unit;
     out.depth.data.resize(static_cast<std::size_t>(w) * h);
     out.color.width = color ? w : 0;
     out.color.height = color ? h : 0;
     out.color.rgb.resize(color ? static_cast<std::size_t>(w) * h * 3 : 0);
-    const std::uint16_t* const depth = in.depth.data.data();
-    const std::uint8_t* const rgb = color ? in.color.rgb.data() : nullptr;
+    const std::uint16_t* const depth = in.depth;
+    const std::uint8_t* const rgb = in.rgb;
 
-    const float scale = in.depth.scale_m_per_unit;  // z = depth * scale, as back-projected
+    const float scale = in.depth_scale_m_per_unit;  // z = depth * scale, as back-projected
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
@@ -88,20 +88,28 @@ void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out, const Depth
 
 DecimatedSource::DecimatedSource(const DepthImage& input, const DepthImage& decimated,
                                  int factor, float same_m, float same_rel)
-    : full_(input.data.data()),
+    : DecimatedSource(input.data.data(), input.width, input.height, input.scale_m_per_unit,
+                      decimated, factor, same_m, same_rel) {
+    if (input.data.size() != static_cast<std::size_t>(W_) * H_)
+        throw InputError("decimation: the decimated depth does not match the input's size");
+}
+
+DecimatedSource::DecimatedSource(const std::uint16_t* input, int width, int height,
+                                 float scale_m_per_unit, const DepthImage& decimated, int factor,
+                                 float same_m, float same_rel)
+    : full_(input),
       small_(decimated.data.data()),
-      W_(input.width),
-      H_(input.height),
+      W_(width),
+      H_(height),
       w_(decimated.width),
       h_(decimated.height),
       factor_(factor),
       // Depths compared in the images' units: metres = units * scale.
-      same_(same_m / input.scale_m_per_unit),
-      same_rel_(same_rel * input.scale_m_per_unit) {
+      same_(same_m / scale_m_per_unit),
+      same_rel_(same_rel * scale_m_per_unit) {
     if (factor < 1 || w_ != (W_ + factor - 1) / factor ||
         h_ != (H_ + factor - 1) / factor ||
-        decimated.data.size() != static_cast<std::size_t>(w_) * h_ ||
-        input.data.size() != static_cast<std::size_t>(W_) * H_)
+        decimated.data.size() != static_cast<std::size_t>(w_) * h_)
         throw InputError("decimation: the decimated depth does not match the input's size");
 }
 
@@ -110,11 +118,22 @@ void DecimatedSource::use_colour_at_edges(const ColorImage& input, const ColorIm
                                           const std::uint16_t* block_labels,
                                           std::vector<std::int32_t>& block_source) {
     if (input.empty() || decimated.empty()) return;  // depth only: depth decides alone
-    if (input.width != W_ || input.height != H_ || decimated.width != w_ || decimated.height != h_ ||
-        input.rgb.size() != 3 * static_cast<std::size_t>(W_) * H_ ||
+    if (input.width != W_ || input.height != H_ ||
+        input.rgb.size() != 3 * static_cast<std::size_t>(W_) * H_)
+        throw InputError("decimation: colour and depth sizes differ");
+    use_colour_at_edges(input.rgb.data(), decimated, edge_blocks, block_labels, block_source);
+}
+
+void DecimatedSource::use_colour_at_edges(const std::uint8_t* input_rgb,
+                                          const ColorImage& decimated,
+                                          const std::uint8_t* edge_blocks,
+                                          const std::uint16_t* block_labels,
+                                          std::vector<std::int32_t>& block_source) {
+    if (input_rgb == nullptr || decimated.empty()) return;  // depth only: depth decides alone
+    if (decimated.width != w_ || decimated.height != h_ ||
         decimated.rgb.size() != 3 * static_cast<std::size_t>(w_) * h_)
         throw InputError("decimation: colour and depth sizes differ");
-    rgb_ = input.rgb.data();
+    rgb_ = input_rgb;
     small_rgb_ = decimated.rgb.data();
     edges_ = edge_blocks;
     block_source.resize(static_cast<std::size_t>(w_) * h_);
@@ -256,15 +275,16 @@ ExpandWorkspace::~ExpandWorkspace() = default;
 ExpandWorkspace::ExpandWorkspace(ExpandWorkspace&&) noexcept = default;
 ExpandWorkspace& ExpandWorkspace::operator=(ExpandWorkspace&&) noexcept = default;
 
-void expand_result(const PipelineParams& params, const RgbdFrame& frame,
+void expand_result(const PipelineParams& params, const RgbdView& frame,
                    const RgbdFrame& decimated, const FrameResult& s, ExpandWorkspace& ws,
                    FrameResult& r) {
     ExpandWorkspace::Buffers& buf = *ws.b_;
-    const int W = frame.width(), H = frame.height();
+    const int W = frame.width, H = frame.height;
     // An input pixel takes a neighbouring block's results across a depth step no larger
     // than the segmentation's own connection rule over the block's width.
     const float n = static_cast<float>(params.decimation);
-    DecimatedSource source(frame.depth, decimated.depth, params.decimation,
+    DecimatedSource source(frame.depth, W, H, frame.depth_scale_m_per_unit, decimated.depth,
+                           params.decimation,
                            n * params.segmentation.depth_jump_m,
                            n * params.segmentation.depth_jump_rel);
     // Edge blocks: an object (or, without the object stages, a cluster) other than the
@@ -309,7 +329,9 @@ void expand_result(const PipelineParams& params, const RgbdFrame& frame,
         for (int u = 0; u < w; ++u)
             out[u] = min3(lo_up[u], lo_row[u], lo_down[u]) != max3(hi_up[u], hi_row[u], hi_down[u]);
     }
-    source.use_colour_at_edges(frame.color, decimated.color, buf.edge_blocks.data(), l, buf.block_source);
+    if (frame.has_color() && !frame.color_matches())
+        throw InputError(std::string(frame.name) + ": colour and depth sizes differ");
+    source.use_colour_at_edges(frame.rgb, decimated.color, buf.edge_blocks.data(), l, buf.block_source);
     r.stats = s.stats;
     r.plane = s.plane;
     r.segment_stats = s.segment_stats;
@@ -345,7 +367,7 @@ void expand_result(const PipelineParams& params, const RgbdFrame& frame,
     // and boxes per fixed row band, reduced in band order below.
     // Raw pointers: through the vectors, every byte store would make the compiler reload
     // every data pointer.
-    const std::uint8_t* const frame_rgb = frame.color.rgb.size() == 3 * N ? frame.color.rgb.data() : nullptr;
+    const std::uint8_t* const frame_rgb = frame.has_color() && frame.color_matches() ? frame.rgb : nullptr;
     const std::uint16_t *const in_labels = s.labels.labels.data(), *const in_segments = s.segments.labels.data(),
                         *const in_objects = s.objects.labels.data();
     const std::uint8_t *const in_rgb = s.colors.rgb.data(), *const in_active = s.active.data(),
@@ -359,9 +381,9 @@ void expand_result(const PipelineParams& params, const RgbdFrame& frame,
     // the block it takes can lie on the other side of a limit. In range, on a block that is
     // not, it takes the nearest in depth of the 3 x 3 blocks that are (its own is: the frame
     // was decimated to blocks in range where they could be); out of range, none.
-    const float scale = frame.depth.scale_m_per_unit;
+    const float scale = frame.depth_scale_m_per_unit;
     const DepthRange& range = params.range;
-    const std::uint16_t* const depth = frame.depth.data.data();
+    const std::uint16_t* const depth = frame.depth;
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < ExpandWorkspace::Buffers::kBands; ++band) {
         ExpandWorkspace::Buffers::Box* const boxes = buf.band_boxes.data() + static_cast<std::size_t>(band) * n_obj;

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "param_check.hpp"
+#include "side_by_side.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -62,27 +63,74 @@ double ms_since(Clock::time_point t0) {
 }
 }  // namespace
 
-Pipeline::Pipeline(const PipelineParams& params)
-    : params_((params.validate(), params)),
-      stage_params_(params.stage_params()),
-      state_(stage_params_.cluster),
-      tracker_(stage_params_.objects) {}
+/// The pipeline's stages, their state across frames and their buffers.
+struct Pipeline::Impl {
+    explicit Impl(const PipelineParams& params)
+        : params_((params.validate(), params)),
+          stage_params_(params.stage_params()),
+          state_(stage_params_.cluster),
+          tracker_(stage_params_.objects) {}
 
-const FrameResult& Pipeline::process(const RgbdFrame& frame) { return run_stages(frame, 0.0); }
+    const FrameResult& run_stages(const RgbdView& frame, double registration_ms);
+    /// Every stage from back-projection on, with stage_params_, into `r`.
+    void run_on(const RgbdView& frame, FrameResult& r);
+    /// run_on's two independent parts: the paper's clusters and colours; the support plane
+    /// and the segments (which read no cluster label but with the kmeans segmenter).
+    void cluster_and_colour(const RgbdView& frame, FrameResult& r);
+    void plane_and_segments(const RgbdView& frame, FrameResult& r);
+
+    detail::SideBySideChoice side_by_side_;  ///< whether run_on's two parts run side by side
+    PipelineParams params_;
+    PipelineParams stage_params_;  ///< params_.stage_params()
+    OrganizedCloud cloud_;
+    NormalMap normals_;
+    ClusterState state_;
+    ObjectTracker tracker_;
+    PlaneWorkspace plane_ws_;
+    SegmentWorkspace segment_ws_;
+    RegistrationWorkspace registration_ws_;
+    RgbdFrame registered_;
+    RgbdFrame staging_;  ///< a caller's FrameView in the stages' layout, when it is not already
+    RgbdFrame decimated_;
+    FrameResult decimated_result_;
+    ExpandWorkspace expand_ws_;
+    FrameResult result_;
+};
+
+Pipeline::Pipeline(const PipelineParams& params) : impl_(std::make_unique<Impl>(params)) {}
+Pipeline::~Pipeline() = default;
+Pipeline::Pipeline(Pipeline&&) noexcept = default;
+Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
+
+const PipelineParams& Pipeline::params() const { return impl_->params_; }
+const OrganizedCloud& Pipeline::cloud() const { return impl_->cloud_; }
+const NormalMap& Pipeline::normals() const { return impl_->normals_; }
+const ClusterState& Pipeline::state() const { return impl_->state_; }
+const ObjectTracker& Pipeline::tracker() const { return impl_->tracker_; }
+const RgbdFrame& Pipeline::registered() const { return impl_->registered_; }
+
+const FrameResult& Pipeline::process(const RgbdFrame& frame) {
+    return impl_->run_stages(frame.view(), 0.0);
+}
+
+const FrameResult& Pipeline::process(const FrameView& frame) {
+    return impl_->run_stages(stage_view(frame, impl_->staging_), 0.0);
+}
 
 const FrameResult& Pipeline::process(const RawRgbdFrame& raw, const StereoCalibration& calib,
                                      RegistrationMode mode) {
+    Impl& m = *impl_;
     const auto t0 = Clock::now();
     if (mode == RegistrationMode::DepthToColor)
-        register_depth_to_color(calib, raw, registration_ws_, registered_);
+        register_depth_to_color(calib, raw, m.registration_ws_, m.registered_);
     else
-        register_color_to_depth(calib, raw, registration_ws_, registered_);
-    return run_stages(registered_, ms_since(t0));
+        register_color_to_depth(calib, raw, m.registration_ws_, m.registered_);
+    return m.run_stages(m.registered_.view(), ms_since(t0));
 }
 
-const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registration_ms) {
-    if (frame.width() <= 0 || frame.height() <= 0 || frame.depth.empty())
-        throw InputError(frame.name + ": empty depth image");
+const FrameResult& Pipeline::Impl::run_stages(const RgbdView& frame, double registration_ms) {
+    if (frame.width <= 0 || frame.height <= 0 || frame.depth == nullptr)
+        throw InputError(std::string(frame.name) + ": empty depth image");
     const int n = params_.decimation;
     if (n == 1) {
         run_on(frame, result_);
@@ -90,7 +138,7 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
         auto t = Clock::now();
         decimate_frame(frame, n, decimated_, &params_.range);
         double ms = ms_since(t);
-        run_on(decimated_, decimated_result_);
+        run_on(decimated_.view(), decimated_result_);
         t = Clock::now();
         expand_result(params_, frame, decimated_, decimated_result_, expand_ws_, result_);
         ms += ms_since(t);
@@ -101,13 +149,14 @@ const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registrat
     return result_;
 }
 
-void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
+void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     const PipelineParams& params = stage_params_;
     r.times = StageTimes{};
     auto t = Clock::now();
     const std::size_t valid = back_project(frame, cloud_);
     r.times.backprojection = ms_since(t);
-    if (valid == 0) throw InputError(frame.name + ": depth has no valid pixel (all zero)");
+    if (valid == 0)
+        throw InputError(std::string(frame.name) + ": depth has no valid pixel (all zero)");
 
     t = Clock::now();
     estimate_normals(params.normals, cloud_, normals_);
@@ -186,7 +235,7 @@ void detail::SideBySideChoice::record(bool side_by_side, double ms) {
     if (i == 2 * kTrials - 1) side_by_side_ = best_ms_[1] < best_ms_[0];
 }
 
-void Pipeline::cluster_and_colour(const RgbdFrame& frame, FrameResult& r) {
+void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {
     auto t = Clock::now();
     r.stats = state_.step(cloud_, normals_, r.active, r.labels);
     r.times.clustering = ms_since(t);
@@ -195,7 +244,7 @@ void Pipeline::cluster_and_colour(const RgbdFrame& frame, FrameResult& r) {
     r.times.colors = ms_since(t);
 }
 
-void Pipeline::plane_and_segments(const RgbdFrame& frame, FrameResult& r) {
+void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
     const PipelineParams& params = stage_params_;
     // Objects: the support plane goes (part of the paper's background step, kept out of the
     // clustering's mask so that labels.png keeps the paper's clusters), the rest is segmented.

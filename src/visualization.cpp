@@ -32,7 +32,7 @@ std::array<std::uint8_t, 3> cluster_color(int j) {
 }
 
 void render_weight_colors(const ClusterState& state, const LabelImage& labels,
-                          const RgbdFrame& frame, ColorImage& out) {
+                          const RgbdView& frame, ColorImage& out) {
     const int W = labels.width, H = labels.height, k = state.params().k;
     out.width = W;
     out.height = H;
@@ -42,8 +42,8 @@ void render_weight_colors(const ClusterState& state, const LabelImage& labels,
         const auto c = cluster_color(j);
         for (int q = 0; q < 3; ++q) C[3 * j + q] = c[q] / PixelWeights::kOne;
     }
-    const bool grey_ok = frame.has_color() && frame.color.width == W && frame.color.height == H;
-    const std::uint8_t* rgb = grey_ok ? frame.color.rgb.data() : nullptr;
+    const bool grey_ok = frame.has_color() && frame.color_width == W && frame.color_height == H;
+    const std::uint8_t* rgb = grey_ok ? frame.rgb : nullptr;
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {

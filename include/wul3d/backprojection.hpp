@@ -13,6 +13,9 @@ namespace wul3d {
 /// equal to the paper's eq. 12-14 for the FOV camera's pinhole equivalent).
 /// Returns the number of valid points. Throws InputError if the colour size differs from
 /// the depth size.
-std::size_t back_project(const RgbdFrame& frame, OrganizedCloud& cloud);
+std::size_t back_project(const RgbdView& frame, OrganizedCloud& cloud);
+inline std::size_t back_project(const RgbdFrame& frame, OrganizedCloud& cloud) {
+    return back_project(frame.view(), cloud);
+}
 
 }  // namespace wul3d

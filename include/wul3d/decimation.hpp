@@ -26,8 +26,12 @@ namespace wul3d {
 /// decimated resolution.
 /// N = 1 copies. Throws ParamError for N outside [1, 8] and InputError for a colour image
 /// whose size differs from the depth's.
-void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out,
+void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out,
                     const DepthRange* range = nullptr);
+inline void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out,
+                           const DepthRange* range = nullptr) {
+    decimate_frame(in.view(), factor, out, range);
+}
 
 /// Which pixel of the decimated frame an input pixel takes its results from (the pipeline
 /// copies every per-pixel result through it: expand_result). An input pixel
@@ -53,6 +57,10 @@ public:
     /// Throws InputError unless `decimated` is `input` decimated by `factor` in size.
     DecimatedSource(const DepthImage& input, const DepthImage& decimated, int factor,
                     float same_m, float same_rel);
+    /// The same for an input depth of `width` x `height` at `input` (packed rows), in units
+    /// of `scale_m_per_unit` metres.
+    DecimatedSource(const std::uint16_t* input, int width, int height, float scale_m_per_unit,
+                    const DepthImage& decimated, int factor, float same_m, float same_rel);
     /// `edge_blocks`: one flag per decimated pixel (results differ from a neighbour's);
     /// `block_labels`: the label each decimated pixel votes for (objects, or clusters). They
     /// and the colour images stay owned by the caller, and so does `block_source`, which
@@ -61,6 +69,11 @@ public:
     /// Ignored for frames without colour. Throws InputError for colour images of other sizes
     /// than the depths'.
     void use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
+                             const std::uint8_t* edge_blocks, const std::uint16_t* block_labels,
+                             std::vector<std::int32_t>& block_source);
+    /// The same with the input colour at `input_rgb` (packed RGB rows of the input depth's
+    /// size; nullptr: none).
+    void use_colour_at_edges(const std::uint8_t* input_rgb, const ColorImage& decimated,
                              const std::uint8_t* edge_blocks, const std::uint16_t* block_labels,
                              std::vector<std::int32_t>& block_source);
 
@@ -120,7 +133,7 @@ public:
 private:
     struct Buffers;
     std::unique_ptr<Buffers> b_;
-    friend void expand_result(const PipelineParams&, const RgbdFrame&, const RgbdFrame&,
+    friend void expand_result(const PipelineParams&, const RgbdView&, const RgbdFrame&,
                               const struct FrameResult&, ExpandWorkspace&, struct FrameResult&);
 };
 
@@ -132,7 +145,7 @@ private:
 /// source, is no point. Each object's pixels and 2D box are counted again at the input's
 /// size, and objects left under params.objects.min_points input pixels are dropped.
 /// Everything else of `small` (stats, plane, object_list) is copied; `out.times` is not set.
-void expand_result(const PipelineParams& params, const RgbdFrame& frame,
+void expand_result(const PipelineParams& params, const RgbdView& frame,
                    const RgbdFrame& decimated, const FrameResult& small, ExpandWorkspace& ws,
                    FrameResult& out);
 

@@ -4,14 +4,15 @@
 /// registration -> back-projection -> normals -> background -> clustering -> colours, then
 /// the object stages: support plane -> segmentation -> objects (tracks and their weights).
 /// Holds the stages' buffers (no allocation after the first frame) and the two objects that
-/// live across frames, ClusterState and ObjectTracker.
-#include <algorithm>
+/// live across frames, ClusterState and ObjectTracker, out of sight (pipeline.cpp).
+#include <memory>
 #include <vector>
 
 #include "wul3d/background.hpp"
 #include "wul3d/backprojection.hpp"
 #include "wul3d/clustering.hpp"
 #include "wul3d/decimation.hpp"
+#include "wul3d/image_view.hpp"
 #include "wul3d/normals.hpp"
 #include "wul3d/objects.hpp"
 #include "wul3d/plane.hpp"
@@ -53,7 +54,7 @@ struct PipelineParams {
 
 /// Milliseconds spent in each stage on one frame (0 for a stage that did not run). On two
 /// threads the clustering (with its colours) and the plane and segmentation stages may run
-/// side by side (detail::SideBySideChoice): each is timed as it ran, and `overlap` is the time
+/// side by side (src/side_by_side.hpp): each is timed as it ran, and `overlap` is the time
 /// they shared.
 struct StageTimes {
     double registration = 0, decimation = 0, backprojection = 0, normals = 0, background = 0,
@@ -84,71 +85,37 @@ struct FrameResult {
     StageTimes times;
 };
 
-namespace detail {
-/// Whether Pipeline::run_on's two parts (the clustering with its colours; the plane and
-/// segmentation stages) run side by side on two threads: each period of frames starts with
-/// a few frames each way, timed, and goes on the faster way. It pays on new scenes at
-/// --decimate 2, not when the clustering is cheap (a frame repeated) nor on 640x480 frames
-/// (docs/DESIGN.md). Results are the same either way; only the time differs.
-class SideBySideChoice {
-public:
-    static constexpr int kTrials = 3;    ///< frames each way per period (the fastest counts)
-    static constexpr int kPeriod = 300;  ///< frames per choice
-
-    bool next() const;  ///< the way for the coming frame: true = side by side
-    void record(bool side_by_side, double ms);  ///< the coming frame's time for the two parts
-
-private:
-    int frame_ = 0;
-    double best_ms_[2] = {0, 0};  ///< [0] one after the other, [1] side by side
-    bool side_by_side_ = false;
-};
-}  // namespace detail
-
 class Pipeline {
 public:
     explicit Pipeline(const PipelineParams& params);  ///< validates params
+    ~Pipeline();
+    Pipeline(Pipeline&&) noexcept;
+    Pipeline& operator=(Pipeline&&) noexcept;
 
     /// Runs every stage on a registered frame.
     const FrameResult& process(const RgbdFrame& frame);
+    /// The same on the caller's memory (image_view.hpp): read in place when its layout is the
+    /// stages' own (packed rows, RGB, 16-bit depth), else converted once into the pipeline's
+    /// buffers. The result is the one process(RgbdFrame) gives for the same pixels. Throws
+    /// InputError for a view that cannot be read (null data, a stride shorter than a row,
+    /// colour of another size, invalid intrinsics or depth scale).
+    const FrameResult& process(const FrameView& frame);
     /// Registers a raw two-camera frame first (timed as "registration").
     const FrameResult& process(const RawRgbdFrame& raw, const StereoCalibration& calib,
                                RegistrationMode mode);
 
-    const PipelineParams& params() const { return params_; }
+    const PipelineParams& params() const;
     /// The cloud, normals and clusters the stages ran on: the decimated frame's with
     /// decimation > 1 (its pixels are not FrameResult's then).
-    const OrganizedCloud& cloud() const { return cloud_; }
-    const NormalMap& normals() const { return normals_; }
-    const ClusterState& state() const { return state_; }
-    const ObjectTracker& tracker() const { return tracker_; }
-    const RgbdFrame& registered() const { return registered_; }  ///< last raw frame, registered
+    const OrganizedCloud& cloud() const;
+    const NormalMap& normals() const;
+    const ClusterState& state() const;
+    const ObjectTracker& tracker() const;
+    const RgbdFrame& registered() const;  ///< last raw frame, registered
 
 private:
-    const FrameResult& run_stages(const RgbdFrame& frame, double registration_ms);
-    /// Every stage from back-projection on, with stage_params_, into `r`.
-    void run_on(const RgbdFrame& frame, FrameResult& r);
-    /// run_on's two independent parts: the paper's clusters and colours; the support plane
-    /// and the segments (which read no cluster label but with the kmeans segmenter).
-    void cluster_and_colour(const RgbdFrame& frame, FrameResult& r);
-    void plane_and_segments(const RgbdFrame& frame, FrameResult& r);
-
-    detail::SideBySideChoice side_by_side_;  ///< whether run_on's two parts run side by side
-
-    PipelineParams params_;
-    PipelineParams stage_params_;  ///< params_.stage_params()
-    OrganizedCloud cloud_;
-    NormalMap normals_;
-    ClusterState state_;
-    ObjectTracker tracker_;
-    PlaneWorkspace plane_ws_;
-    SegmentWorkspace segment_ws_;
-    RegistrationWorkspace registration_ws_;
-    RgbdFrame registered_;
-    RgbdFrame decimated_;
-    FrameResult decimated_result_;
-    ExpandWorkspace expand_ws_;
-    FrameResult result_;
+    struct Impl;  ///< the stages' state and buffers (pipeline.cpp)
+    std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace wul3d

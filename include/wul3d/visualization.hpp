@@ -17,7 +17,11 @@ std::array<std::uint8_t, 3> cluster_color(int j);
 /// other pixels show the frame's own colour as dim grey (black for depth-only frames), so
 /// the clusters stay readable in context. `out` gets the labels' resolution.
 void render_weight_colors(const ClusterState& state, const LabelImage& labels,
-                          const RgbdFrame& frame, ColorImage& out);
+                          const RgbdView& frame, ColorImage& out);
+inline void render_weight_colors(const ClusterState& state, const LabelImage& labels,
+                                 const RgbdFrame& frame, ColorImage& out) {
+    render_weight_colors(state, labels, frame.view(), out);
+}
 
 /// The dim grey shown for a pixel without a label, from its R, G, B.
 inline std::uint8_t dimmed_grey(const std::uint8_t* rgb) {
