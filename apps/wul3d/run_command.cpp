@@ -264,7 +264,8 @@ void run(const RunOptions& o) {
         progress.update(i, 1000.0 / std::max(1e-9, median(compute_ms)));
         if (video) video->write(frame, r, selection ? &selected_mask : nullptr, i - 1,
                                 n_total ? n_total : i,  // live without --frames: no end known
-                                1000.0 / std::max(1e-9, median(compute_ms)));
+                                1000.0 / std::max(1e-9, median(compute_ms)),
+                                object_selected ? selected_object->label() : 0);
     }
     const std::size_t n_frames = i;
     progress.finish();
@@ -343,7 +344,7 @@ void add_run_command(CLI::App& app) {
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_option("--video", opts->video,
-                    "Also write a video: colour | clusters | selected object (e.g. out.mp4)");
+                    "Also write a video: colour | objects | clusters (e.g. out.mp4)");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
     cmd->callback([opts]() { run(*opts); });
 }
