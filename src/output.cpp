@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +14,7 @@
 
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/visualization.hpp"
 
 namespace wul3d {
 namespace fs = std::filesystem;
@@ -97,6 +99,39 @@ std::string objects_json(const FrameResult& r, int selected_id) {
     return j.dump(1) + "\n";
 }
 
+namespace {
+
+/// overlay.png's picture: the objects over the frame's colour, or over its depth in grey
+/// (near bright) for a depth-only frame.
+void overlay_picture(const RgbdFrame& frame, const FrameResult& r, ColorImage& out) {
+    ColorImage base;
+    if (frame.has_color()) {
+        base = frame.color;
+    } else {
+        base.width = frame.depth.width;
+        base.height = frame.depth.height;
+        base.rgb.assign(frame.depth.data.size() * 3, 0);
+        std::uint16_t lo = 0xffff, hi = 0;
+        for (const std::uint16_t d : frame.depth.data)
+            if (d) lo = std::min(lo, d), hi = std::max(hi, d);
+        const float span = std::max(1.0f, static_cast<float>(hi) - static_cast<float>(lo));
+        for (std::size_t p = 0; p < frame.depth.data.size(); ++p) {
+            const std::uint16_t d = frame.depth.data[p];
+            if (d == 0) continue;
+            const auto g = static_cast<std::uint8_t>(
+                235.0f - 180.0f * (static_cast<float>(d) - static_cast<float>(lo)) / span);
+            base.rgb[3 * p] = base.rgb[3 * p + 1] = base.rgb[3 * p + 2] = g;
+        }
+    }
+    if (r.objects.labels.size() != base.rgb.size() / 3) {
+        out = std::move(base);  // no object stages ran (PipelineParams::detect_objects)
+        return;
+    }
+    render_object_overlay(base, r.objects, r.object_list, frame.intrinsics, out);
+}
+
+}  // namespace
+
 void write_frame(const std::string& out_dir, const std::string& name, const Pipeline& pipeline,
                  const RgbdFrame& frame, const FrameResult& r, const FrameOutputs& extra) {
     write_folder_atomic((fs::path(out_dir) / name).string(), [&](const std::string& dir) {
@@ -111,6 +146,11 @@ void write_frame(const std::string& out_dir, const std::string& name, const Pipe
         if (extra.selected_object)
             write_mask_png((tmp_dir / "selected_object.png").string(), r.objects.width,
                            r.objects.height, *extra.selected_object);
+        if (extra.overlay) {
+            ColorImage picture;
+            overlay_picture(frame, r, picture);
+            write_color_png((tmp_dir / "overlay.png").string(), picture);
+        }
         if (extra.ply && pipeline.cloud().size() == r.labels.labels.size()) {
             write_ply((tmp_dir / "cloud.ply").string(), pipeline.cloud(), r.labels, r.colors);
         } else if (extra.ply) {  // decimation: the results are at the input's size, the cloud not

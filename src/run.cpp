@@ -129,12 +129,13 @@ struct Selection {
         }
         if (!object_selected) object_mask.assign(r.objects.labels.size(), 0);
     }
-    FrameOutputs outputs(bool ply) const {
+    FrameOutputs outputs(bool ply, bool overlay) const {
         FrameOutputs o;
         o.selected = cluster ? &cluster_mask : nullptr;
         o.selected_object = object ? &object_mask : nullptr;
         o.selected_id = object_selected ? object->label() : 0;
         o.ply = ply;
+        o.overlay = overlay;
         return o;
     }
 };
@@ -189,14 +190,15 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
         selection.update(r);
 
         const auto t_out = Clock::now();
-        write_frame(o.out_dir, name, pipeline, frame, r, selection.outputs(o.ply));
+        write_frame(o.out_dir, name, pipeline, frame, r, selection.outputs(o.ply, o.overlay));
         log.add(r.times, std::chrono::duration<double, std::milli>(Clock::now() - t_out).count());
         nlohmann::json f = frame_json(name, r);
         if (selection.cluster) f["selected_pixels"] = selection.cluster->pixels();
         per_frame.push_back(std::move(f));
         const double fps = 1000.0 / std::max(1e-9, median(log.compute_ms));
         obs.frame(RunFrame{name, s.frames, n_total, frame, r,
-                           selection.cluster ? &selection.cluster_mask : nullptr, fps});
+                           selection.cluster ? &selection.cluster_mask : nullptr,
+                           selection.object_selected ? selection.object->label() : 0, fps});
         ++s.frames;
     }
     obs.frames_done();

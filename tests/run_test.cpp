@@ -7,12 +7,15 @@
 
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
 #include "wul3d/output.hpp"
+#include "wul3d/visualization.hpp"
 
 namespace wul3d {
 namespace {
@@ -98,9 +101,10 @@ TEST(RunSequence, SameBytesAsTheCommand) {
     TempDir dir;
     RunOptions o = sample_run(dir / "lib");
     o.select = std::make_pair(320, 240);
+    o.overlay = true;
     run_sequence(o);
     const auto cli = test::run_cli({"run", o.feed.input, "-o", (dir / "cli").string(), "-q",
-                                    "--select", "320,240"});
+                                    "--select", "320,240", "--overlay"});
     ASSERT_EQ(cli.exit_code, 0) << cli.err;
     const auto files = test::list_files(dir / "lib");
     ASSERT_EQ(files, test::list_files(dir / "cli"));
@@ -108,6 +112,72 @@ TEST(RunSequence, SameBytesAsTheCommand) {
         if (f == "summary.json") continue;  // timings differ
         EXPECT_EQ(slurp(dir / "lib" / f), slurp(dir / "cli" / f)) << f;
     }
+}
+
+TEST(RunSequence, OverlayTintsOutlinesAndNumbersTheObjectsOverTheColour) {
+    TempDir dir;
+    RunOptions o = sample_run(dir / "out");
+    o.max_frames = 1;
+    o.overlay = true;
+    run_sequence(o);
+    const fs::path frame = test::sample_dir() / "uois_tabletop" / "image_0000";
+    const ColorImage colour = read_color_image((frame / "color.png").string());
+    const ColorImage overlay = read_color_image((dir / "out" / "image_0000" / "overlay.png").string());
+    const LabelImage objects = read_label_png((dir / "out" / "image_0000" / "objects.png").string());
+    ASSERT_EQ(overlay.width, colour.width);
+    ASSERT_EQ(overlay.height, colour.height);
+    const int W = colour.width, H = colour.height;
+    // Each object's id tag: up to 45 x 32 px from its 2D box's top-left corner.
+    std::vector<std::uint8_t> tag(static_cast<std::size_t>(W) * H, 0);
+    std::map<int, std::pair<int, int>> corner;
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u)
+            if (const int l = objects.labels[static_cast<std::size_t>(v) * W + u]) {
+                auto [it, fresh] = corner.try_emplace(l, u, v);
+                if (!fresh) it->second.first = std::min(it->second.first, u);
+            }
+    ASSERT_GE(corner.size(), 5u);
+    for (const auto& [id, c] : corner)
+        for (int v = c.second; v < std::min(H, c.second + 32); ++v)
+            for (int u = c.first; u < std::min(W, c.first + 45); ++u) tag[static_cast<std::size_t>(v) * W + u] = 1;
+    std::size_t tinted = 0, inside = 0, untouched = 0, outside = 0, outline = 0;
+    std::map<int, int> white_in_tag;
+    for (int v = 1; v < H - 1; ++v)
+        for (int u = 1; u < W - 1; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            const int l = objects.labels[p];
+            const bool inner = objects.labels[p - 1] == l && objects.labels[p + 1] == l &&
+                               objects.labels[p - W] == l && objects.labels[p + W] == l;
+            const std::uint8_t* c = &colour.rgb[3 * p];
+            const std::uint8_t* t = &overlay.rgb[3 * p];
+            const bool white = t[0] == 255 && t[1] == 255 && t[2] == 255;
+            if (tag[p]) {
+                if (l != 0 && t[0] > 200 && t[1] > 200 && t[2] > 200) ++white_in_tag[l];
+                continue;
+            }
+            if (l != 0 && !inner) {
+                outline += white;  // the border of an object: white
+                continue;
+            }
+            if (!inner) continue;
+            if (l == 0) {
+                ++outside;
+                untouched += t[0] == c[0] && t[1] == c[1] && t[2] == c[2];
+            } else {
+                ++inside;
+                const auto oc = object_color(l);
+                bool ok = true;
+                for (int q = 0; q < 3; ++q) ok &= std::abs(t[q] - (0.45 * c[q] + 0.55 * oc[q])) <= 1.0;
+                tinted += ok;
+            }
+        }
+    EXPECT_GT(inside, 20000u);
+    EXPECT_EQ(tinted, inside);     // outside the tags and the box lines (boxes are off)
+    EXPECT_EQ(untouched, outside);
+    EXPECT_GT(outline, 1000u);
+    // The ids: white text in the tags of most objects (a tag over a small object's corner
+    // may fall on the background).
+    EXPECT_GE(white_in_tag.size(), corner.size() / 2);
 }
 
 TEST(RunSequence, BadInputIsAnInputError_NoOutputFolder) {

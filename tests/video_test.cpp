@@ -1,5 +1,6 @@
-// `wul3d run --video`: the side-by-side video (colour | clusters | selected object) is read
-// back with OpenCV's VideoCapture: one video frame per input frame, three panels wide. The
+// `wul3d run --video`: the side-by-side video (colour | objects | clusters) is read back with
+// OpenCV's VideoCapture: one video frame per input frame, three panels wide, the objects
+// panel tinting the selected object and darkening the rest. The
 // video is written by the plugin libwul3d_video.so, which wul3d loads from its own folder:
 // a copy of wul3d in a folder without it must fail at once and leave nothing behind.
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "test_support.hpp"
+#include "wul3d/io.hpp"
 
 namespace {
 
@@ -28,7 +30,7 @@ TEST(RunVideo, OneVideoFramePerInputFrame_ThreePanelsWide) {
     TempDir tmp;
     const fs::path video = tmp / "clips" / "tabletop.mp4";  // the folder is created
     const auto r = run_cli({"run", (sample_dir() / "uois_tabletop").string(), "--out",
-                            (tmp / "out").string(), "--select", "420,260", "--video",
+                            (tmp / "out").string(), "--select", "490,240", "--video",
                             video.string(), "-q"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     ASSERT_TRUE(fs::is_regular_file(video));
@@ -51,6 +53,38 @@ TEST(RunVideo, OneVideoFramePerInputFrame_ThreePanelsWide) {
     cv::Scalar mean, stddev;
     cv::meanStdDev(first(cv::Rect(0, 100, 640, 380)), mean, stddev);
     EXPECT_GT(stddev[0] + stddev[1] + stddev[2], 30.0);
+
+    // The middle panel shows the objects over the colour: the selected one (the object
+    // under 490,240) tinted, away from its outline and its id's tag; the rest darkened to a
+    // quarter. Below the captions (row 40 on), within what the video's compression keeps.
+    const wul3d::LabelImage objects =
+        wul3d::read_label_png((tmp / "out" / "image_0000" / "objects.png").string());
+    const int id = objects.labels[240 * 640 + 490];
+    ASSERT_NE(id, 0);
+    int inside = 0, tinted = 0, outside = 0, darkened = 0;
+    for (int v = 40; v < 478; v += 2)
+        for (int u = 2; u < 638; u += 2) {
+            int same = 0, count = 0;
+            for (int dv = -2; dv <= 2; ++dv)
+                for (int du = -2; du <= 2; ++du, ++count)
+                    same += objects.labels[static_cast<std::size_t>(v + dv) * 640 + u + du] == id;
+            const cv::Vec3b c = first.at<cv::Vec3b>(v, u), o = first.at<cv::Vec3b>(v, 640 + u);
+            int most = 0, off_quarter = 0;
+            for (int q = 0; q < 3; ++q) {
+                most = std::max(most, std::abs(int(o[q]) - int(c[q])));
+                off_quarter = std::max(off_quarter, std::abs(int(o[q]) - int(c[q]) / 4));
+            }
+            if (same == count) {
+                ++inside;
+                tinted += most > 30;
+            } else if (same == 0) {
+                ++outside;
+                darkened += off_quarter <= 16;
+            }
+        }
+    ASSERT_GT(inside, 500);
+    EXPECT_GT(tinted, inside * 7 / 10) << tinted << " of " << inside;
+    EXPECT_GT(darkened, outside * 9 / 10) << darkened << " of " << outside;
 }
 
 TEST(RunVideo, FolderThatCannotBeCreated_OneLineAndNoFrames) {

@@ -25,6 +25,7 @@ struct RunCommandOptions {
     std::string video;           // --video FILE: side-by-side video (video_writer.hpp)
     std::size_t max_frames = 0;  // 0 = all
     bool ply = false;
+    bool overlay = false;        // --overlay: OUT/<frame>/overlay.png
     bool quiet = false;
 };
 
@@ -68,7 +69,8 @@ public:
         if (video_)
             video_->write(f.frame, f.result, f.selected, f.index,
                           f.total ? f.total : f.index + 1,  // live without --frames: no end known
-                          f.fps);
+                          f.fps, f.selected_object);
+        objects_ += f.result.object_list.size();
     }
     void frames_done() override {
         progress_.finish();
@@ -76,7 +78,8 @@ public:
     }
     void finished(const RunSummary& s) override {
         std::cout << std::fixed << std::setprecision(1) << "wul3d: " << s.frames << " frame"
-                  << (s.frames == 1 ? "" : "s") << ", k = " << k_ << ": " << s.fps << " FPS ("
+                  << (s.frames == 1 ? "" : "s") << ", " << objects_ << " object"
+                  << (objects_ == 1 ? "" : "s") << " in all, k = " << k_ << ": " << s.fps << " FPS ("
                   << s.ms_per_frame_median << " ms/frame without disk I/O), peak "
                   << std::setprecision(0) << s.peak_rss_mb << " MB -> " << o_.out_dir
                   << std::endl;
@@ -86,6 +89,7 @@ private:
     int k_;  // for the last line
     Progress progress_;
     std::optional<RunVideo> video_;
+    std::size_t objects_ = 0;  // objects found, summed over the frames
 };
 
 /// Puts the default signal handlers back however the run ends.
@@ -105,6 +109,7 @@ void run(const RunCommandOptions& o) {
     r.out_dir = o.out_dir;
     r.max_frames = o.max_frames;
     r.ply = o.ply;
+    r.overlay = o.overlay;
     r.stop = stop_requested;
     apply_threads(o.pipeline);
 
@@ -130,8 +135,11 @@ void add_run_command(CLI::App& app) {
                     "Stop after N frames (default: all; with --camera: until Ctrl-C or its end)")
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
+    cmd->add_flag("--overlay", opts->overlay,
+                  "Also write OUT/<frame>/overlay.png: the objects tinted, outlined and numbered "
+                  "over the colour image");
     cmd->add_option("--video", opts->video,
-                    "Also write a video: colour | clusters | selected object (e.g. out.mp4)");
+                    "Also write a video: colour | objects | clusters (e.g. out.mp4)");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
     cmd->callback([opts]() { run(*opts); });
 }

@@ -1,4 +1,4 @@
-// The side-by-side video of `wul3d run --video` and the panel pictures shared with the viewer.
+// The side-by-side video of `wul3d run --video` (colour | objects | clusters) and the panel pictures shared with the viewer.
 #include "video_writer.hpp"
 
 #include <algorithm>
@@ -14,6 +14,7 @@
 
 #include "video_plugin.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/visualization.hpp"
 
 namespace wul3d::cli {
 namespace fs = std::filesystem;
@@ -234,7 +235,7 @@ void caption(cv::Mat& canvas, int x0, const std::vector<std::string>& lines) {
 
 void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
                      const std::vector<std::uint8_t>* selected, std::size_t index,
-                     std::size_t total, double fps) {
+                     std::size_t total, double fps, int selected_object_id) {
     const Wul3dVideoApi& api = *impl_->api;
     if (!impl_->writer) {
         // Even sizes: H.264 in yuv420p needs them.
@@ -254,14 +255,23 @@ void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
     const cv::Size panel = impl_->panel;
     render_color_panel(frame, colour_);
     paste(colour_, impl_->canvas, 0, panel);
-    paste(result.colors, impl_->canvas, panel.width, panel);
-    if (selected) {
-        highlight_mask(result.colors, *selected, kSelectionOutline, selected_);
+    // Objects: tinted and numbered over the colour, with their oriented boxes.
+    OverlayStyle style;
+    style.boxes = true;
+    style.selected = selected_object_id;
+    if (result.objects.labels.size() == colour_.rgb.size() / 3) {
+        render_object_overlay(colour_, result.objects, result.object_list, frame.intrinsics,
+                              objects_, style);
     } else {
-        highlight_mask(result.colors, std::vector<std::uint8_t>(result.colors.rgb.size() / 3, 0),
-                       kSelectionOutline, selected_);
+        objects_ = colour_;  // objects off (--no-objects): the colour alone
     }
-    paste(selected_, impl_->canvas, 2 * panel.width, panel);
+    paste(objects_, impl_->canvas, panel.width, panel);
+    if (selected) {
+        highlight_mask(result.colors, *selected, kSelectionOutline, clusters_);
+        paste(clusters_, impl_->canvas, 2 * panel.width, panel);
+    } else {
+        paste(result.colors, impl_->canvas, 2 * panel.width, panel);
+    }
 
     char fps_text[64];
     std::snprintf(fps_text, sizeof fps_text, "%.1f FPS", fps);
@@ -269,9 +279,10 @@ void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
             {"frame " + std::to_string(index + 1) + "/" + std::to_string(total) + "  " +
                  frame.name,
              fps_text});
-    caption(impl_->canvas, panel.width, {"clusters (eq. 9)"});
+    caption(impl_->canvas, panel.width,
+            {std::to_string(result.object_list.size()) + " objects (track ids, 3D boxes)"});
     caption(impl_->canvas, 2 * panel.width,
-            {selected ? "selected object" : "no object selected (--select U,V)"});
+            {selected ? "clusters (eq. 9), selected cluster" : "clusters (eq. 9)"});
     if (api.write(impl_->writer, impl_->canvas.data, impl_->canvas.step[0]) != 0)
         throw IoError(path_.string() + ": cannot write the video: " + api.last_error());
 }

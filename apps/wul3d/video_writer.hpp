@@ -1,6 +1,5 @@
 #pragma once
-// `wul3d run --video FILE`: a side-by-side video of the run (colour | clusters | selected
-// object) with the frame number and the pipeline's FPS burned in, written through OpenCV's
+// `wul3d run --video FILE`: a side-by-side video of the run (colour | objects | clusters) with the frame number and the pipeline's FPS burned in, written through OpenCV's
 // FFmpeg-backed VideoWriter in the plugin libwul3d_video.so (video_plugin.hpp), loaded only
 // here. Also the panel pictures the viewer (`wul3d view`) shows, so the video and the window
 // look alike.
@@ -38,8 +37,8 @@ inline constexpr std::uint8_t kSelectionOutline[3] = {255, 255, 255};
 // ---- the video --------------------------------------------------------------------------
 
 /// Writes one video frame per pipeline frame: three panels of the frame's size side by side
-/// (colour | clusters, eq. 9 | selected object), with the frame number and FPS in the first
-/// panel. The file plays at kVideoFps frames per second, H.264 (avc1) when FFmpeg has it,
+/// (colour | objects, tinted with their track ids and oriented 3D boxes | clusters, eq. 9),
+/// with the frame number and FPS in the first panel. The file plays at kVideoFps frames per second, H.264 (avc1) when FFmpeg has it,
 /// else MPEG-4 part 2 (mp4v). Written under a temporary name beside `path` and renamed by
 /// close(); destroyed without close(), the partial file is removed.
 class RunVideo {
@@ -55,13 +54,14 @@ public:
     RunVideo(const RunVideo&) = delete;
     RunVideo& operator=(const RunVideo&) = delete;
 
-    /// Appends the frame. `selected` is the followed object's mask (255 = object) or nullptr
-    /// when no object is followed; `index` counts from 0; `fps` is the pipeline's current
+    /// Appends the frame. `selected` is the followed cluster's mask (255 = cluster), shown
+    /// on the clusters panel, or nullptr; `selected_object_id` the followed object's track
+    /// id (the others darkened on the objects panel), 0 none; `index` counts from 0; `fps` is the pipeline's current
     /// frames per second. Throws IoError if the writer cannot be opened (one line, naming
     /// the file). A frame of another size than the first is scaled to the first's.
     void write(const RgbdFrame& frame, const FrameResult& result,
                const std::vector<std::uint8_t>* selected, std::size_t index, std::size_t total,
-               double fps);
+               double fps, int selected_object_id = 0);
 
     /// Finishes the file and renames it to `path`. Throws IoError if no frame was written.
     void close();
@@ -70,7 +70,7 @@ private:
     struct Impl;
     std::filesystem::path path_, tmp_path_;
     std::unique_ptr<Impl> impl_;
-    ColorImage colour_, clusters_, selected_;
+    ColorImage colour_, objects_, clusters_;
 };
 
 }  // namespace wul3d::cli

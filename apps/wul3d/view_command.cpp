@@ -51,7 +51,7 @@ ViewerConfig make_config(const ViewOptions& o) {
 void add_view_command(CLI::App& app) {
     auto o = std::make_shared<ViewOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "view", "Watch a recording live: 3D cloud, colour, depth, clusters, live parameters");
+        "view", "Watch a recording live: objects in 3D and 2D, clusters, depth, live parameters");
     add_pipeline_options(cmd, o->pipeline);
     cmd->add_option("--screenshot", o->screenshot,
                     "After --exit-after frames, write the window to this PNG and exit");

@@ -1,5 +1,6 @@
 // The `wul3d view` window. One loop: poll input, maybe run the pipeline on the next frame,
-// lay out the UI (controls | 3D cloud over colour, depth, clusters), draw, maybe screenshot.
+// lay out the UI (controls and the object list | 3D cloud over objects, clusters, depth),
+// draw, maybe screenshot.
 #include "viewer_app.hpp"
 
 #define GL_GLEXT_PROTOTYPES 1
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -135,7 +137,8 @@ public:
         delta_is_one_minus_alpha_ =
             std::abs(params_.cluster.alpha + params_.cluster.delta - 1.0f) < 1e-6f;
         pipeline_ = std::make_unique<Pipeline>(params_);
-        if (cfg_.select) selection_.emplace(cfg_.select->first, cfg_.select->second);
+        // --select: a click on the objects panel at that pixel, once the panel is laid out.
+        pending_click_ = cfg_.select;
         scripted_ = cfg_.exit_after > 0;
         playing_ = true;
         process(0);
@@ -143,6 +146,13 @@ public:
         const float fov_y = 2.0f * std::atan(static_cast<float>(f.height()) /
                                              (2.0f * static_cast<float>(f.intrinsics.fy)));
         view_fov_y_ = fov_y;
+        if (pending_click_ && (pending_click_->first < 0 || pending_click_->second < 0 ||
+                               pending_click_->first >= f.width() ||
+                               pending_click_->second >= f.height()))
+            throw InputError("--select " + std::to_string(pending_click_->first) + "," +
+                             std::to_string(pending_click_->second) + " is outside the " +
+                             std::to_string(f.width()) + "x" + std::to_string(f.height()) +
+                             " frame");
         camera_.reset(scene_depth_, fov_y);
         constexpr float kRadPerDeg = 3.14159265f / 180.0f;
         camera_.yaw = cfg_.orbit_yaw_deg * kRadPerDeg;
@@ -158,7 +168,14 @@ private:
     void rebuild_cloud();
     const OrganizedCloud& result_cloud();
     void select_at(int u, int v);
+    void follow_selection();
+    const DetectedObject* selected_object() const;
+    void clear_selection();
+    void add_plane_patch();
+    void inject_pending_click();
     void handle_keys();
+    void draw_object_list();
+    void draw_selected();
     void draw_controls(const Rect& area);
     void draw_cloud(const Rect& area);
     void draw_image(const char* title, ImageTexture& texture, const Rect& area, bool clickable,
@@ -189,12 +206,16 @@ private:
     bool playing_ = true, loop_ = true, real_time_ = true, step_ = false, scripted_ = false;
     Clock::time_point last_frame_time_{};
 
-    std::optional<SelectedObject> selection_;
-    std::vector<std::uint8_t> mask_;
+    int selected_id_ = 0;                       // the followed object's track id, 0 none
+    std::vector<std::uint8_t> mask_;            // its pixels this frame (255), empty if none
+    std::map<int, std::size_t> first_seen_;     // track id -> played_ when it first showed
+    std::optional<std::pair<int, int>> pending_click_;  // --select's click, frame pixel
+    int click_stage_ = 0;                       // 0 not yet, 1 pressed, 2 released
+    int listed_id_ = 0;                         // the selection the object list last showed
     std::string status_;
 
-    ImageTexture tex_color_, tex_depth_, tex_clusters_;
-    ColorImage img_color_, img_depth_, img_clusters_;
+    ImageTexture tex_objects_, tex_depth_, tex_clusters_;
+    ColorImage img_color_, img_objects_, img_depth_, img_clusters_;
     std::pair<float, float> depth_ramp_{0, 0};  // metres at the ramp's warm and cool ends
     CloudRenderer cloud_;
     OrbitCamera camera_;
@@ -203,11 +224,14 @@ private:
     std::vector<std::uint8_t> rgb_;
     std::vector<std::int32_t> pixel_of_point_;
     OrganizedCloud full_cloud_;  // the frame's own cloud under --decimate (result_cloud)
-    int cloud_colour_mode_ = 0;  // 0 clusters (eq. 9), 1 the frame's colour
+    enum ColourMode { kObjects = 0, kClusters = 1, kColour = 2 };
+    int cloud_colour_mode_ = kObjects;  // what colours the 3D points
+    bool show_plane_ = true;            // the support plane as a translucent patch
+    bool show_boxes_ = true;            // each object's oriented box and id in 3D
     bool show_inactive_ = true;
     float point_size_ = 2.0f;
     Mat4 mvp_{};
-    Rect cloud_rect_, clusters_rect_;
+    Rect cloud_rect_, clusters_rect_, objects_rect_;
     int screenshots_ = 0;
 };
 
@@ -233,6 +257,7 @@ void Viewer::process(std::size_t index) {
         param_error_ = e.what();
         params_ = pending_ = before;
         pipeline_ = std::make_unique<Pipeline>(params_);
+        first_seen_.clear();
         result_ = &run_once();
     }
     frame_ = item_.is_raw ? &pipeline_->registered() : &item_.frame;
@@ -256,17 +281,39 @@ void Viewer::process(std::size_t index) {
             scene_depth_ = std::max(0.1f, z[z.size() / 2]);
         }
     }
-    if (selection_) {
-        try {
-            selection_->update(result_->labels, mask_);
-            status_ = "following cluster " + std::to_string(selection_->cluster()) + ", " +
-                      std::to_string(selection_->pixels()) + " px";
-        } catch (const InputError& e) {
-            selection_.reset();
-            mask_.clear();
-            status_ = e.what();
-        }
+    for (const DetectedObject& d : result_->object_list) first_seen_.try_emplace(d.id, played_);
+    follow_selection();
+    refresh_views();
+}
+
+const DetectedObject* Viewer::selected_object() const {
+    if (selected_id_ == 0) return nullptr;
+    for (const DetectedObject& d : result_->object_list)
+        if (d.id == selected_id_) return &d;
+    return nullptr;
+}
+
+void Viewer::follow_selection() {
+    // Track ids are stable (ObjectTracker), so following is finding the id again.
+    mask_.clear();
+    if (selected_id_ == 0) return;
+    const std::string id = "object " + std::to_string(selected_id_);
+    if (const DetectedObject* d = selected_object()) {
+        const auto& L = result_->objects.labels;
+        mask_.resize(L.size());
+        for (std::size_t p = 0; p < L.size(); ++p) mask_[p] = L[p] == selected_id_ ? 255 : 0;
+        status_ = "following " + id + ", " + std::to_string(d->pixels) + " px, tracked " +
+                  std::to_string(played_ - first_seen_[d->id] + 1) + " frames";
+    } else {
+        status_ = id + " is not in this frame (kept: it may come back)";
     }
+    if (scripted_) std::cout << "wul3d: " << frame_->name << ": " << status_ << std::endl;
+}
+
+void Viewer::clear_selection() {
+    selected_id_ = 0;
+    mask_.clear();
+    status_.clear();
     refresh_views();
 }
 
@@ -281,9 +328,12 @@ void Viewer::apply_pending() {
         pending_ = params_;
         return;
     }
-    // The pipeline has no setters: a new one is the honest way, and it re-seeds.
+    // The pipeline has no setters: a new one is the honest way, and it re-seeds (track ids
+    // start again at 1, so the selection goes).
     params_ = pending_;
     pipeline_ = std::make_unique<Pipeline>(params_);
+    first_seen_.clear();
+    selected_id_ = 0;
 }
 
 void Viewer::refresh_views() {
@@ -291,12 +341,21 @@ void Viewer::refresh_views() {
     render_color_panel(*frame_, img_color_);
     depth_ramp_ = render_depth_panel(frame_->depth, params_.range.zmin_m, params_.range.zmax_m,
                                      img_depth_);
-    if (selection_) {
+    if (r.objects.labels.size() == img_color_.rgb.size() / 3) {
+        OverlayStyle style;
+        style.boxes = true;
+        style.selected = selected_object() ? selected_id_ : 0;
+        render_object_overlay(img_color_, r.objects, r.object_list, frame_->intrinsics,
+                              img_objects_, style);
+    } else {
+        img_objects_ = img_color_;  // no object stages: the colour alone
+    }
+    if (!mask_.empty()) {
         highlight_mask(r.colors, mask_, kSelectionOutline, img_clusters_);
     } else {
         img_clusters_ = r.colors;
     }
-    tex_color_.upload(img_color_);
+    tex_objects_.upload(img_objects_);
     tex_depth_.upload(img_depth_);
     tex_clusters_.upload(img_clusters_);
     rebuild_cloud();
@@ -313,79 +372,171 @@ const OrganizedCloud& Viewer::result_cloud() {
 void Viewer::rebuild_cloud() {
     const OrganizedCloud& c = result_cloud();
     const FrameResult& r = *result_;
-    const bool selected = selection_ && mask_.size() == c.x.size();
+    const bool selected = mask_.size() == c.x.size();
+    const bool objects = r.objects.labels.size() == c.x.size();
     xyz_.clear();
     rgb_.clear();
     pixel_of_point_.clear();
-    std::vector<float> sx, sy, sz;  // the selected object's points, for its box
     for (std::size_t p = 0; p < c.x.size(); ++p) {
         if (!c.valid[p]) continue;
         const bool labelled = r.labels.labels[p] != 0;
         if (!labelled && !show_inactive_) continue;
-        const float x = c.x[p], y = -c.y[p], z = -c.z[p];
-        xyz_.insert(xyz_.end(), {x, y, z});
+        const int object = objects ? r.objects.labels[p] : 0;
+        xyz_.insert(xyz_.end(), {c.x[p], -c.y[p], -c.z[p]});
         pixel_of_point_.push_back(static_cast<std::int32_t>(p));
-        const std::uint8_t* src = (cloud_colour_mode_ == 0 && labelled)
-                                      ? &r.colors.rgb[3 * p]
-                                      : (frame_->has_color() ? &frame_->color.rgb[3 * p] : nullptr);
         std::uint8_t col[3] = {160, 160, 160};
-        if (src) std::copy_n(src, 3, col);
         float gain = labelled ? 1.0f : 0.3f;
-        if (selected && !mask_[p]) gain *= 0.35f;
-        if (selected && mask_[p]) {
-            sx.push_back(x);
-            sy.push_back(y);
-            sz.push_back(z);
+        if (cloud_colour_mode_ == kObjects && object != 0) {
+            const auto oc = object_color(object);
+            std::copy_n(oc.data(), 3, col);
+        } else if (cloud_colour_mode_ == kClusters && labelled) {
+            std::copy_n(&r.colors.rgb[3 * p], 3, col);
+        } else {
+            if (frame_->has_color()) std::copy_n(&frame_->color.rgb[3 * p], 3, col);
+            // Objects mode: the rest of the scene (the table) stays readable but recedes.
+            if (cloud_colour_mode_ == kObjects) gain *= 0.5f;
         }
+        if (selected && !mask_[p]) gain *= 0.35f;
         for (int q = 0; q < 3; ++q)
             rgb_.push_back(static_cast<std::uint8_t>(static_cast<float>(col[q]) * gain));
     }
     cloud_.set_points(xyz_, rgb_);
 
-    // The selected object's box: 2nd to 98th percentile on each axis, so a few stray pixels
-    // at its border do not blow it up.
+    // Each object's oriented box in its colour (the selected one white), and a cross at the
+    // selected one's centroid. View space is the camera's (x, -y, -z).
     std::vector<float> lines;
     std::vector<std::uint8_t> line_rgb;
-    if (sx.size() >= 10) {
-        float lo[3], hi[3];
-        std::vector<float>* axes[3] = {&sx, &sy, &sz};
-        for (int a = 0; a < 3; ++a) {
-            auto& v = *axes[a];
-            const auto n = static_cast<std::ptrdiff_t>(v.size());
-            std::nth_element(v.begin(), v.begin() + n / 50, v.end());
-            lo[a] = v[static_cast<std::size_t>(n / 50)];
-            std::nth_element(v.begin(), v.begin() + n - 1 - n / 50, v.end());
-            hi[a] = v[static_cast<std::size_t>(n - 1 - n / 50)];
-        }
-        for (int e = 0; e < 12; ++e) {
-            // Edge e runs along axis e / 4; the other two axes take the corners of e % 4.
-            const int axis = e / 4, o1 = (axis + 1) % 3, o2 = (axis + 2) % 3;
-            for (int end = 0; end < 2; ++end) {
-                float pt[3];
-                pt[axis] = end ? hi[axis] : lo[axis];
-                pt[o1] = (e % 4) & 1 ? hi[o1] : lo[o1];
-                pt[o2] = (e % 4) & 2 ? hi[o2] : lo[o2];
-                lines.insert(lines.end(), pt, pt + 3);
-                line_rgb.insert(line_rgb.end(), kSelectionOutline, kSelectionOutline + 3);
+    const auto add_line = [&](const float* a, const float* b, const std::uint8_t* rgb) {
+        lines.insert(lines.end(), {a[0], -a[1], -a[2], b[0], -b[1], -b[2]});
+        line_rgb.insert(line_rgb.end(), {rgb[0], rgb[1], rgb[2], rgb[0], rgb[1], rgb[2]});
+    };
+    for (const DetectedObject& d : r.object_list) {
+        const bool is_selected = d.id == selected_id_;
+        if (!show_boxes_ && !is_selected) continue;
+        if (selected && !is_selected) continue;  // a selection shows its own box alone
+        const auto oc = object_color(d.id);
+        const std::uint8_t* rgb = is_selected ? kSelectionOutline : oc.data();
+        float corner[8][3];
+        for (int k = 0; k < 8; ++k)
+            for (int i = 0; i < 3; ++i) {
+                corner[k][i] = d.obb_centre[i];
+                for (int a = 0; a < 3; ++a)
+                    corner[k][i] += ((k >> a) & 1 ? 1.0f : -1.0f) * d.obb_half_extent[a] *
+                                    d.obb_axes[3 * a + i];
+            }
+        for (int k = 0; k < 8; ++k)
+            for (int a = 0; a < 3; ++a)
+                if (!((k >> a) & 1)) add_line(corner[k], corner[k | (1 << a)], rgb);
+        if (is_selected) {
+            for (int a = 0; a < 3; ++a) {
+                float lo[3], hi[3];
+                for (int i = 0; i < 3; ++i) lo[i] = hi[i] = d.centroid[i];
+                lo[a] -= 0.02f;
+                hi[a] += 0.02f;
+                add_line(lo, hi, kSelectionOutline);
             }
         }
     }
     cloud_.set_lines(lines, line_rgb);
+    add_plane_patch();
+}
+
+void Viewer::add_plane_patch() {
+    // The support plane as a rectangle on it, over the 2nd to 98th percentile of its points
+    // along their two principal directions in the plane: the table, not the whole plane.
+    std::vector<float> tri;
+    std::vector<std::uint8_t> tri_rgb;
+    const PlaneResult& pr = result_->plane;
+    const OrganizedCloud& c = result_cloud();
+    if (show_plane_ && pr.found) {
+        const Plane& pl = pr.support;
+        const float n[3] = {pl.nx, pl.ny, pl.nz};
+        // e1 = n x (0, 0, 1) (or x (1, 0, 0) for a plane facing sideways), e2 = n x e1.
+        float e1[3] = {n[1], -n[0], 0};
+        if (std::abs(n[2]) > 0.9f) e1[0] = 0, e1[1] = n[2], e1[2] = -n[1];
+        const float l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+        for (float& x : e1) x /= l1;
+        const float e2[3] = {n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2],
+                             n[0] * e1[1] - n[1] * e1[0]};
+        std::vector<float> s1, s2;
+        for (std::size_t p = 0; p < c.x.size(); p += 3) {
+            if (!c.valid[p] || !result_->active[p]) continue;
+            if (std::abs(pl.height(c.x[p], c.y[p], c.z[p])) > 0.01f) continue;
+            s1.push_back(c.x[p] * e1[0] + c.y[p] * e1[1] + c.z[p] * e1[2]);
+            s2.push_back(c.x[p] * e2[0] + c.y[p] * e2[1] + c.z[p] * e2[2]);
+        }
+        if (s1.size() >= 50) {
+            // Turn (e1, e2) onto the principal axes of the points' 2 x 2 covariance, so
+            // that the rectangle lies along the table's sides.
+            double m1 = 0, m2 = 0, c11 = 0, c12 = 0, c22 = 0;
+            for (std::size_t i = 0; i < s1.size(); ++i) m1 += s1[i], m2 += s2[i];
+            m1 /= static_cast<double>(s1.size());
+            m2 /= static_cast<double>(s1.size());
+            for (std::size_t i = 0; i < s1.size(); ++i) {
+                const double a = s1[i] - m1, b = s2[i] - m2;
+                c11 += a * a, c12 += a * b, c22 += b * b;
+            }
+            const double angle = 0.5 * std::atan2(2 * c12, c11 - c22);
+            const float ca = static_cast<float>(std::cos(angle)), sa = static_cast<float>(std::sin(angle));
+            float r1[3], r2[3];
+            for (int i = 0; i < 3; ++i) {
+                r1[i] = ca * e1[i] + sa * e2[i];
+                r2[i] = -sa * e1[i] + ca * e2[i];
+            }
+            for (std::size_t i = 0; i < s1.size(); ++i) {
+                const float a = s1[i], b = s2[i];
+                s1[i] = ca * a + sa * b;
+                s2[i] = -sa * a + ca * b;
+            }
+            std::copy_n(r1, 3, e1);
+            const float* f2 = r2;
+            const auto pct = [](std::vector<float>& v, double q) {
+                const auto i = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+                std::nth_element(v.begin(), v.begin() + i, v.end());
+                return v[static_cast<std::size_t>(i)];
+            };
+            const float a0 = pct(s1, 0.02), a1 = pct(s1, 0.98), b0 = pct(s2, 0.02),
+                        b1 = pct(s2, 0.98);
+            const auto at = [&](float a, float b) {
+                // The point a e1 + b e2 - d n lies on the plane n . X + d = 0.
+                for (int i = 0; i < 3; ++i) {
+                    const float x = a * e1[i] + b * f2[i] - pl.d * n[i];
+                    tri.push_back(i == 0 ? x : -x);
+                    tri_rgb.push_back(i == 1 ? 200 : 90);  // green
+                }
+            };
+            at(a0, b0);
+            at(a1, b0);
+            at(a1, b1);
+            at(a0, b0);
+            at(a1, b1);
+            at(a0, b1);
+        }
+    }
+    cloud_.set_patch(tri, tri_rgb);
 }
 
 void Viewer::select_at(int u, int v) {
-    selection_.emplace(u, v);
-    mask_.clear();
-    try {
-        selection_->update(result_->labels, mask_);
-        status_ = "selected cluster " + std::to_string(selection_->cluster()) + " at (" +
-                  std::to_string(u) + ", " + std::to_string(v) + "), " +
-                  std::to_string(selection_->pixels()) + " px";
-    } catch (const InputError& e) {
-        selection_.reset();
-        mask_.clear();
-        status_ = e.what();
+    // The object under (u, v), or the nearest object pixel within 15 px: a click just off a
+    // thin object still takes it.
+    const LabelImage& L = result_->objects;
+    int best = 0, best_d2 = 15 * 15 + 1;
+    for (int dv = -15; dv <= 15; ++dv)
+        for (int du = -15; du <= 15; ++du) {
+            const int x = u + du, y = v + dv, d2 = du * du + dv * dv;
+            if (x < 0 || y < 0 || x >= L.width || y >= L.height || d2 >= best_d2) continue;
+            const int l = L.labels[static_cast<std::size_t>(y) * L.width + x];
+            if (l != 0) best = l, best_d2 = d2;
+        }
+    selected_id_ = best;
+    if (best == 0) {
+        status_ = "no object at (" + std::to_string(u) + ", " + std::to_string(v) + ")";
+        if (scripted_) std::cout << "wul3d: " << frame_->name << ": " << status_ << std::endl;
+    } else if (scripted_) {
+        std::cout << "wul3d: " << frame_->name << ": clicked (" << u << ", " << v
+                  << "): selected object " << best << std::endl;
     }
+    follow_selection();
     refresh_views();
 }
 
@@ -405,11 +556,10 @@ void Viewer::handle_keys() {
                 break;
             case GLFW_KEY_L: loop_ = !loop_; break;
             case GLFW_KEY_R: camera_.reset(scene_depth_, view_fov_y_); break;
-            case GLFW_KEY_C:
-                selection_.reset();
-                mask_.clear();
-                status_.clear();
-                refresh_views();
+            case GLFW_KEY_C: clear_selection(); break;
+            case GLFW_KEY_O:
+                cloud_colour_mode_ = (cloud_colour_mode_ + 1) % 3;
+                rebuild_cloud();
                 break;
             case GLFW_KEY_S: {
                 char name[64];
@@ -454,7 +604,9 @@ void Viewer::draw_controls(const Rect& area) {
         ImGui::Checkbox("Real time (30 FPS at most)", &real_time_);
     }
 
-    if (ImGui::CollapsingHeader("Parameters", ImGuiTreeNodeFlags_DefaultOpen)) {
+    draw_object_list();
+
+    if (ImGui::CollapsingHeader("Parameters")) {
         ImGui::PushItemWidth(170);
         ClusterParams& c = pending_.cluster;
         bool changed = false;
@@ -520,29 +672,17 @@ void Viewer::draw_controls(const Rect& area) {
         ImGui::PopStyleColor();
     }
 
-    if (ImGui::CollapsingHeader("Selected object", ImGuiTreeNodeFlags_DefaultOpen)) {
-        if (selection_) {
-            const auto col = cluster_color(selection_->cluster() - 1);
-            ImGui::ColorButton("##c", ImVec4(col[0] / 255.0f, col[1] / 255.0f, col[2] / 255.0f, 1),
-                               ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
-            ImGui::SameLine();
-            ImGui::Text("cluster %d, %zu px", selection_->cluster(), selection_->pixels());
-            if (ImGui::Button("Clear (C)")) {
-                selection_.reset();
-                mask_.clear();
-                status_.clear();
-                refresh_views();
-            }
-        } else {
-            ImGui::TextColored(kDimColour, "click an object in a picture or in 3D");
-        }
-        if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
-    }
+    draw_selected();
 
     if (ImGui::CollapsingHeader("3D view", ImGuiTreeNodeFlags_DefaultOpen)) {
-        bool changed = ImGui::RadioButton("clusters", &cloud_colour_mode_, 0);
+        bool changed = ImGui::RadioButton("objects", &cloud_colour_mode_, kObjects);
         ImGui::SameLine();
-        changed |= ImGui::RadioButton("colour", &cloud_colour_mode_, 1);
+        changed |= ImGui::RadioButton("clusters (eq. 9)", &cloud_colour_mode_, kClusters);
+        ImGui::SameLine();
+        changed |= ImGui::RadioButton("colour", &cloud_colour_mode_, kColour);
+        changed |= ImGui::Checkbox("boxes and ids", &show_boxes_);
+        ImGui::SameLine();
+        changed |= ImGui::Checkbox("support plane", &show_plane_);
         changed |= ImGui::Checkbox("points out of range (dim)", &show_inactive_);
         ImGui::PushItemWidth(170);
         ImGui::SliderFloat("point size", &point_size_, 1.0f, 6.0f, "%.1f");
@@ -555,6 +695,7 @@ void Viewer::draw_controls(const Rect& area) {
         ImGui::TextColored(kDimColour,
                            "space play/pause   N or right step\n"
                            "L loop   R reset view   C clear selection\n"
+                           "O objects / clusters / colour in 3D\n"
                            "S screenshot (wul3d_view_NNN.png)   Q quit\n"
                            "3D: left drag orbit, right drag pan,\n"
                            "    wheel zoom, click select");
@@ -562,11 +703,102 @@ void Viewer::draw_controls(const Rect& area) {
     ImGui::End();
 }
 
+void Viewer::draw_object_list() {
+    const auto& list = result_->object_list;
+    char header[64];
+    std::snprintf(header, sizeof header, "Objects: %zu###objects", list.size());
+    if (!ImGui::CollapsingHeader(header, ImGuiTreeNodeFlags_DefaultOpen)) return;
+    if (list.empty()) {
+        ImGui::TextColored(kDimColour, "no object in this frame");
+        return;
+    }
+    constexpr ImGuiTableFlags kFlags = ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV |
+                                       ImGuiTableFlags_SizingFixedFit | ImGuiTableFlags_ScrollY;
+    const float rows = static_cast<float>(std::min<std::size_t>(list.size(), 8) + 1);
+    if (!ImGui::BeginTable("##objects", 5, kFlags,
+                           ImVec2(0, rows * ImGui::GetTextLineHeightWithSpacing() + 6)))
+        return;
+    ImGui::TableSetupScrollFreeze(0, 1);
+    ImGui::TableSetupColumn("id");
+    ImGui::TableSetupColumn("pixels");
+    ImGui::TableSetupColumn("size, cm");
+    ImGui::TableSetupColumn("dist, m");
+    ImGui::TableSetupColumn("frames");
+    ImGui::TableHeadersRow();
+    for (const DetectedObject& d : list) {
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        const auto c = object_color(d.id);
+        ImGui::ColorButton("##c", ImVec4(c[0] / 255.0f, c[1] / 255.0f, c[2] / 255.0f, 1),
+                           ImGuiColorEditFlags_NoTooltip, ImVec2(12, 12));
+        ImGui::SameLine();
+        char id[16];
+        std::snprintf(id, sizeof id, "%d", d.id);
+        // The whole row is the click target.
+        // A selection made elsewhere (a click in 2D or 3D) scrolls its row into view once.
+        if (d.id == selected_id_ && listed_id_ != selected_id_) ImGui::SetScrollHereY();
+        if (ImGui::Selectable(id, d.id == selected_id_, ImGuiSelectableFlags_SpanAllColumns)) {
+            selected_id_ = d.id == selected_id_ ? 0 : d.id;
+            follow_selection();
+            refresh_views();
+        }
+        ImGui::TableNextColumn();
+        ImGui::Text("%zu", d.pixels);
+        ImGui::TableNextColumn();
+        // The oriented box's sides, largest first.
+        float side[3] = {200 * d.obb_half_extent[0], 200 * d.obb_half_extent[1],
+                         200 * d.obb_half_extent[2]};
+        std::sort(side, side + 3, std::greater<>());
+        ImGui::Text("%.0f x %.0f x %.0f", static_cast<double>(side[0]),
+                    static_cast<double>(side[1]), static_cast<double>(side[2]));
+        ImGui::TableNextColumn();
+        ImGui::Text("%.2f", static_cast<double>(std::sqrt(d.centroid[0] * d.centroid[0] +
+                                                          d.centroid[1] * d.centroid[1] +
+                                                          d.centroid[2] * d.centroid[2])));
+        ImGui::TableNextColumn();
+        const auto seen = first_seen_.find(d.id);
+        ImGui::Text("%zu", seen == first_seen_.end() ? std::size_t{1} : played_ - seen->second + 1);
+    }
+    ImGui::EndTable();
+    listed_id_ = selected_id_;
+}
+
+void Viewer::draw_selected() {
+    if (!ImGui::CollapsingHeader("Selected object", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    if (selected_id_ == 0) {
+        ImGui::PushStyleColor(ImGuiCol_Text, kDimColour);
+        ImGui::TextWrapped("click an object in a picture, in 3D or in the list");
+        ImGui::PopStyleColor();
+    } else {
+        const auto col = object_color(selected_id_);
+        ImGui::ColorButton("##sel", ImVec4(col[0] / 255.0f, col[1] / 255.0f, col[2] / 255.0f, 1),
+                           ImGuiColorEditFlags_NoTooltip, ImVec2(14, 14));
+        ImGui::SameLine();
+        ImGui::Text("object %d", selected_id_);
+        if (const DetectedObject* d = selected_object()) {
+            const auto seen = first_seen_.find(d->id);
+            ImGui::Text("%zu px, tracked %zu frames", d->pixels,
+                        seen == first_seen_.end() ? std::size_t{1} : played_ - seen->second + 1);
+            ImGui::Text("centroid %.3f, %.3f, %.3f m", static_cast<double>(d->centroid[0]),
+                        static_cast<double>(d->centroid[1]), static_cast<double>(d->centroid[2]));
+            ImGui::Text("box %.1f x %.1f x %.1f cm", 200.0 * d->obb_half_extent[0],
+                        200.0 * d->obb_half_extent[1], 200.0 * d->obb_half_extent[2]);
+            ImGui::Text("mean colour %.0f, %.0f, %.0f", static_cast<double>(d->mean_rgb[0]),
+                        static_cast<double>(d->mean_rgb[1]), static_cast<double>(d->mean_rgb[2]));
+        }
+        if (ImGui::Button("Clear (C)")) clear_selection();
+    }
+    if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
+}
+
 void Viewer::draw_cloud(const Rect& area) {
     ImGui::SetNextWindowPos(ImVec2(area.x, area.y));
     ImGui::SetNextWindowSize(ImVec2(area.w, area.h));
     ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
-    ImGui::Begin("3D: coloured point cloud (eq. 9)", nullptr, kPanelFlags);
+    static constexpr const char* kTitles[3] = {
+        "3D: objects (track ids, oriented boxes)###3d", "3D: clusters (eq. 9)###3d",
+        "3D: colour###3d"};
+    ImGui::Begin(kTitles[cloud_colour_mode_], nullptr, kPanelFlags);
     const ImVec2 pos = ImGui::GetCursorScreenPos();
     const ImVec2 size = ImGui::GetContentRegionAvail();
     cloud_rect_ = {pos.x, pos.y, size.x, size.y};
@@ -605,7 +837,9 @@ void Viewer::draw_cloud(const Rect& area) {
             }
         }
         if (best >= 0) {
-            const int W = pipeline_->cloud().width;
+            // pixel_of_point_ indexes the results' pixels (result_cloud), not the
+            // decimated cloud's.
+            const int W = result_->labels.width;
             select_at(best % W, best / W);
         } else {
             status_ = "no point under the mouse";
@@ -618,6 +852,29 @@ void Viewer::draw_cloud(const Rect& area) {
     ImDrawList* dl = ImGui::GetWindowDrawList();
     dl->AddImage(reinterpret_cast<ImTextureID>(static_cast<std::uintptr_t>(tex)), pos,
                  ImVec2(pos.x + size.x, pos.y + size.y), ImVec2(0, 1), ImVec2(1, 0));
+    // Each object's id on a tag at the top of its box, in screen space.
+    for (const DetectedObject& d : result_->object_list) {
+        if (!show_boxes_ && d.id != selected_id_) continue;
+        if (!mask_.empty() && d.id != selected_id_) continue;
+        float top[3] = {d.centroid[0], d.centroid[1], d.centroid[2]};
+        top[1] = std::min(top[1], d.aabb_min[1]);  // camera y points down: the box's top
+        const float x = top[0], y = -top[1], z = -top[2];
+        const float cx = mvp_[0] * x + mvp_[4] * y + mvp_[8] * z + mvp_[12];
+        const float cy = mvp_[1] * x + mvp_[5] * y + mvp_[9] * z + mvp_[13];
+        const float cw = mvp_[3] * x + mvp_[7] * y + mvp_[11] * z + mvp_[15];
+        if (cw <= 0) continue;
+        const ImVec2 at(pos.x + (cx / cw * 0.5f + 0.5f) * size.x,
+                        pos.y + (0.5f - cy / cw * 0.5f) * size.y);
+        if (!cloud_rect_.contains(at)) continue;
+        char id[16];
+        std::snprintf(id, sizeof id, "%d", d.id);
+        const ImVec2 ts = ImGui::CalcTextSize(id);
+        const auto c = object_color(d.id);
+        const ImVec2 lo(at.x - ts.x / 2 - 4, at.y - ts.y - 6), hi(at.x + ts.x / 2 + 4, at.y - 2);
+        dl->AddRectFilled(lo, hi, IM_COL32(20, 20, 24, 220), 3);
+        dl->AddRect(lo, hi, IM_COL32(c[0], c[1], c[2], 255), 3);
+        dl->AddText(ImVec2(lo.x + 4, lo.y + 2), IM_COL32(255, 255, 255, 255), id);
+    }
     char line[160];
     if (live_)
         std::snprintf(line, sizeof line, "live  %s   k = %d", frame_->name.c_str(),
@@ -663,8 +920,10 @@ void Viewer::draw_image(const char* title, ImageTexture& texture, const Rect& ar
                             ? static_cast<float>(frame_->depth.data[p]) * frame_->depth.scale_m_per_unit
                             : 0.0f;
         const int label = p < result_->labels.labels.size() ? result_->labels.labels[p] : 0;
+        const int object = p < result_->objects.labels.size() ? result_->objects.labels[p] : 0;
         ImGui::BeginTooltip();
-        ImGui::Text("(%d, %d)  z %.3f m  cluster %d", u, v, static_cast<double>(z), label);
+        ImGui::Text("(%d, %d)  z %.3f m  cluster %d  object %d", u, v, static_cast<double>(z),
+                    label, object);
         ImGui::EndTooltip();
         if (clickable && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) select_at(u, v);
     }
@@ -681,11 +940,28 @@ void Viewer::take_screenshot(const std::string& path, bool scripted) {
     status_ = "screenshot: " + path;
     if (scripted)
         std::cout << "wul3d: screenshot " << path << " (" << w << "x" << h
-                  << "), clusters panel at " << px(clusters_rect_.x) << "," << px(clusters_rect_.y)
+                  << "), objects panel at " << px(objects_rect_.x) << "," << px(objects_rect_.y)
+                  << " " << px(objects_rect_.w) << "x" << px(objects_rect_.h)
+                  << ", clusters panel at " << px(clusters_rect_.x) << "," << px(clusters_rect_.y)
                   << " " << px(clusters_rect_.w) << "x" << px(clusters_rect_.h) << std::endl;
 }
 
 // ---- the loop ------------------------------------------------------------------------------
+
+void Viewer::inject_pending_click() {
+    // --select U,V: a mouse click on the objects panel at the frame's pixel (U, V), through
+    // the UI library as a real click would come (press one frame, release the next), once
+    // the panel has been laid out. Playback waits for it.
+    if (!pending_click_ || objects_rect_.w <= 0 || tex_objects_.width() <= 0) return;
+    ImGuiIO& io = ImGui::GetIO();
+    const auto [u, v] = *pending_click_;
+    io.MousePos = ImVec2(objects_rect_.x + (static_cast<float>(u) + 0.5f) * objects_rect_.w /
+                                               static_cast<float>(tex_objects_.width()),
+                         objects_rect_.y + (static_cast<float>(v) + 0.5f) * objects_rect_.h /
+                                               static_cast<float>(tex_objects_.height()));
+    io.MouseDown[0] = click_stage_ == 0;
+    if (++click_stage_ == 2) pending_click_.reset();
+}
 
 void Viewer::run() {
     last_frame_time_ = Clock::now();
@@ -717,7 +993,8 @@ void Viewer::run() {
             const bool at_end = current_ + 1 >= n;
             const double since =
                 std::chrono::duration<double>(Clock::now() - last_frame_time_).count();
-            const bool due = playing_ && !scripted_done && (!at_end || loop_) &&
+            const bool due = playing_ && !scripted_done && !pending_click_ &&
+                             (!at_end || loop_) &&
                              (scripted_ || !real_time_ || since >= 1.0 / kRecordingFps);
             if (due || step_) {
                 last_frame_time_ = Clock::now();
@@ -730,6 +1007,7 @@ void Viewer::run() {
 
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
+        inject_pending_click();
         ImGui::NewFrame();
         const ImVec2 display = ImGui::GetIO().DisplaySize;
         const float right_w = std::max(300.0f, display.x - kControlsWidth);
@@ -741,19 +1019,22 @@ void Viewer::run() {
         const float cloud_h = std::max(100.0f, display.y - panel_h);
         draw_controls({0, 0, kControlsWidth, display.y});
         draw_cloud({kControlsWidth, 0, right_w, cloud_h});
-        draw_image("colour", tex_color_, {kControlsWidth, cloud_h, panel_w, panel_h}, true,
-                   nullptr);
+        char objects_title[96];
+        std::snprintf(objects_title, sizeof objects_title,
+                      "objects: %zu, click to select###objects", result_->object_list.size());
+        draw_image(objects_title, tex_objects_, {kControlsWidth, cloud_h, panel_w, panel_h}, true,
+                   &objects_rect_);
+        draw_image("clusters (eq. 9)###clusters", tex_clusters_,
+                   {kControlsWidth + panel_w, cloud_h, panel_w, panel_h}, true, &clusters_rect_);
         char depth_title[128];
         std::snprintf(depth_title, sizeof depth_title,
                       "depth: %.2f m (yellow) to %.2f m (blue), grey out of range###depth",
                       static_cast<double>(depth_ramp_.first),
                       static_cast<double>(depth_ramp_.second));
-        draw_image(depth_title, tex_depth_, {kControlsWidth + panel_w, cloud_h, panel_w, panel_h},
-                   true, nullptr);
-        draw_image("clusters (eq. 9): click to select###clusters", tex_clusters_,
+        draw_image(depth_title, tex_depth_,
                    {kControlsWidth + 2 * panel_w, cloud_h, display.x - kControlsWidth - 2 * panel_w,
                     panel_h},
-                   true, &clusters_rect_);
+                   true, nullptr);
         ImGui::Render();
 
         int fb_w = 0, fb_h = 0;

@@ -1,7 +1,9 @@
 #pragma once
-// The `wul3d view` window: plays a recording through the pipeline and shows the coloured
-// cloud in 3D, the colour, depth and cluster pictures in 2D, live parameter controls, timings
-// and the user-selected object. GLFW + OpenGL 3.3 + Dear ImGui.
+// The `wul3d view` window: plays a recording through the pipeline and shows its objects (a
+// colour per track id, oriented boxes and ids) in the 3D cloud and over the colour picture,
+// the list of objects, the clusters (eq. 9) and depth pictures, live parameter controls,
+// timings and the selected object, followed from frame to frame. GLFW + OpenGL 3.3 + Dear
+// ImGui.
 #include <optional>
 #include <string>
 #include <utility>
@@ -17,7 +19,9 @@ struct ViewerConfig {
     bool lossless = false;   ///< --lossless: capture waits for the viewer (replays)
     SourceOptions source;
     PipelineParams params;
-    std::optional<std::pair<int, int>> select;  ///< follow the object under (u, v)
+    std::optional<std::pair<int, int>> select;  ///< click the objects panel at frame pixel
+                                                ///< (u, v) of the first frame (selects and
+                                                ///< follows the object there)
     std::string screenshot;  ///< write the window here after exit_after frames, then exit
     int exit_after = 0;      ///< frames to play before the screenshot and exit; 0 = until closed
     int width = 1600, height = 900;  ///< window size, screen pixels

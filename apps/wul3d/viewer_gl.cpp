@@ -124,8 +124,9 @@ void main() {
 
 constexpr const char* kFragmentShader = R"(#version 330 core
 in vec3 v_color;
+uniform float alpha;
 out vec4 frag;
-void main() { frag = vec4(v_color, 1.0); }
+void main() { frag = vec4(v_color, alpha); }
 )";
 
 unsigned compile(GLenum type, const char* source) {
@@ -159,7 +160,8 @@ CloudRenderer::CloudRenderer() {
     if (!ok) throw Error("viewer: shader program does not link");
     mvp_loc_ = glGetUniformLocation(program_, "mvp");
     size_loc_ = glGetUniformLocation(program_, "point_size");
-    for (Buffers* b : {&points_, &lines_}) {
+    alpha_loc_ = glGetUniformLocation(program_, "alpha");
+    for (Buffers* b : {&points_, &lines_, &patch_}) {
         glGenVertexArrays(1, &b->vao);
         glGenBuffers(1, &b->vbo_xyz);
         glGenBuffers(1, &b->vbo_rgb);
@@ -175,7 +177,7 @@ CloudRenderer::CloudRenderer() {
 }
 
 CloudRenderer::~CloudRenderer() {
-    for (Buffers* b : {&points_, &lines_}) {
+    for (Buffers* b : {&points_, &lines_, &patch_}) {
         glDeleteBuffers(1, &b->vbo_xyz);
         glDeleteBuffers(1, &b->vbo_rgb);
         glDeleteVertexArrays(1, &b->vao);
@@ -208,6 +210,11 @@ void CloudRenderer::set_lines(const std::vector<float>& xyz,
     fill(lines_, xyz, rgb);
 }
 
+void CloudRenderer::set_patch(const std::vector<float>& xyz,
+                              const std::vector<std::uint8_t>& rgb) {
+    fill(patch_, xyz, rgb);
+}
+
 void CloudRenderer::resize_target(int width, int height) {
     if (width == fbo_w_ && height == fbo_h_ && fbo_) return;
     fbo_w_ = width;
@@ -232,7 +239,7 @@ void CloudRenderer::resize_target(int width, int height) {
 }
 
 unsigned CloudRenderer::render(int width, int height, const Mat4& mvp, float point_size_px,
-                               const float background[3]) {
+                               const float background[3], float patch_alpha) {
     width = std::max(width, 1);
     height = std::max(height, 1);
     resize_target(width, height);
@@ -245,9 +252,21 @@ unsigned CloudRenderer::render(int width, int height, const Mat4& mvp, float poi
     glUseProgram(program_);
     glUniformMatrix4fv(mvp_loc_, 1, GL_FALSE, mvp.data());
     glUniform1f(size_loc_, point_size_px);
+    glUniform1f(alpha_loc_, 1.0f);
     glBindVertexArray(points_.vao);
     glDrawArrays(GL_POINTS, 0, points_.count);
-    glDisable(GL_DEPTH_TEST);  // the selection box stays visible through the points
+    // The patch: blended over the points in front of it, hidden behind them, and writing
+    // no depth so that the points under it still show through.
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    glUniform1f(alpha_loc_, patch_alpha);
+    glBindVertexArray(patch_.vao);
+    glDrawArrays(GL_TRIANGLES, 0, patch_.count);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glUniform1f(alpha_loc_, 1.0f);
+    glDisable(GL_DEPTH_TEST);  // the boxes stay visible through the points
     glBindVertexArray(lines_.vao);
     glDrawArrays(GL_LINES, 0, lines_.count);
     glBindVertexArray(0);

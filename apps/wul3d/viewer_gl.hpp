@@ -52,7 +52,7 @@ struct OrbitCamera {
 
 Mat4 multiply(const Mat4& a, const Mat4& b);
 
-/// Points (position + colour) and line segments, drawn with one tiny shader into an
+/// Points (position + colour), line segments and translucent triangles, drawn with one tiny shader into an
 /// offscreen colour texture of the size asked for.
 class CloudRenderer {
 public:
@@ -65,9 +65,12 @@ public:
     void set_points(const std::vector<float>& xyz, const std::vector<std::uint8_t>& rgb);
     /// Line segments: 2 vertices each, same layout.
     void set_lines(const std::vector<float>& xyz, const std::vector<std::uint8_t>& rgb);
+    /// Translucent triangles (3 vertices each, same layout), drawn over the points with
+    /// `patch_alpha` opacity (the support plane's patch).
+    void set_patch(const std::vector<float>& xyz, const std::vector<std::uint8_t>& rgb);
     /// Draws into the offscreen target (resized to width x height) and returns its texture.
     unsigned render(int width, int height, const Mat4& mvp, float point_size_px,
-                    const float background[3]);
+                    const float background[3], float patch_alpha = 0.3f);
 
 private:
     void resize_target(int width, int height);
@@ -78,8 +81,8 @@ private:
     static void fill(Buffers& b, const std::vector<float>& xyz,
                      const std::vector<std::uint8_t>& rgb);
     unsigned program_ = 0;
-    int mvp_loc_ = -1, size_loc_ = -1;
-    Buffers points_, lines_;
+    int mvp_loc_ = -1, size_loc_ = -1, alpha_loc_ = -1;
+    Buffers points_, lines_, patch_;
     unsigned fbo_ = 0, color_tex_ = 0, depth_rb_ = 0;
     int fbo_w_ = 0, fbo_h_ = 0;
 };

@@ -2,7 +2,7 @@
 /// @file output.hpp
 /// What `wul3d run` writes for one frame, as library calls an embedding program can make:
 /// the frame folder OUT/<frame>/ (labels.png, colors.png, objects.png, objects.json, and on
-/// request selected.png, selected_object.png, cloud.ply), the objects.json schema, and the
+/// request selected.png, selected_object.png, overlay.png, cloud.ply), the objects.json schema, and the
 /// one atomic-write helper every writer of wul3d goes through (README, "Outputs").
 #include <cstddef>
 #include <cstdint>
@@ -38,6 +38,9 @@ struct FrameOutputs {
     const Mask* selected_object = nullptr;
     int selected_id = 0;  ///< objects.json's "selected" (see objects_json)
     bool ply = false;     ///< cloud.ply: the labelled points, binary PLY
+    /// overlay.png: the objects tinted, outlined and numbered over the frame's colour
+    /// (render_object_overlay; over a grey depth picture for a depth-only frame).
+    bool overlay = false;
 };
 
 /// Writes one frame's outputs to OUT/<name>/ atomically (write_folder_atomic): labels.png,

@@ -26,6 +26,7 @@ struct RunOptions {
     std::string out_dir;        ///< OUT; created if missing
     std::size_t max_frames = 0; ///< stop after N frames; 0 = all (a camera: until stop or end)
     bool ply = false;           ///< also OUT/<frame>/cloud.ply
+    bool overlay = false;       ///< also OUT/<frame>/overlay.png (FrameOutputs::overlay)
     /// Follow the object under pixel (u, v) of the first frame: selected.png (its cluster),
     /// selected_object.png (its object) and "selected" in objects.json.
     std::optional<std::pair<int, int>> select;
@@ -41,6 +42,7 @@ struct RunFrame {
     const RgbdFrame& frame;    ///< the (registered) input frame
     const FrameResult& result;
     const Mask* selected;      ///< the followed cluster's mask, or nullptr
+    int selected_object;       ///< the followed object's track id this frame, 0 none
     double fps;                ///< the pipeline's rate so far (median frame time)
 };
 

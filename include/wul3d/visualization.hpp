@@ -1,11 +1,16 @@
 #pragma once
 /// @file visualization.hpp
-/// Step 8 of the paper: colour each point by its weights, C_p = sum_j C_j mu_pj (eq. 9).
+/// Step 8 of the paper: colour each point by its weights, C_p = sum_j C_j mu_pj (eq. 9);
+/// and the pictures of objects (objects.hpp): tinted, outlined and numbered over the colour
+/// image (`wul3d run --overlay`, the viewer's and the video's objects panels).
 #include <array>
 #include <cstdint>
+#include <vector>
 
+#include "wul3d/camera.hpp"
 #include "wul3d/clustering.hpp"
 #include "wul3d/frame.hpp"
+#include "wul3d/objects.hpp"
 
 namespace wul3d {
 
@@ -28,5 +33,30 @@ inline std::uint8_t dimmed_grey(const std::uint8_t* rgb) {
     const float grey = 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2];
     return static_cast<std::uint8_t>(grey * 0.35f);
 }
+
+/// The display colour of the object with track id `track_id` (>= 1): fixed for the id, so an
+/// object keeps its colour while it is tracked; golden-ratio hues, bright and saturated so
+/// that a white outline and white text stay readable next to it.
+std::array<std::uint8_t, 3> object_color(int track_id);
+
+/// How render_object_overlay draws.
+struct OverlayStyle {
+    float tint = 0.55f;        ///< share of the object's colour in its pixels; [0, 1]
+    bool outline = true;       ///< white outline on each object's border pixels
+    bool ids = true;           ///< the track id, white on a dark tag, at the object's 2D box
+    bool boxes = false;        ///< the oriented 3D box (DetectedObject::obb_*) projected
+    int selected = 0;          ///< a track id drawn as selected: the other pixels darkened
+                               ///< to a quarter; 0 none
+};
+
+/// Objects over a picture: each pixel of object i (objects.labels == track id) takes
+/// (1 - tint) of `base` and tint of object_color(i); border pixels (a 4-neighbour with another
+/// label) white; then the ids and boxes of `list`. `base` (the frame's colour, usually) and
+/// `objects` must have the same size, and `intrinsics` their pixels (used for the boxes);
+/// throws ParamError otherwise. Pixels of no object keep `base`.
+void render_object_overlay(const ColorImage& base, const LabelImage& objects,
+                           const std::vector<DetectedObject>& list,
+                           const PinholeIntrinsics& intrinsics, ColorImage& out,
+                           const OverlayStyle& style = {});
 
 }  // namespace wul3d
