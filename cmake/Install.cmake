@@ -4,7 +4,7 @@
 # and its config and version files under lib/cmake/wul3d/, and the command with its video
 # plugin in bin/ (the command looks for the plugin beside itself).
 #
-# The library is static by default (-DBUILD_SHARED_LIBS=ON makes it shared). A static
+# The library is static by default (-DBUILD_SHARED_LIBS=ON makes it shared: untested). A static
 # library's private dependencies (OpenCV core/imgproc, libpng, libjpeg, threads, the camera
 # backends) are still needed when the consumer links, so wul3dConfig.cmake finds them again;
 # a shared library needs only its public one, OpenMP.
