@@ -11,6 +11,7 @@
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/stop.hpp"
 
 namespace wul3d {
 
@@ -450,6 +451,7 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
         double potential = 0;
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
+            if (stop_requested()) break;  // thrown below, outside the parallel region
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
             // Inactive points may come along: f_ is 0 there, which Lower and Potential
             // keep (f >= 0) and Set writes.
@@ -472,6 +474,7 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
         }
         chunk_potential[ch] = potential;
     }
+    throw_if_stop_requested("the clustering's seeding");
     double total = 0;
     for (double p : chunk_potential) total += p;
     return total;
@@ -540,7 +543,10 @@ void ClusterState::seed_kmeanspp(const Grid& grid) {
         nth_active(grid, std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_));
     set_centre(0, grid, first);
     f_to_point(grid, first, FToPoint::Set);
-    for (int j = 1; j < params_.k; ++j) add_centre(j, grid);
+    for (int j = 1; j < params_.k; ++j) {
+        throw_if_stop_requested("the clustering's seeding");
+        add_centre(j, grid);
+    }
 }
 
 void ClusterState::assign(const Grid& grid) {
@@ -562,6 +568,8 @@ void ClusterState::assign(const Grid& grid) {
         double* sums = chunk_sums_.data() + static_cast<std::size_t>(ch) * k * kSums;
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
+            // A block is 256 points against every centre: some 0.1 s at k = 65535.
+            if (stop_requested()) break;  // thrown below, outside the parallel region
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
             const PointView pts = grid.points(g0, g1, pb);
             assign_block(view, pts, winner, f);
@@ -589,6 +597,7 @@ void ClusterState::assign(const Grid& grid) {
             }
         }
     }
+    throw_if_stop_requested("the clustering");
 }
 
 double ClusterState::move_centres() {
@@ -626,6 +635,7 @@ int ClusterState::reseed_empty(const Grid& grid) {
     int reseeded = 0;
     for (int j = 0; j < params_.k; ++j) {
         if (centres_.count[j] != 0 || n_ == 0) continue;
+        throw_if_stop_requested("the clustering's re-seeding");
         add_centre(j, grid);
         ++reseeded;
     }

@@ -9,6 +9,7 @@
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/stop.hpp"
 
 namespace wul3d {
 
@@ -83,6 +84,9 @@ const FrameResult& Pipeline::process(const RawRgbdFrame& raw, const StereoCalibr
 const FrameResult& Pipeline::run_stages(const RgbdFrame& frame, double registration_ms) {
     if (frame.width() <= 0 || frame.height() <= 0 || frame.depth.empty())
         throw InputError(frame.name + ": empty depth image");
+    // Readers check the intrinsics they read; this also covers cameras and callers' frames.
+    frame.intrinsics.validate(frame.name);
+    throw_if_stop_requested("the frame's start");
     const int n = params_.decimation;
     if (n == 1) {
         run_on(frame, result_);
@@ -108,10 +112,12 @@ void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
     const std::size_t valid = back_project(frame, cloud_);
     r.times.backprojection = ms_since(t);
     if (valid == 0) throw InputError(frame.name + ": depth has no valid pixel (all zero)");
+    throw_if_stop_requested("the back-projection");
 
     t = Clock::now();
     estimate_normals(params.normals, cloud_, normals_);
     r.times.normals = ms_since(t);
+    throw_if_stop_requested("the normals");
 
     t = Clock::now();
     r.active_points = select_depth_range(params.range, cloud_, r.active);
@@ -160,6 +166,7 @@ void Pipeline::run_on(const RgbdFrame& frame, FrameResult& r) {
         plane_and_segments(frame, r);
     }
     const double both_ms = ms_since(t);
+    throw_if_stop_requested("the segmentation");
     if (may_overlap) side_by_side_.record(side_by_side, both_ms);
     if (side_by_side)
         r.times.overlap = std::max(0.0, r.times.clustering + r.times.colors + r.times.plane +
@@ -211,6 +218,7 @@ void Pipeline::plane_and_segments(const RgbdFrame& frame, FrameResult& r) {
         r.plane.kept = r.active_points;
     }
     r.times.plane = ms_since(t);
+    throw_if_stop_requested("the plane removal");
 
     t = Clock::now();
     r.segment_stats = segment_objects(params.segmentation, cloud_, normals_, r.plane_classes,

@@ -197,10 +197,16 @@ void run(const RunOptions& o) {
         }
         if (!feed.next_frame(item, stopped_by, lost)) break;
         const std::string name = feed.name();
-        const FrameResult& r = item.is_raw
-                                   ? pipeline.process(item.raw, *feed.calibration(),
-                                                      source_options.registration)
-                                   : pipeline.process(item.frame);
+        const FrameResult* result = nullptr;
+        try {
+            result = item.is_raw ? &pipeline.process(item.raw, *feed.calibration(),
+                                                     source_options.registration)
+                                 : &pipeline.process(item.frame);
+        } catch (const Stopped&) {  // SIGINT/SIGTERM mid-frame: this frame is not written
+            stopped_by = "signal";
+            break;
+        }
+        const FrameResult& r = *result;
         const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
         if (!frame.has_color() && !said_depth_only) {
             std::cerr << "wul3d: note: " << name

@@ -109,7 +109,8 @@ class Pipeline {
 public:
     explicit Pipeline(const PipelineParams& params);  ///< validates params
 
-    /// Runs every stage on a registered frame.
+    /// Runs every stage on a registered frame. Throws Stopped when a stop is requested
+    /// (stop.hpp) during the frame; the Pipeline is then not to be used again.
     const FrameResult& process(const RgbdFrame& frame);
     /// Registers a raw two-camera frame first (timed as "registration").
     const FrameResult& process(const RawRgbdFrame& raw, const StereoCalibration& calib,
