@@ -5,6 +5,7 @@
 
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/output.hpp"
 
 namespace wul3d {
 namespace fs = std::filesystem;
@@ -20,16 +21,8 @@ void write_intrinsics_json(const std::string& path, const PinholeIntrinsics& K,
 }
 
 void write_frame_folder(const std::string& dir, const RgbdFrame& frame) {
-    const fs::path final_dir(dir);
-    std::string tmp_name = final_dir.filename().string();
-    tmp_name.insert(0, 1, '.');
-    tmp_name.append(".partial");
-    const fs::path tmp_dir = final_dir.parent_path() / tmp_name;
-    std::error_code ec;
-    fs::remove_all(tmp_dir, ec);
-    fs::create_directories(tmp_dir, ec);
-    if (ec) throw IoError(tmp_dir.string() + ": cannot create folder: " + ec.message());
-    try {
+    write_folder_atomic(dir, [&](const std::string& tmp) {
+        const fs::path tmp_dir(tmp);
         write_depth_png((tmp_dir / "depth.png").string(), frame.depth);
         if (frame.has_color()) write_color_png((tmp_dir / "color.png").string(), frame.color);
         PinholeIntrinsics K = frame.intrinsics;
@@ -37,12 +30,7 @@ void write_frame_folder(const std::string& dir, const RgbdFrame& frame) {
         K.height = frame.depth.height;
         write_intrinsics_json((tmp_dir / "intrinsics.json").string(), K,
                               frame.depth.scale_m_per_unit);
-        fs::remove_all(final_dir, ec);
-        fs::rename(tmp_dir, final_dir);
-    } catch (...) {
-        fs::remove_all(tmp_dir, ec);
-        throw;
-    }
+    });
 }
 
 }  // namespace wul3d

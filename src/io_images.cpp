@@ -1,7 +1,7 @@
 // Single-file readers and the atomic writers of io.hpp.
 #include <fcntl.h>
-#include <sys/stat.h>
 #include <png.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -26,6 +26,7 @@
 #include "io_detail.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/output.hpp"
 
 namespace wul3d {
 
@@ -502,35 +503,6 @@ void decode_or_clear(Image& image, Data& data, Decode&& decode) {
 }
 
 // ---- writing ------------------------------------------------------------------------
-
-std::string errno_text() { return std::strerror(errno); }
-
-/// Writes `path` through `<path>.tmp-<pid>` and a rename, so a failure never leaves a
-/// partial file under the final name. IoError names the path.
-void write_file_atomic(const std::string& path, const void* data, std::size_t size) {
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) throw IoError(path + ": cannot write (" + errno_text() + ")");
-    auto fail = [&](const std::string& why) {
-        ::unlink(tmp.c_str());
-        throw IoError(path + ": cannot write (" + why + ")");
-    };
-    const char* p = static_cast<const char*>(data);
-    std::size_t left = size;
-    while (left > 0) {
-        const ssize_t n = ::write(fd, p, left);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            const std::string why = n < 0 ? errno_text() : "short write";
-            ::close(fd);
-            fail(why);
-        }
-        p += n;
-        left -= static_cast<std::size_t>(n);
-    }
-    if (::close(fd) != 0) fail(errno_text());
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno_text());
-}
 
 /// libpng's output: a growing buffer, and whether growing it failed.
 struct PngOutput {

@@ -1,17 +1,9 @@
 #pragma once
-// Where `run`, `record` and `view` take their frames from: a recording (FrameSource, one
-// frame after the other) or a live camera (LiveSource: its own capture thread, newest frame
-// wins). Also the stop request of SIGINT/SIGTERM, so that a stopped run still finalizes its
-// outputs.
-#include <chrono>
-#include <cstdint>
-#include <exception>
-#include <memory>
-#include <string>
-
+// The CLI's side of the frame feed (wul3d/feed.hpp): the stop request of SIGINT/SIGTERM,
+// so that a stopped run still finalizes its outputs, and the feed options of the shared
+// command-line options.
 #include "pipeline_options.hpp"
-#include "wul3d/capture.hpp"
-#include "wul3d/io.hpp"
+#include "wul3d/feed.hpp"
 
 namespace wul3d::cli {
 
@@ -22,48 +14,7 @@ bool stop_requested();
 /// Puts the default handlers back.
 void restore_signals();
 
-class FrameFeed {
-public:
-    enum class Status {
-        Frame,   ///< `item` holds the next frame, named `name()`
-        End,     ///< the recording or the replay ended
-        Stopped, ///< SIGINT/SIGTERM
-    };
-
-    /// From `o.camera` when given (live), else `o.input` with `source` (recording).
-    FrameFeed(const PipelineOptions& o, const SourceOptions& source);
-
-    /// Blocks until the next frame, the end, or a stop request (polled every 100 ms).
-    /// Throws DeviceLost when the camera disappears, InputError for a damaged recording.
-    Status next(SourceItem& item);
-    /// The loop step `run` and `record` share: next() and what ended the feed. True with a
-    /// frame in `item`; false at the end ("end" stays in `stopped_by`), on SIGINT/SIGTERM
-    /// ("signal") or when the camera is lost ("device_lost", the DeviceLost kept in `lost`
-    /// to be rethrown once the outputs are final).
-    bool next_frame(SourceItem& item, std::string& stopped_by, std::exception_ptr& lost);
-    /// Waits at most `timeout` (live: newest frame; recording: reads the next one).
-    /// Returns Frame, End, Stopped, or, live only, no frame yet: `false` in `got`.
-    Status poll(SourceItem& item, std::chrono::milliseconds timeout, bool& got);
-
-    bool live() const { return live_ != nullptr; }
-    const std::string& name() const { return name_; }  ///< name of the last frame
-    const StereoCalibration* calibration() const;
-    /// Recording: its frame count; live: 0 (unknown).
-    std::size_t size() const { return source_ ? source_->size() : 0; }
-    /// "recording" formats (frames, tum, unregistered) or "camera".
-    std::string format() const;
-    std::string description() const;  ///< camera description or input path
-    std::uint64_t captured() const { return live_ ? live_->captured() : index_; }
-    std::uint64_t dropped() const { return live_ ? live_->dropped() : 0; }
-    /// Random access for `view` (recordings only).
-    FrameSource* source() { return source_.get(); }
-
-private:
-    std::unique_ptr<FrameSource> source_;
-    std::unique_ptr<LiveSource> live_;
-    std::string input_;
-    std::size_t index_ = 0;
-    std::string name_;
-};
+/// The input (or --camera, --lossless) of `o`, read with `source`.
+FeedOptions feed_options(const PipelineOptions& o, const SourceOptions& source);
 
 }  // namespace wul3d::cli

@@ -30,7 +30,7 @@ struct RecordOptions {
 void record(const RecordOptions& o) {
     if (o.input.camera.empty()) throw ParamError("record: --camera is required");
     install_stop_signals();
-    FrameFeed feed(o.input, SourceOptions{});
+    FrameFeed feed(feed_options(o.input, SourceOptions{}), stop_requested);
     std::error_code ec;
     fs::create_directories(o.out_dir, ec);
     if (ec || !fs::is_directory(o.out_dir))

@@ -1,0 +1,51 @@
+#pragma once
+/// @file output.hpp
+/// What `wul3d run` writes for one frame, as library calls an embedding program can make:
+/// the frame folder OUT/<frame>/ (labels.png, colors.png, objects.png, objects.json, and on
+/// request selected.png, selected_object.png, cloud.ply), the objects.json schema, and the
+/// one atomic-write helper every writer of wul3d goes through (README, "Outputs").
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "wul3d/frame.hpp"
+#include "wul3d/pipeline.hpp"
+
+namespace wul3d {
+
+/// Writes `size` bytes to `path` through `<path>.tmp-<pid>` and a rename, so a failure never
+/// leaves a partial file under the final name. Throws IoError naming the path.
+void write_file_atomic(const std::string& path, const void* data, std::size_t size);
+
+/// Makes the folder `dir` complete or not at all: `fill` writes into the hidden sibling
+/// `.<name>.partial` (created empty), which is then renamed to `dir`, replacing any folder
+/// of that name. If `fill` throws, the partial folder is removed and the exception goes on.
+void write_folder_atomic(const std::string& dir,
+                         const std::function<void(const std::string& tmp_dir)>& fill);
+
+/// objects.json of one frame: every object with its boxes, colour and sources, and the
+/// support plane (null when none was found). `selected_id` != 0 adds "selected" to every
+/// object (true for the object with that id). Ends with a newline.
+std::string objects_json(const FrameResult& result, int selected_id = 0);
+
+/// What write_frame writes beyond the four images and objects.json.
+struct FrameOutputs {
+    /// selected.png: the followed cluster's mask (255 = in it), or nullptr for none.
+    const std::vector<std::uint8_t>* selected = nullptr;
+    /// selected_object.png: the followed object's mask, or nullptr for none.
+    const std::vector<std::uint8_t>* selected_object = nullptr;
+    int selected_id = 0;  ///< objects.json's "selected" (see objects_json)
+    bool ply = false;     ///< cloud.ply: the labelled points, binary PLY
+};
+
+/// Writes one frame's outputs to OUT/<name>/ atomically (write_folder_atomic): labels.png,
+/// colors.png, objects.png, objects.json and what `extra` asks for. `frame` is the frame
+/// `result` came from (registered); `pipeline` the one that processed it (its cloud is
+/// reused for cloud.ply when it has the frame's size). Throws IoError.
+void write_frame(const std::string& out_dir, const std::string& name, const Pipeline& pipeline,
+                 const RgbdFrame& frame, const FrameResult& result,
+                 const FrameOutputs& extra = {});
+
+}  // namespace wul3d

@@ -1,0 +1,80 @@
+#pragma once
+/// @file run.hpp
+/// A whole run, as `wul3d run` does it: every frame of a recording or a live camera through
+/// the pipeline, each frame's outputs written to OUT/<frame>/ (output.hpp) and, at the end,
+/// OUT/summary.json. A RunObserver hears of each frame (for a progress bar or a video);
+/// the outputs are the same whoever calls (README, "Outputs"; docs/LIBRARY.md).
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "wul3d/feed.hpp"
+#include "wul3d/pipeline.hpp"
+
+namespace wul3d {
+
+struct RunOptions {
+    FeedOptions feed;           ///< the recording or camera
+    PipelineParams params;      ///< validated by the Pipeline
+    /// The preset `params` came from, for summary.json ("" is written as "default").
+    std::string preset;
+    std::string out_dir;        ///< OUT; created if missing
+    std::size_t max_frames = 0; ///< stop after N frames; 0 = all (a camera: until stop or end)
+    bool ply = false;           ///< also OUT/<frame>/cloud.ply
+    /// Follow the object under pixel (u, v) of the first frame: selected.png (its cluster),
+    /// selected_object.png (its object) and "selected" in objects.json.
+    std::optional<std::pair<int, int>> select;
+    /// Polled between frames: true ends the run as "signal" (outputs still complete).
+    std::function<bool()> stop;
+};
+
+/// One processed frame, as the observer sees it (valid during the call only).
+struct RunFrame {
+    const std::string& name;   ///< OUT/<name>/, already written
+    std::size_t index;         ///< from 0
+    std::size_t total;         ///< frames this run will process; 0 = unknown (a camera)
+    const RgbdFrame& frame;    ///< the (registered) input frame
+    const FrameResult& result;
+    const std::vector<std::uint8_t>* selected;  ///< the followed cluster's mask, or nullptr
+    double fps;                ///< the pipeline's rate so far (median frame time)
+};
+
+/// What a run did; also in summary.json.
+struct RunSummary {
+    std::size_t frames = 0;
+    /// "end", "frames" (max_frames reached), "signal" (stop), "device_lost".
+    std::string stopped_by = "end";
+    double ms_per_frame_median = 0;  ///< the pipeline's time, no disk I/O
+    double fps = 0;
+    double wall_s = 0;
+    double peak_rss_mb = 0;
+};
+
+/// Hears of a run's progress; every method defaults to nothing. Called on the caller's
+/// thread.
+class RunObserver {
+public:
+    virtual ~RunObserver() = default;
+    /// The input is open, OUT exists, the pipeline is built; `total` as in RunFrame.
+    virtual void started(std::size_t total) { (void)total; }
+    /// A remark for the user, one line (e.g. a frame without colour).
+    virtual void note(const std::string& text) { (void)text; }
+    virtual void frame(const RunFrame& f) { (void)f; }
+    /// No more frames will come; summary.json is not written yet.
+    virtual void frames_done() {}
+    /// summary.json is written. A lost camera is thrown after this.
+    virtual void finished(const RunSummary& summary) { (void)summary; }
+};
+
+/// Runs `options.feed` through a Pipeline into `options.out_dir` exactly as `wul3d run`.
+/// Throws ParamError, InputError (unreadable input; a camera that ended before its first
+/// frame), IoError; DeviceLost when the camera disappears, after the outputs of the frames
+/// before are final and summary.json is written.
+RunSummary run_sequence(const RunOptions& options, RunObserver* observer = nullptr);
+
+}  // namespace wul3d

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Compares what two wul3d binaries write with `wul3d run` on the same inputs: every output
+# file byte for byte (cmp), summary.json on every key but the timings. Used to show that a
+# restructuring changed no output.
+#   scripts/compare-run-outputs.sh OLD_WUL3D NEW_WUL3D [WORKDIR]
+# Inputs: the shipped samples (with --select and --ply once), and ../shared/data's osd_mosd
+# (first 10 frames) and osd_moving/slide_learn38 when present.
+set -euo pipefail
+old=$1 new=$2
+work=${3:-$(mktemp -d)}
+root=$(cd "$(dirname "$0")/.." && pwd)
+shared=$root/../shared/data
+cases=(
+  "uois|$root/data/samples/uois_tabletop|"
+  "uois_sel|$root/data/samples/uois_tabletop|--select 320,240 --ply"
+  "pcl|$root/data/samples/pcl_kinect|"
+  "pcl_paper|$root/data/samples/pcl_kinect|--preset paper"
+)
+[[ -d $shared/osd_mosd ]] && cases+=("mosd|$shared/osd_mosd|--frames 10")
+[[ -d $shared/osd_moving/slide_learn38 ]] && cases+=("slide|$shared/osd_moving/slide_learn38|")
+status=0
+for c in "${cases[@]}"; do
+  IFS='|' read -r name input args <<<"$c"
+  rm -rf "$work/$name"
+  # shellcheck disable=SC2086
+  "$old" run "$input" -o "$work/$name/old" -q $args >/dev/null
+  # shellcheck disable=SC2086
+  "$new" run "$input" -o "$work/$name/new" -q $args >/dev/null
+  ok=1
+  diff -r -q -x summary.json "$work/$name/old" "$work/$name/new" || ok=0
+  python3 - "$work/$name/old/summary.json" "$work/$name/new/summary.json" <<'PY' || ok=0
+import json, sys
+timing = {"stage_ms_median", "ms_per_frame_median", "fps", "wall_s", "peak_rss_mb"}
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+for s in (a, b):
+    for k in timing: s.pop(k, None)
+    for f in s.get("per_frame", []): f.pop("ms", None)
+sys.exit(0 if a == b else f"summary.json differs beyond timings: {sys.argv[1]}")
+PY
+  if [[ $ok == 0 ]]; then status=1; echo "$name: DIFFERS"; continue; fi
+  echo "$name: $(find "$work/$name/new" -type f | wc -l) files identical (summary.json: but timings)"
+done
+[[ -z ${3:-} ]] && rm -rf "$work"
+exit $status

@@ -1,0 +1,157 @@
+// The library's run loop (run.hpp) and output helpers (output.hpp) on the shipped samples:
+// what run_sequence writes, what its observer hears, a stop request, and that `wul3d run`
+// writes the same bytes as the library call.
+#include "wul3d/run.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "test_support.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/output.hpp"
+
+namespace wul3d {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+RunOptions sample_run(const fs::path& out) {
+    RunOptions o;
+    o.feed.input = (test::sample_dir() / "uois_tabletop").string();
+    o.out_dir = out.string();
+    return o;
+}
+
+struct Recorder : RunObserver {
+    std::size_t total = 99;
+    std::vector<std::string> names;
+    std::vector<std::size_t> indices;
+    bool done = false, finished_after_done = false;
+    void started(std::size_t t) override { total = t; }
+    void frame(const RunFrame& f) override {
+        names.push_back(f.name);
+        indices.push_back(f.index);
+        EXPECT_EQ(f.result.labels.width, f.frame.depth.width);
+        EXPECT_GT(f.fps, 0.0);
+        EXPECT_TRUE(fs::is_directory(fs::path(out) / f.name)) << "written before the call";
+    }
+    void frames_done() override { done = true; }
+    void finished(const RunSummary&) override {
+        finished_after_done = done && fs::exists(fs::path(out) / "summary.json");
+    }
+    std::string out;
+};
+
+TEST(RunSequence, WritesEveryFrameAndTheSummary_ObserverHearsEach) {
+    TempDir dir;
+    RunOptions o = sample_run(dir / "out");
+    Recorder rec;
+    rec.out = o.out_dir;
+    const RunSummary s = run_sequence(o, &rec);
+    std::size_t n = 0;  // the frame folders of the sample
+    for (const auto& e : fs::directory_iterator(test::sample_dir() / "uois_tabletop"))
+        n += fs::exists(e.path() / "depth.png");
+    EXPECT_EQ(s.frames, rec.names.size());
+    EXPECT_EQ(rec.total, s.frames);
+    EXPECT_EQ(s.frames, n);
+    EXPECT_GE(n, 2u);
+    EXPECT_EQ(s.stopped_by, "end");
+    EXPECT_TRUE(rec.finished_after_done);
+    for (std::size_t i = 0; i < rec.names.size(); ++i) {
+        EXPECT_EQ(rec.indices[i], i);
+        for (const char* f : {"labels.png", "colors.png", "objects.png", "objects.json"})
+            EXPECT_TRUE(fs::exists(dir / "out" / rec.names[i] / f)) << rec.names[i] << "/" << f;
+    }
+    const auto summary = nlohmann::json::parse(slurp(dir / "out" / "summary.json"));
+    EXPECT_EQ(summary["frames"].get<std::size_t>(), s.frames);
+    EXPECT_EQ(summary["per_frame"].size(), s.frames);
+    EXPECT_EQ(summary["parameters"]["preset"], "default");
+    EXPECT_EQ(summary["input"], o.feed.input);
+}
+
+TEST(RunSequence, MaxFramesAndStopEndTheRun) {
+    TempDir dir;
+    RunOptions o = sample_run(dir / "a");
+    o.max_frames = 1;
+    EXPECT_EQ(run_sequence(o).stopped_by, "frames");
+    EXPECT_EQ(test::list_files(dir / "a").size(), 5u);  // 4 files of one frame + summary.json
+
+    RunOptions stop = sample_run(dir / "b");
+    int polls = 0;
+    stop.stop = [&polls] { return ++polls > 1; };  // after the first frame
+    const RunSummary s = run_sequence(stop);
+    EXPECT_EQ(s.stopped_by, "signal");
+    EXPECT_EQ(s.frames, 1u);
+}
+
+TEST(RunSequence, SameBytesAsTheCommand) {
+    TempDir dir;
+    RunOptions o = sample_run(dir / "lib");
+    o.select = std::make_pair(320, 240);
+    run_sequence(o);
+    const auto cli = test::run_cli({"run", o.feed.input, "-o", (dir / "cli").string(), "-q",
+                                    "--select", "320,240"});
+    ASSERT_EQ(cli.exit_code, 0) << cli.err;
+    const auto files = test::list_files(dir / "lib");
+    ASSERT_EQ(files, test::list_files(dir / "cli"));
+    for (const std::string& f : files) {
+        if (f == "summary.json") continue;  // timings differ
+        EXPECT_EQ(slurp(dir / "lib" / f), slurp(dir / "cli" / f)) << f;
+    }
+}
+
+TEST(RunSequence, BadInputIsAnInputError_NoOutputFolder) {
+    TempDir dir;
+    RunOptions o = sample_run(dir / "out");
+    o.feed.input = (dir / "missing").string();
+    EXPECT_THROW(run_sequence(o), InputError);
+    EXPECT_FALSE(fs::exists(dir / "out"));
+    o.feed.camera = "freenect";
+    EXPECT_THROW(run_sequence(o), ParamError);  // both an input and a camera
+}
+
+TEST(WriteFolderAtomic, CompleteOrAbsent) {
+    TempDir dir;
+    const std::string target = (dir / "frame").string();
+    write_folder_atomic(target, [](const std::string& tmp) {
+        write_text_file(tmp + "/a.txt", "one\n");
+    });
+    EXPECT_EQ(slurp(dir / "frame" / "a.txt"), "one\n");
+    EXPECT_THROW(write_folder_atomic(target,
+                                     [](const std::string& tmp) {
+                                         write_text_file(tmp + "/b.txt", "two\n");
+                                         throw IoError("disk full");
+                                     }),
+                 IoError);
+    // The old folder stays as it was and no partial folder is left.
+    EXPECT_EQ(test::list_files(dir.path()), std::vector<std::string>{"frame/a.txt"});
+    write_folder_atomic(target, [](const std::string& tmp) {
+        write_text_file(tmp + "/b.txt", "two\n");
+    });
+    EXPECT_EQ(test::list_files(dir.path()), std::vector<std::string>{"frame/b.txt"});
+}
+
+TEST(WriteFileAtomic, UnwritablePathIsAnIoErrorNamingIt) {
+    TempDir dir;
+    const std::string path = (dir / "no" / "such" / "file.bin").string();
+    try {
+        write_file_atomic(path, "x", 1);
+        FAIL() << "no error";
+    } catch (const IoError& e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(test::list_files(dir.path()).empty());
+}
+
+}  // namespace
+}  // namespace wul3d
