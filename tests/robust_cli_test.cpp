@@ -16,6 +16,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <utility>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -242,6 +245,75 @@ TEST(RobustCli, BenchFailureIsOneLineWithTheChildsExitCode) {
     expect_one_line(r, 2, {"70000", "k = 70000"});
 }
 
+
+// ---- outputs never touch inputs or foreign files ------------------------------------------------
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(RobustCli, OutThatIsOrHoldsTheInputIsRefused) {
+    TempDir tmp;
+    const fs::path seq = tmp / "x";
+    copy_frame(tabletop_frame(), seq / "image_0000");
+    const std::string depth = slurp(seq / "image_0000" / "depth.png");
+    // The case: the recording as its own output; the parent of a single frame
+    // folder; an output folder inside the recording.
+    for (const auto& [in, out] : std::vector<std::pair<fs::path, fs::path>>{
+             {seq, seq}, {seq / "image_0000", seq}, {seq, seq / "image_0000" / "out"}}) {
+        const CommandResult r = run_bounded({"run", in.string(), "--out", out.string(), "-q"});
+        expect_one_line(r, 2, {"output folder", "input"});
+    }
+    EXPECT_EQ(slurp(seq / "image_0000" / "depth.png"), depth);
+    EXPECT_EQ(wul3d::test::list_files(seq).size(), 3u);  // color, depth, intrinsics only
+}
+
+TEST(RobustCli, ForeignOutputFolderIsRefusedUnlessOverwrite) {
+    TempDir tmp;
+    const fs::path out = tmp / "out";
+    fs::create_directories(out / "image_0000");
+    write_text(out / "image_0000" / "notes.txt", "the user's\n");
+    CommandResult r = run_bounded({"run", tabletop_frame().string(), "--out", out.string(), "-q"});
+    expect_one_line(r, 2, {"notes.txt", "--overwrite"});
+    r = run_bounded({"run", tabletop_frame().string(), "--out", out.string(), "-q", "--overwrite"});
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_EQ(slurp(out / "image_0000" / "notes.txt"), "the user's\n");
+    EXPECT_TRUE(fs::is_regular_file(out / "image_0000" / "labels.png"));
+}
+
+TEST(RobustCli, LongAndReservedFrameNames) {
+    TempDir tmp;
+    const std::string long_name(250, 'f');
+    copy_frame(tabletop_frame(), tmp / "seq" / long_name);
+    CommandResult r = run_bounded({"run", (tmp / "seq").string(), "--out", (tmp / "out").string(), "-q"});
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_TRUE(fs::is_regular_file(tmp / "out" / long_name / "objects.json"));
+
+    copy_frame(tabletop_frame(), tmp / "seq2" / "summary.json");
+    r = run_bounded({"run", (tmp / "seq2").string(), "--out", (tmp / "out2").string(), "-q"});
+    expect_one_line(r, 2, {"summary.json"});
+    EXPECT_FALSE(fs::exists(tmp / "out2"));  // refused before anything was written
+}
+
+TEST(RobustCli, FullDiskEndsWithExit1AndASummary) {
+    // A file size limit (ulimit -f, SIGXFSZ ignored) fails writes as a full disk does: EFBIG.
+    TempDir tmp;
+    const fs::path out = tmp / "out";
+    const std::string cmd = "trap '' XFSZ; ulimit -f 40; exec timeout 60 '" +
+                            wul3d::test::cli_path().string() + "' run '" +
+                            (sample_dir() / "uois_tabletop").string() + "' --out '" + out.string() +
+                            "' -q";
+    const CommandResult r = run_command({"sh", "-c", cmd});
+    expect_one_line(r, 1, {"cannot write"});
+    std::ifstream in(out / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    EXPECT_EQ(summary["stopped_by"], "error");
+    EXPECT_NE(summary["error"].get<std::string>().find("cannot write"), std::string::npos);
+    for (const auto& f : wul3d::test::list_files(out))
+        EXPECT_EQ(f.find(".tmp"), std::string::npos) << "temporary file left behind: " << f;
+}
+
 // ---- stop requests reach the computation --------------------------------------------------------
 
 TEST(RobustCli, SigtermStopsAFrameOfMinutesWithinSeconds) {
@@ -281,7 +353,10 @@ TEST(RobustCli, SigtermStopsAFrameOfMinutesWithinSeconds) {
     }
     ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << WTERMSIG(status);
     EXPECT_EQ(WEXITSTATUS(status), 0);
-    EXPECT_TRUE(fs::is_regular_file(out / "summary.json"));
+    std::ifstream in(out / "summary.json");
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    EXPECT_EQ(summary["stopped_by"], "signal");
+    EXPECT_EQ(summary["frames"], 0);
     EXPECT_FALSE(fs::exists(out / "image_0000"));  // the stopped frame is not written
 }
 

@@ -26,6 +26,7 @@ struct RunCommandOptions {
     std::size_t max_frames = 0;  // 0 = all
     bool ply = false;
     bool quiet = false;
+    bool overwrite = false;
 };
 
 /// A one-line progress bar on stderr, only when stderr is a terminal.
@@ -105,6 +106,7 @@ void run(const RunCommandOptions& o) {
     r.out_dir = o.out_dir;
     r.max_frames = o.max_frames;
     r.ply = o.ply;
+    r.overwrite = o.overwrite;
     r.stop = stop_requested;
     apply_threads(o.pipeline);
 
@@ -133,6 +135,9 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("--video", opts->video,
                     "Also write a video: colour | clusters | selected object (e.g. out.mp4)");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
+    cmd->add_flag("--overwrite", opts->overwrite,
+                  "Write into an output folder that holds other files too (only wul3d's own "
+                  "files there are replaced)");
     cmd->callback([opts]() { run(*opts); });
 }
 
