@@ -286,7 +286,6 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
                     : (o.max_frames ? std::min(o.max_frames, feed.size()) : feed.size());
     prepare_out_dir(o.out_dir, o.overwrite);
     const fs::path out_dir(o.out_dir);
-    FramesLog frames_log((out_dir / kFramesFile).string());
 
     Pipeline pipeline(o.params);
     Selection selection(o.select);
@@ -295,7 +294,8 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     bool said_depth_only = false;
     using Clock = std::chrono::steady_clock;
     const auto run_start = Clock::now();
-    obs.started(n_total);
+    obs.started(n_total);  // may refuse the run (a video writer that cannot start)
+    FramesLog frames_log((out_dir / kFramesFile).string());
 
     RunSummary s;
     std::exception_ptr lost;    // DeviceLost: rethrown once the outputs are final
