@@ -21,6 +21,9 @@
 #   libfreenect-dev libopenni2-dev                 live cameras: Kinect v1 (libfreenect), OpenNI2 devices
 #                                                  and .oni files; each backend built only when found
 #   libfreenect-bin                                fakenect: the capture tests replay a Kinect v1 dump
+#   clang libclang-rt-14-dev libomp-14-dev         the fuzzers (fuzz/, .ci/run): clang 14's libFuzzer
+#                                                  (-fsanitize=fuzzer), its sanitizer runtimes, OpenMP
+#   zlib1g-dev                                     tests/robust_cli_test.cpp writes PNG chunks (crc32)
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -51,6 +54,10 @@ packages=(
   libfreenect-dev
   libfreenect-bin
   libopenni2-dev
+  clang
+  libclang-rt-14-dev
+  libomp-14-dev
+  zlib1g-dev
 )
 
 missing=()
