@@ -27,15 +27,22 @@ for c in "${cases[@]}"; do
   # shellcheck disable=SC2086
   "$new" run "$input" -o "$work/$name/new" -q $args >/dev/null
   ok=1
-  diff -r -q -x summary.json "$work/$name/old" "$work/$name/new" || ok=0
-  python3 - "$work/$name/old/summary.json" "$work/$name/new/summary.json" <<'PY' || ok=0
-import json, sys
+  diff -r -q -x summary.json -x frames.jsonl "$work/$name/old" "$work/$name/new" || ok=0
+  python3 - "$work/$name/old" "$work/$name/new" <<'PY' || ok=0
+import json, pathlib, sys
+# Per-frame statistics: summary.json's "per_frame" before issue 24, OUT/frames.jsonl since.
 timing = {"stage_ms_median", "ms_per_frame_median", "fps", "wall_s", "peak_rss_mb"}
-a, b = (json.load(open(p)) for p in sys.argv[1:])
-for s in (a, b):
-    for k in timing: s.pop(k, None)
-    for f in s.get("per_frame", []): f.pop("ms", None)
-sys.exit(0 if a == b else f"summary.json differs beyond timings: {sys.argv[1]}")
+def load(out):
+    s = json.loads((pathlib.Path(out) / "summary.json").read_text())
+    lines = pathlib.Path(out) / "frames.jsonl"
+    frames = s.pop("per_frame", None)
+    if frames is None and lines.exists():
+        frames = [json.loads(l) for l in lines.read_text().splitlines()]
+    for k in timing | {"frames_file", "error"}: s.pop(k, None)
+    for f in frames or []: f.pop("ms", None)
+    return s, frames
+a, b = load(sys.argv[1]), load(sys.argv[2])
+sys.exit(0 if a == b else f"summary.json / frames.jsonl differ beyond timings: {sys.argv[1]}")
 PY
   if [[ $ok == 0 ]]; then status=1; echo "$name: DIFFERS"; continue; fi
   echo "$name: $(find "$work/$name/new" -type f | wc -l) files identical (summary.json: but timings)"

@@ -27,6 +27,9 @@
 #   python3-open3d                                 examples/python/to_open3d.py and its test
 #   python3-dask python3-distributed               batch runs over many sequences (wul3d.batch,
 #                                                  docs/SCALE.md)
+#   clang libclang-rt-14-dev libomp-14-dev         the fuzzers (fuzz/, .ci/run): clang 14's libFuzzer
+#                                                  (-fsanitize=fuzzer), its sanitizer runtimes, OpenMP
+#   zlib1g-dev                                     tests/robust_cli_test.cpp writes PNG chunks (crc32)
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -64,6 +67,10 @@ packages=(
   python3-open3d
   python3-dask
   python3-distributed
+  clang
+  libclang-rt-14-dev
+  libomp-14-dev
+  zlib1g-dev
 )
 
 missing=()

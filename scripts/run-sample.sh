@@ -10,11 +10,11 @@ cmake --build build -j2
 scripts/install-python.sh build || true  # the Python module (docs/PYTHON.md); needs root
 build/wul3d run data/samples/uois_tabletop --out out/sample --overlay
 
-# What was found, from summary.json: objects per frame.
+# What was found, from frames.jsonl (one line of statistics per frame): objects per frame.
 echo
-python3 - out/sample/summary.json <<'PY'
+python3 - out/sample/frames.jsonl <<'PY'
 import json, sys
-frames = json.load(open(sys.argv[1]))["per_frame"]
+frames = [json.loads(line) for line in open(sys.argv[1])]
 total = sum(f["objects"] for f in frames)
 print(f"{len(frames)} frames, {total} objects: " +
       ", ".join(f'{f["name"]}: {f["objects"]} objects' for f in frames))
@@ -27,4 +27,5 @@ echo "  <frame>/objects.png  16-bit object labels (0 = none, else the object's t
 echo "  <frame>/objects.json each object: id, pixels, centroid, 3D boxes, 2D box, colour"
 echo "  <frame>/labels.png   16-bit cluster labels of the paper (0 = no point, 1..k)"
 echo "  <frame>/colors.png   8-bit RGB, each point coloured by its cluster weights (eq. 9)"
-echo "  summary.json         parameters, stage timings, fps, peak memory"
+echo "  summary.json         parameters, how the run ended, stage timings, fps, peak memory"
+echo "  frames.jsonl         one line of statistics per frame"

@@ -8,10 +8,12 @@
 namespace wul3d {
 
 void DepthRange::validate() const {
-    if (!(std::isfinite(zmin_m) && std::isfinite(zmax_m) && zmin_m >= 0 && zmax_m > zmin_m)) {
+    // 1000 m: beyond any depth sensor, and where a float still resolves millimetres.
+    if (!(std::isfinite(zmin_m) && std::isfinite(zmax_m) && zmin_m >= 0 && zmax_m > zmin_m &&
+          zmax_m <= 1000.0f)) {
         std::ostringstream msg;
         msg << "depth range zmin = " << zmin_m << " m, zmax = " << zmax_m
-            << " m: need 0 <= zmin < zmax";
+            << " m: need 0 <= zmin < zmax <= 1000";
         throw ParamError(msg.str());
     }
 }

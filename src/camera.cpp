@@ -1,5 +1,6 @@
 #include "wul3d/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -8,16 +9,39 @@
 
 namespace wul3d {
 
+namespace {
+
+[[noreturn]] void invalid(const std::string& what, const PinholeIntrinsics& K, const char* why) {
+    std::ostringstream msg;
+    msg << what << ": invalid intrinsics (width " << K.width << ", height " << K.height
+        << ", fx " << K.fx << ", fy " << K.fy << ", cx " << K.cx << ", cy " << K.cy << "): " << why;
+    throw ParamError(msg.str());
+}
+
+}  // namespace
+
+void PinholeIntrinsics::validate_unsized(const std::string& what) const {
+    const bool finite = std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy);
+    if (!finite) invalid(what, *this, "every value must be a finite number");
+    if (!(fx >= kMinFocalPx && fy >= kMinFocalPx && fx <= kMaxFocalPx && fy <= kMaxFocalPx))
+        invalid(what, *this, "fx and fy must be in [0.01, 1e8] pixels");
+    if (!(std::abs(cx) <= kMaxFocalPx && std::abs(cy) <= kMaxFocalPx))
+        invalid(what, *this, "cx and cy must be in [-1e8, 1e8] pixels");
+}
+
 void PinholeIntrinsics::validate(const std::string& what) const {
-    const bool ok = width > 0 && height > 0 && std::isfinite(fx) && std::isfinite(fy) &&
-                    std::isfinite(cx) && std::isfinite(cy) && fx > 0 && fy > 0;
-    if (!ok) {
-        std::ostringstream msg;
-        msg << what << ": invalid intrinsics (width " << width << ", height " << height
-            << ", fx " << fx << ", fy " << fy << ", cx " << cx << ", cy " << cy
-            << "): sizes and focal lengths must be positive";
-        throw ParamError(msg.str());
-    }
+    if (!(width > 0 && height > 0 && width <= kMaxSidePx && height <= kMaxSidePx))
+        invalid(what, *this, "width and height must be in [1, 65536]");
+    validate_unsized(what);
+    // A field of view between about 170 and 0.06 degrees: fx = W / (2 tan(fov / 2)).
+    const double w = width, h = height, side = std::max(w, h);
+    if (!(fx >= w / 20 && fy >= h / 20 && fx <= 1000 * side && fy <= 1000 * side))
+        invalid(what, *this,
+                "fx must be in [width / 20, 1000 max(width, height)] and fy in [height / 20, "
+                "1000 max(width, height)] (a field of view of 170 down to 0.06 degrees)");
+    // The principal point lies in the image or at most one image size beyond its edges.
+    if (!(cx >= -w && cx <= 2 * w && cy >= -h && cy <= 2 * h))
+        invalid(what, *this, "cx must be in [-width, 2 width] and cy in [-height, 2 height]");
 }
 
 void FovCamera::back_project(double px, double py, double z, double& x, double& y) const {

@@ -11,6 +11,7 @@
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/stop.hpp"
 
 namespace wul3d {
 
@@ -383,6 +384,25 @@ void ClusterState::reset() {
     rng_.seed(params_.seed);
 }
 
+namespace {
+/// `v` resized to `n` zeros, 8 MB at a time with a stop check between: at k = 65535 the
+/// centre sums are 369 MB, whose one memset takes seconds on a loaded machine.
+void zero_checked(std::vector<double>& v, std::size_t n) {
+    constexpr std::size_t kSlice = std::size_t{1} << 20;
+    if (v.size() > n) v.resize(n);
+    for (std::size_t i = 0; i < v.size(); i += kSlice) {
+        std::fill(v.begin() + static_cast<std::ptrdiff_t>(i),
+                  v.begin() + static_cast<std::ptrdiff_t>(std::min(v.size(), i + kSlice)), 0.0);
+        throw_if_stop_requested("the clustering's allocation");
+    }
+    v.reserve(n);
+    while (v.size() < n) {
+        v.resize(std::min(n, v.size() + kSlice), 0.0);
+        throw_if_stop_requested("the clustering's allocation");
+    }
+}
+}  // namespace
+
 void ClusterState::allocate(int width, int height) {
     width_ = width;
     height_ = height;
@@ -394,7 +414,7 @@ void ClusterState::allocate(int width, int height) {
     grid_label_.assign(grid, 0);
     winner_.assign(grid, kNoWinner);
     f_.assign(grid, 0.0f);
-    chunk_sums_.assign(static_cast<std::size_t>(kChunks) * params_.k * kSums, 0.0);
+    zero_checked(chunk_sums_, static_cast<std::size_t>(kChunks) * params_.k * kSums);
     reset();
 }
 
@@ -450,6 +470,7 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
         double potential = 0;
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
+            if (stop_requested()) break;  // thrown below, outside the parallel region
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
             // Inactive points may come along: f_ is 0 there, which Lower and Potential
             // keep (f >= 0) and Set writes.
@@ -472,6 +493,7 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
         }
         chunk_potential[ch] = potential;
     }
+    throw_if_stop_requested("the clustering's seeding");
     double total = 0;
     for (double p : chunk_potential) total += p;
     return total;
@@ -540,7 +562,10 @@ void ClusterState::seed_kmeanspp(const Grid& grid) {
         nth_active(grid, std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_));
     set_centre(0, grid, first);
     f_to_point(grid, first, FToPoint::Set);
-    for (int j = 1; j < params_.k; ++j) add_centre(j, grid);
+    for (int j = 1; j < params_.k; ++j) {
+        throw_if_stop_requested("the clustering's seeding");
+        add_centre(j, grid);
+    }
 }
 
 void ClusterState::assign(const Grid& grid) {
@@ -553,7 +578,7 @@ void ClusterState::assign(const Grid& grid) {
                           centres_.nx.data(), centres_.ny.data(), centres_.nz.data(),
                           centre_normal_.data(), k, params_.delta * params_.delta,
                           use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
-    std::fill(chunk_sums_.begin(), chunk_sums_.end(), 0.0);
+    zero_checked(chunk_sums_, chunk_sums_.size());
 #pragma omp parallel for schedule(static)
     for (int ch = 0; ch < kChunks; ++ch) {
         PointBlock pb;
@@ -562,6 +587,8 @@ void ClusterState::assign(const Grid& grid) {
         double* sums = chunk_sums_.data() + static_cast<std::size_t>(ch) * k * kSums;
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
+            // A block is 256 points against every centre: some 0.1 s at k = 65535.
+            if (stop_requested()) break;  // thrown below, outside the parallel region
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
             const PointView pts = grid.points(g0, g1, pb);
             assign_block(view, pts, winner, f);
@@ -589,6 +616,7 @@ void ClusterState::assign(const Grid& grid) {
             }
         }
     }
+    throw_if_stop_requested("the clustering");
 }
 
 double ClusterState::move_centres() {
@@ -626,6 +654,7 @@ int ClusterState::reseed_empty(const Grid& grid) {
     int reseeded = 0;
     for (int j = 0; j < params_.k; ++j) {
         if (centres_.count[j] != 0 || n_ == 0) continue;
+        throw_if_stop_requested("the clustering's re-seeding");
         add_centre(j, grid);
         ++reseeded;
     }

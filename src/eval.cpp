@@ -81,9 +81,11 @@ struct Offset {
 /// reference's dilation).
 std::vector<Offset> disk(int r) {
     std::vector<Offset> d;
+    // 64-bit squares: EvalParams bounds r, but this must not overflow for any int.
+    const std::int64_t r2 = std::int64_t{r} * r;
     for (int dv = -r; dv <= r; ++dv)
         for (int du = -r; du <= r; ++du)
-            if (du * du + dv * dv <= r * r) d.push_back({du, dv});
+            if (std::int64_t{du} * du + std::int64_t{dv} * dv <= r2) d.push_back({du, dv});
     return d;
 }
 
@@ -129,13 +131,14 @@ void set_all(ImageScore& s, double p, double r, double f, double detected_share)
 }  // namespace
 
 void EvalParams::validate() const {
-    if (!(boundary_fraction > 0 && std::isfinite(boundary_fraction)))
+    if (!(boundary_fraction > 0 && boundary_fraction <= 0.01))
         throw ParamError("EvalParams.boundary_fraction = " + std::to_string(boundary_fraction) +
-                         ": must be > 0");
-    if (boundary_tolerance_px < -1)
+                         ": must be in (0, 0.01]");
+    if (boundary_tolerance_px < -1 || boundary_tolerance_px > kMaxBoundaryTolerancePx)
         throw ParamError("EvalParams.boundary_tolerance_px = " +
-                         std::to_string(boundary_tolerance_px) +
-                         ": must be >= 0, or -1 for the fraction of the diagonal");
+                         std::to_string(boundary_tolerance_px) + ": must be in [0, " +
+                         std::to_string(kMaxBoundaryTolerancePx) +
+                         "], or -1 for the fraction of the diagonal");
     if (!(detected_f >= 0 && detected_f <= 1))
         throw ParamError("EvalParams.detected_f = " + std::to_string(detected_f) +
                          ": must be in [0, 1]");
@@ -146,7 +149,8 @@ int boundary_tolerance_px(const EvalParams& params, int width, int height) {
     // As the reference: ceil(0.003 * norm((H, W))), the norm taken as sqrt of the squares.
     const double diag = std::sqrt(static_cast<double>(width) * width +
                                   static_cast<double>(height) * height);
-    return static_cast<int>(std::ceil(params.boundary_fraction * diag));
+    const double t = std::ceil(params.boundary_fraction * diag);
+    return static_cast<int>(std::min(t, static_cast<double>(kMaxBoundaryTolerancePx)));
 }
 
 std::vector<int> hungarian_max(const std::vector<double>& weights, int rows, int cols) {

@@ -1,4 +1,7 @@
 // Writing a fakenect dump (kinect_v1.hpp): the file layout fakenect-record(1) documents.
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -24,12 +27,28 @@ void write_file(const fs::path& path, const std::string& header, const void* dat
 
 FakenectDumpWriter::FakenectDumpWriter(const std::string& dir, double fps)
     : dir_(dir), fps_(fps) {
-    if (!(fps > 0.0)) throw ParamError("FakenectDumpWriter: fps must be > 0");
+    if (!(fps > 0.0 && fps <= 1000.0)) throw ParamError("FakenectDumpWriter: fps must be in (0, 1000]");
     std::error_code ec;
     if (fs::exists(dir_, ec) && !(fs::is_directory(dir_, ec) && fs::is_empty(dir_, ec)))
         throw IoError(dir_ + ": exists and is not an empty folder");
-    fs::create_directories(dir_, ec);
-    if (ec || !fs::is_directory(dir_)) throw IoError(dir_ + ": cannot create folder");
+    // Beside the dump, under a short name of its own (whatever the length of the dump's).
+    static std::atomic<unsigned> serial{0};
+    const fs::path parent = fs::absolute(fs::path(dir_), ec).lexically_normal().parent_path();
+    fs::create_directories(parent, ec);
+    tmp_ = (parent / (".wul3d-dump-" + std::to_string(::getpid()) + "-" +
+                      std::to_string(serial++)))
+               .string();
+    if (!fs::create_directory(tmp_, ec) || ec)
+        throw IoError(tmp_ + ": cannot create folder" + (ec ? " (" + ec.message() + ")" : ""));
+}
+
+FakenectDumpWriter::~FakenectDumpWriter() {
+    if (finished_) return;
+    // Only what this writer wrote: its files, then its folder (rmdir fails if not empty).
+    std::error_code ec;
+    for (const std::string& name : index_) fs::remove(fs::path(tmp_) / name, ec);
+    fs::remove(fs::path(tmp_) / "INDEX.txt", ec);
+    fs::remove(tmp_, ec);
 }
 
 void FakenectDumpWriter::add(const ColorImage& color, const std::vector<std::uint16_t>& raw_depth) {
@@ -41,11 +60,14 @@ void FakenectDumpWriter::add(const ColorImage& color, const std::vector<std::uin
     // File times start at 1 s (fakenect sleeps by their differences); the second number is
     // the sensor timestamp handed to the callbacks, in the Kinect's 60 MHz ticks.
     const double t = 1.0 + static_cast<double>(frames_) / fps_;
-    const auto ticks = static_cast<unsigned>(static_cast<double>(frames_) * 60e6 / fps_);
+    // The counter is 32 bits and wraps, as the Kinect's does (after 72 s, frame 2148 at
+    // 30 FPS): through 64 bits, since a double beyond unsigned's range has no unsigned value.
+    const auto ticks = static_cast<unsigned>(
+        static_cast<std::uint64_t>(static_cast<double>(frames_) * 60e6 / fps_) & 0xffffffffu);
     char name[64];
     std::snprintf(name, sizeof name, "r-%.6f-%u.ppm", t, ticks);
-    write_file(fs::path(dir_) / name, "P6 640 480 255\n", color.rgb.data(), color.rgb.size());
-    index_.emplace_back(name);
+    index_.emplace_back(name);  // listed first, so that the destructor removes it if this fails
+    write_file(fs::path(tmp_) / name, "P6 640 480 255\n", color.rgb.data(), color.rgb.size());
     // Little-endian uint16, what fakenect hands to the depth callback byte for byte.
     std::vector<unsigned char> bytes(2 * n);
     for (std::size_t p = 0; p < n; ++p) {
@@ -53,19 +75,20 @@ void FakenectDumpWriter::add(const ColorImage& color, const std::vector<std::uin
         bytes[2 * p + 1] = static_cast<unsigned char>(raw_depth[p] >> 8);
     }
     std::snprintf(name, sizeof name, "d-%.6f-%u.pgm", t + 0.001, ticks);
-    write_file(fs::path(dir_) / name, "P5 640 480 65535\n", bytes.data(), bytes.size());
     index_.emplace_back(name);
+    write_file(fs::path(tmp_) / name, "P5 640 480 65535\n", bytes.data(), bytes.size());
     ++frames_;
 }
 
 void FakenectDumpWriter::finish() {
     std::string text;
     for (const std::string& line : index_) text += line + "\n";
-    const fs::path tmp = fs::path(dir_) / ".INDEX.txt.partial";
-    write_file(tmp, text, nullptr, 0);
+    write_file(fs::path(tmp_) / "INDEX.txt", text, nullptr, 0);
+    // rename(2) replaces `dir` if it is an empty folder, and fails if anything came into it.
     std::error_code ec;
-    fs::rename(tmp, fs::path(dir_) / "INDEX.txt", ec);
-    if (ec) throw IoError(dir_ + "/INDEX.txt: cannot write: " + ec.message());
+    fs::rename(tmp_, dir_, ec);
+    if (ec) throw IoError(dir_ + ": cannot write the dump (" + ec.message() + ")");
+    finished_ = true;
 }
 
 }  // namespace wul3d

@@ -30,7 +30,7 @@ void write_frame_folder(const std::string& dir, const RgbdFrame& frame) {
         K.height = frame.depth.height;
         write_intrinsics_json((tmp_dir / "intrinsics.json").string(), K,
                               frame.depth.scale_m_per_unit);
-    });
+    }, {"depth.png", "color.png", "intrinsics.json"});
 }
 
 }  // namespace wul3d

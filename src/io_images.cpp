@@ -1,5 +1,8 @@
 // Single-file readers and the atomic writers of io.hpp.
+#include <fcntl.h>
 #include <png.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <cstdio>  // before jpeglib.h, which needs FILE and size_t
@@ -7,6 +10,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -34,21 +38,20 @@ namespace {
 
 // ---- reading bytes --------------------------------------------------------------------
 
-/// The whole file into `bytes` (capacity reused). InputError if missing or unreadable.
-void read_file(const std::string& path, std::vector<unsigned char>& bytes) {
-    std::error_code ec;
-    const auto status = fs::status(path, ec);
-    if (!fs::exists(status)) throw InputError(path + ": no such file");
-    if (fs::is_directory(status)) throw InputError(path + ": is a folder, expected a file");
-    std::ifstream in(path, std::ios::binary | std::ios::ate);
-    if (!in) throw InputError(path + ": cannot read (" + std::strerror(errno) + ")");
-    const std::streamoff size = in.tellg();
-    if (size < 0) throw InputError(path + ": cannot read (cannot tell its size)");
-    bytes.resize(static_cast<std::size_t>(size));
-    in.seekg(0);
-    if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
-        throw InputError(path + ": cannot read (read error)");
-    }
+std::atomic<std::uint64_t> g_max_image_pixels{kDefaultMaxImagePixels};
+
+/// What stat() says a path is, for the message that refuses it.
+const char* kind_of(mode_t mode) {
+    if (S_ISDIR(mode)) return "a folder";
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    if (S_ISSOCK(mode)) return "a socket";
+    return "not a regular file";
+}
+
+std::string bytes_str(std::uint64_t n) {
+    return n % (1u << 20) == 0 ? std::to_string(n >> 20) + " MiB" : std::to_string(n) + " bytes";
 }
 
 // ---- PNG integrity --------------------------------------------------------------------
@@ -430,11 +433,18 @@ private:
 
 // -- the file
 
-/// OpenCV's limits on a decoded image, kept: 2^20 pixels a side, 2^30 in all.
+/// The image limits (io.hpp), checked from the header, before the pixels are allocated.
 void check_size(const std::string& path, std::size_t w, std::size_t h) {
-    if (w == 0 || h == 0 || w > (1u << 20) || h > (1u << 20) || w * h > (std::size_t{1} << 30)) {
+    if (w == 0 || h == 0) {
         throw InputError(path + ": cannot decode (an image of " + std::to_string(w) + "x" +
-                         std::to_string(h) + " pixels is empty or too large)");
+                         std::to_string(h) + " pixels is empty)");
+    }
+    const std::uint64_t limit = max_image_pixels();
+    if (w > kMaxImageSide || h > kMaxImageSide || std::uint64_t{w} * h > limit) {
+        throw InputError(path + ": image of " + std::to_string(w) + "x" + std::to_string(h) +
+                         " pixels is larger than the limit of " + std::to_string(limit) +
+                         " pixels and " + std::to_string(kMaxImageSide) +
+                         " a side (--max-pixels raises it)");
     }
 }
 
@@ -443,7 +453,7 @@ class ImageFile {
 public:
     /// PNG only unless allow_jpeg. InputError if missing, not a PNG (or JPEG), damaged.
     ImageFile(const std::string& path, ImageScratch& s, bool allow_jpeg) : path_(path), s_(s) {
-        read_file(path, s.bytes);
+        detail::read_regular_file(path, max_image_file_bytes(), s.bytes);
         if (is_png(s.bytes)) {
             png_.emplace(path, check_png(path, s.bytes, s.cleaned));
         } else if (allow_jpeg && is_jpeg(s.bytes)) {
@@ -571,10 +581,11 @@ void check_buffer(const std::string& path, const char* what, int w, int h, std::
 
 nlohmann::json read_json(const std::string& path) {
     std::vector<unsigned char> bytes;
-    read_file(path, bytes);
+    detail::read_regular_file(path, kMaxJsonBytes, bytes);
     try {
         return nlohmann::json::parse(bytes.begin(), bytes.end());
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {
+        // Also out_of_range: a number such as 1e400 that no double holds.
         throw InputError(path + ": invalid JSON (" + e.what() + ")");
     }
 }
@@ -610,8 +621,10 @@ float depth_scale(const std::string& path, const nlohmann::json& obj) {
     // Optional: 16-bit depth in millimetres is the common default (OpenNI, RealSense, Kinect).
     if (!obj.contains("depth_scale_m_per_unit")) return 0.001f;
     const double s = number(path, obj, "", "depth_scale_m_per_unit");
-    if (!(s > 0.0) || !std::isfinite(s)) {
-        throw InputError(path + ": key 'depth_scale_m_per_unit' must be positive");
+    // 1 um to 1 m per unit: 16-bit depth then reaches from 65 mm to 65 km.
+    if (!(s >= 1e-6 && s <= 1.0)) {
+        throw InputError(path + ": key 'depth_scale_m_per_unit' = " + std::to_string(s) +
+                         ": must be in [1e-6, 1] metres per unit");
     }
     return static_cast<float>(s);
 }
@@ -648,9 +661,57 @@ double float_for_json(float f) {
 
 }  // namespace
 
+// ---- limits -------------------------------------------------------------------------
+
+void set_max_image_pixels(std::uint64_t pixels) {
+    if (pixels < 1 || pixels > kMaxImagePixelsCeiling)
+        throw ParamError("--max-pixels " + std::to_string(pixels) + ": must be in [1, " +
+                         std::to_string(kMaxImagePixelsCeiling) + "]");
+    g_max_image_pixels.store(pixels, std::memory_order_relaxed);
+}
+
+std::uint64_t max_image_pixels() { return g_max_image_pixels.load(std::memory_order_relaxed); }
+
+std::uint64_t max_image_file_bytes() { return (std::uint64_t{64} << 20) + 8 * max_image_pixels(); }
+
 // ---- detail: readers into reused buffers ---------------------------------------------
 
 namespace detail {
+
+void read_regular_file(const std::string& path, std::uint64_t max_bytes,
+                       std::vector<unsigned char>& bytes) {
+    // The type first, by stat(), so that a FIFO or device is never opened: opening a FIFO
+    // for reading blocks until a writer comes. O_NONBLOCK and fstat() then close the race of
+    // a path replaced between the two calls.
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) {
+        if (errno == ENOENT || errno == ENOTDIR) throw InputError(path + ": no such file");
+        throw InputError(path + ": cannot read (" + std::strerror(errno) + ")");
+    }
+    if (!S_ISREG(st.st_mode))
+        throw InputError(path + ": is " + kind_of(st.st_mode) + ", expected a regular file");
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) throw InputError(path + ": cannot read (" + std::strerror(errno) + ")");
+    struct Closer {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+        throw InputError(path + ": is " + kind_of(st.st_mode) + ", expected a regular file");
+    const auto size = static_cast<std::uint64_t>(st.st_size);
+    if (size > max_bytes)
+        throw InputError(path + ": is " + bytes_str(size) + ", more than the " +
+                         bytes_str(max_bytes) + " accepted for this file");
+    bytes.resize(static_cast<std::size_t>(size));
+    std::size_t got = 0;
+    while (got < bytes.size()) {
+        const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) throw InputError(path + ": cannot read (" + std::strerror(errno) + ")");
+        if (n == 0) throw InputError(path + ": cannot read (the file shrank while read)");
+        got += static_cast<std::size_t>(n);
+    }
+}
 
 void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageScratch& s,
                          DepthImage& out) {

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -25,6 +24,24 @@ constexpr const char* kNoFramesHint =
 bool is_file(const fs::path& p) {
     std::error_code ec;
     return fs::is_regular_file(p, ec);
+}
+
+/// Whether the optional file `p` (color.png, intrinsics.json) is there. Something there that
+/// is not a regular file (a FIFO, a device, a folder) is an error, not an absent file.
+bool present(const fs::path& p) {
+    std::error_code ec;
+    const auto status = fs::status(p, ec);
+    if (!fs::exists(status)) return false;
+    if (!fs::is_regular_file(status))
+        throw InputError(p.string() + ": is not a regular file (a FIFO, device or folder)");
+    return true;
+}
+
+/// Anything at `p`: a file a reader then opens, or refuses by its type with a clear message
+/// (a FIFO named depth.png is an error, not a folder without frames).
+bool something_at(const fs::path& p) {
+    std::error_code ec;
+    return fs::exists(p, ec);
 }
 
 bool is_dir(const fs::path& p) {
@@ -57,7 +74,7 @@ bool looks_like_frame(const fs::path& dir) {
 
 FrameDirs find_frame_dirs(const std::string& path, const fs::path& root) {
     FrameDirs found;
-    if (is_file(root / "depth.png")) {
+    if (something_at(root / "depth.png")) {
         found.single = true;
         found.dirs.push_back(root);
         found.names.push_back(normalized(root).filename().string());
@@ -67,7 +84,7 @@ FrameDirs find_frame_dirs(const std::string& path, const fs::path& root) {
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(root, ec)) {
         if (!is_dir(entry.path())) continue;
-        if (is_file(entry.path() / "depth.png")) {
+        if (something_at(entry.path() / "depth.png")) {
             subs.push_back(entry.path());
         } else if (looks_like_frame(entry.path())) {
             throw InputError(entry.path().string() + ": frame folder has no depth.png");
@@ -132,7 +149,7 @@ public:
         // then the hint matters more than a missing intrinsics.json.
         detail::read_depth_png_into((dir / "depth.png").string(), 0.001f, depth_scratch_, f.depth);
         const fs::path color = dir / "color.png";
-        if (is_file(color)) {
+        if (present(color)) {
             detail::read_color_image_into(color.string(), color_scratch_, f.color);
             check_colour_size(dir, f.color, f.depth);
         } else {
@@ -149,7 +166,8 @@ public:
                 f.intrinsics.width = f.depth.width;  // no size given: the frame's own
                 f.intrinsics.height = f.depth.height;
             }
-            if (is_file(intr)) {
+            f.intrinsics.validate(dir.string() + ": the given intrinsics");
+            if (present(intr)) {
                 f.depth.scale_m_per_unit = read_intrinsics_json(intr.string()).depth_scale_m_per_unit;
             }
         } else {
@@ -201,7 +219,7 @@ public:
                              size_str(calib_.depth.width, calib_.depth.height));
         }
         const fs::path color = dir / "color.png";
-        if (is_file(color)) {
+        if (present(color)) {
             detail::read_color_image_into(color.string(), color_scratch_, raw.color);
             if (!calib_.color.same_size(raw.color.width, raw.color.height)) {
                 throw InputError(dir.string() + ": color.png is " +
@@ -232,9 +250,9 @@ struct Stamped {
 /// `rgb.txt` / `depth.txt`: "timestamp filename" lines, '#' comments, blank lines skipped.
 std::vector<Stamped> read_tum_list(const fs::path& file) {
     const std::string path = file.string();
-    if (!is_file(file)) throw InputError(path + ": no such file");
-    std::ifstream in(file);
-    if (!in) throw InputError(path + ": cannot read");
+    std::vector<unsigned char> bytes;
+    detail::read_regular_file(path, kMaxListBytes, bytes);
+    std::istringstream in(std::string(bytes.begin(), bytes.end()));
     std::vector<Stamped> list;
     std::string line;
     for (int lineno = 1; std::getline(in, line); ++lineno) {
@@ -306,6 +324,7 @@ public:
         if (K_.width == 0 && K_.height == 0) {
             f.intrinsics.width = f.depth.width;  // given intrinsics without a size
             f.intrinsics.height = f.depth.height;
+            f.intrinsics.validate(pair.depth.string() + ": the intrinsics (" + intrinsics_from_ + ")");
         }
         if (!f.intrinsics.same_size(f.depth.width, f.depth.height)) {
             throw InputError(pair.depth.string() + ": depth is " +
@@ -365,9 +384,10 @@ std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& r
         K = intrinsics_preset(preset);
         from = preset;
     }
-    PinholeIntrinsics check = K;
-    if (check.width == 0 && check.height == 0) check.width = check.height = 1;  // sized per frame
-    check.validate("TUM intrinsics (" + from + ")");
+    if (K.sized())
+        K.validate("TUM intrinsics (" + from + ")");
+    else
+        K.validate_unsized("TUM intrinsics (" + from + ")");  // checked with each frame's size
     return std::make_unique<TumSource>(std::move(pairs), K, from);
 }
 
@@ -377,9 +397,9 @@ std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& r
 /// single frame folder, or above a sequence).
 std::optional<fs::path> find_calibration_file(const fs::path& root) {
     const fs::path here = root / "calibration.json";
-    if (is_file(here)) return here;
+    if (something_at(here)) return here;
     const fs::path parent = normalized(root).parent_path() / "calibration.json";
-    if (is_file(parent)) return parent;
+    if (something_at(parent)) return parent;
     return std::nullopt;
 }
 
@@ -414,7 +434,7 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
     }
 
     InputFormat format = options.format;
-    if (format == InputFormat::Auto && is_file(root / "rgb.txt") && is_file(root / "depth.txt")) {
+    if (format == InputFormat::Auto && something_at(root / "rgb.txt") && something_at(root / "depth.txt")) {
         format = InputFormat::Tum;
     }
     if (format == InputFormat::Tum) {
@@ -432,7 +452,7 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
     if (options.calibration.empty() && format != InputFormat::Frames) {
         if (format == InputFormat::Unregistered || dirs.single) {
             calib_file = find_calibration_file(root);
-        } else if (is_file(root / "calibration.json")) {
+        } else if (something_at(root / "calibration.json")) {
             calib_file = root / "calibration.json";
         }
     }

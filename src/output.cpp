@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -23,9 +24,19 @@ namespace {
 std::string errno_text() { return std::strerror(errno); }
 }  // namespace
 
+namespace {
+/// A temporary name in `dir` of at most 40 bytes, whatever the final name's length (a name
+/// of 250 bytes plus a suffix would pass NAME_MAX, 255), unique in this process.
+fs::path temp_name(const fs::path& dir, const char* kind) {
+    static std::atomic<unsigned> serial{0};
+    return dir / (std::string(".wul3d.") + kind + "-" + std::to_string(::getpid()) + "-" +
+                  std::to_string(serial++));
+}
+}  // namespace
+
 void write_file_atomic(const std::string& path, const void* data, std::size_t size) {
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const std::string tmp = temp_name(fs::path(path).parent_path(), "tmp").string();
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) throw IoError(path + ": cannot write (" + errno_text() + ")");
     auto fail = [&](const std::string& why) {
         ::unlink(tmp.c_str());
@@ -49,24 +60,111 @@ void write_file_atomic(const std::string& path, const void* data, std::size_t si
 }
 
 void write_folder_atomic(const std::string& dir,
-                         const std::function<void(const std::string& tmp_dir)>& fill) {
+                         const std::function<void(const std::string& tmp_dir)>& fill,
+                         const std::vector<std::string>& own_names) {
     const fs::path final_dir(dir);
-    std::string tmp_name = final_dir.filename().string();
-    tmp_name.insert(0, 1, '.');
-    tmp_name.append(".partial");
-    const fs::path tmp_dir = final_dir.parent_path() / tmp_name;
+    const fs::path tmp_dir = temp_name(final_dir.parent_path(), "partial");
     std::error_code ec;
-    fs::remove_all(tmp_dir, ec);
-    fs::create_directories(tmp_dir, ec);
-    if (ec) throw IoError(tmp_dir.string() + ": cannot create folder: " + ec.message());
+    if (!fs::create_directory(tmp_dir, ec) || ec)
+        throw IoError(tmp_dir.string() + ": cannot create folder" + (ec ? ": " + ec.message() : ""));
     try {
         fill(tmp_dir.string());
-        fs::remove_all(final_dir, ec);
-        fs::rename(tmp_dir, final_dir);
+        const auto status = fs::symlink_status(final_dir, ec);
+        if (!fs::exists(status)) {
+            fs::rename(tmp_dir, final_dir);
+            return;
+        }
+        if (!fs::is_directory(status))
+            throw IoError(dir + ": exists and is not a folder; not replaced");
+        // A folder there already: only the writer's own files in it are replaced (or, those
+        // the new folder lacks, removed); anything else in it stays.
+        for (const std::string& name : own_names)
+            if (!fs::exists(tmp_dir / name, ec)) fs::remove(final_dir / name, ec);
+        for (const auto& e : fs::directory_iterator(tmp_dir))
+            fs::rename(e.path(), final_dir / e.path().filename());
+        fs::remove(tmp_dir);
+    } catch (const fs::filesystem_error& e) {
+        fs::remove_all(tmp_dir, ec);  // the folder this call made, holding only its files
+        throw IoError(dir + ": cannot write (" + e.code().message() + ")");
     } catch (...) {
         fs::remove_all(tmp_dir, ec);
         throw;
     }
+}
+
+const std::vector<std::string>& frame_output_files() {
+    static const std::vector<std::string> names = {"labels.png",      "colors.png",
+                                                   "selected.png",    "objects.png",
+                                                   "objects.json",    "selected_object.png",
+                                                   "cloud.ply"};
+    return names;
+}
+
+void check_frame_name(const std::string& name) {
+    const char* why = nullptr;
+    if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos ||
+        name.find('\0') != std::string::npos)
+        why = "is not a folder name";
+    else if (name.size() > 255)
+        why = "is longer than a file name may be (255 bytes)";
+    else if (name[0] == '.')
+        why = "starts with '.', which wul3d keeps for its temporary files in OUT";
+    else if (name == kSummaryFile || name == kFramesFile)
+        why = "is the name of a file wul3d writes in OUT";
+    if (why) throw InputError("frame name '" + name + "' " + why + "; rename the frame");
+}
+
+namespace {
+
+bool is_own_file_name(const std::string& name) { return name.rfind(".wul3d.", 0) == 0; }
+
+/// Whether `entry` of OUT is wul3d's: summary.json, frames.jsonl, a temporary, or a frame
+/// folder holding nothing but frame outputs. Sets `what` to the first foreign thing seen.
+bool is_own_entry(const fs::directory_entry& entry, std::string& what) {
+    const std::string name = entry.path().filename().string();
+    std::error_code ec;
+    if (name == kSummaryFile || name == kFramesFile || is_own_file_name(name)) return true;
+    if (!entry.is_directory(ec) || entry.is_symlink(ec)) {
+        what = entry.path().string();
+        return false;
+    }
+    const auto& own = frame_output_files();
+    for (const auto& e : fs::directory_iterator(entry.path(), ec)) {
+        const std::string file = e.path().filename().string();
+        if ((!e.is_regular_file(ec) || std::find(own.begin(), own.end(), file) == own.end()) &&
+            !is_own_file_name(file)) {
+            what = e.path().string();
+            return false;
+        }
+    }
+    if (ec) {
+        what = entry.path().string() + " (" + ec.message() + ")";
+        return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+void prepare_out_dir(const std::string& out, bool overwrite) {
+    const fs::path dir(out);
+    std::error_code ec;
+    const auto status = fs::status(dir, ec);
+    if (!fs::exists(status)) {
+        fs::create_directories(dir, ec);
+        if (ec || !fs::is_directory(dir))
+            throw IoError(out + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
+        return;
+    }
+    if (!fs::is_directory(status)) throw InputError(out + ": exists and is not a folder");
+    if (overwrite) return;
+    std::string what;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+        if (!is_own_entry(e, what))
+            throw InputError(out + ": holds what wul3d did not write (" + what +
+                             "); choose another output folder, or --overwrite to replace "
+                             "only wul3d's own files there");
+    if (ec) throw IoError(out + ": cannot list the folder (" + ec.message() + ")");
 }
 
 std::string objects_json(const FrameResult& r, int selected_id) {
@@ -134,6 +232,7 @@ void overlay_picture(const RgbdFrame& frame, const FrameResult& r, ColorImage& o
 
 void write_frame(const std::string& out_dir, const std::string& name, const Pipeline& pipeline,
                  const RgbdFrame& frame, const FrameResult& r, const FrameOutputs& extra) {
+    check_frame_name(name);
     write_folder_atomic((fs::path(out_dir) / name).string(), [&](const std::string& dir) {
         const fs::path tmp_dir(dir);
         write_label_png((tmp_dir / "labels.png").string(), r.labels);
@@ -158,7 +257,7 @@ void write_frame(const std::string& out_dir, const std::string& name, const Pipe
             back_project(frame, full);
             write_ply((tmp_dir / "cloud.ply").string(), full, r.labels, r.colors);
         }
-    });
+    }, frame_output_files());
 }
 
 }  // namespace wul3d

@@ -10,6 +10,7 @@
 #include "param_check.hpp"
 #include "side_by_side.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/stop.hpp"
 
 namespace wul3d {
 
@@ -131,6 +132,9 @@ const FrameResult& Pipeline::process(const RawRgbdFrame& raw, const StereoCalibr
 const FrameResult& Pipeline::Impl::run_stages(const RgbdView& frame, double registration_ms) {
     if (frame.width <= 0 || frame.height <= 0 || frame.depth == nullptr)
         throw InputError(std::string(frame.name) + ": empty depth image");
+    // Readers check the intrinsics they read; this also covers cameras and callers' frames.
+    frame.intrinsics.validate(std::string(frame.name));
+    throw_if_stop_requested("the frame's start");
     const int n = params_.decimation;
     if (n == 1) {
         run_on(frame, result_);
@@ -157,10 +161,12 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     r.times.backprojection = ms_since(t);
     if (valid == 0)
         throw InputError(std::string(frame.name) + ": depth has no valid pixel (all zero)");
+    throw_if_stop_requested("the back-projection");
 
     t = Clock::now();
     estimate_normals(params.normals, cloud_, normals_);
     r.times.normals = ms_since(t);
+    throw_if_stop_requested("the normals");
 
     t = Clock::now();
     r.active_points = select_depth_range(params.range, cloud_, r.active);
@@ -209,6 +215,7 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
         plane_and_segments(frame, r);
     }
     const double both_ms = ms_since(t);
+    throw_if_stop_requested("the segmentation");
     if (may_overlap) side_by_side_.record(side_by_side, both_ms);
     if (side_by_side)
         r.times.overlap = std::max(0.0, r.times.clustering + r.times.colors + r.times.plane +
@@ -260,6 +267,7 @@ void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
         r.plane.kept = r.active_points;
     }
     r.times.plane = ms_since(t);
+    throw_if_stop_requested("the plane removal");
 
     t = Clock::now();
     r.segment_stats = segment_objects(params.segmentation, cloud_, normals_, r.plane_classes,

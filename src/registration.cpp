@@ -169,12 +169,15 @@ void StereoCalibration::validate() const {
             << ", det = " << det << "; need |R^T R - I| <= 1e-3 and det > 0)";
         throw ParamError(msg.str());
     }
+    // Two cameras of one sensor: at most 10 m apart.
     for (double t : translation_m) {
-        if (!std::isfinite(t)) throw ParamError("StereoCalibration.translation_m is not finite");
+        if (!(std::abs(t) <= 10.0))
+            throw ParamError("StereoCalibration.translation_m = " + std::to_string(t) +
+                             ": each component must be finite and in [-10, 10] metres");
     }
-    if (!(depth_scale_m_per_unit > 0.0f) || !std::isfinite(depth_scale_m_per_unit)) {
+    if (!(depth_scale_m_per_unit >= 1e-6f && depth_scale_m_per_unit <= 1.0f)) {
         throw ParamError("StereoCalibration.depth_scale_m_per_unit = " +
-                         std::to_string(depth_scale_m_per_unit) + ": must be > 0");
+                         std::to_string(depth_scale_m_per_unit) + ": must be in [1e-6, 1]");
     }
 }
 

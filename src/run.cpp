@@ -2,10 +2,15 @@
 // summary.json. `wul3d run` is this plus argument parsing and printing.
 #include "wul3d/run.hpp"
 
+#include <fcntl.h>
 #include <omp.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <random>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -15,6 +20,7 @@
 #include "wul3d/io.hpp"
 #include "wul3d/objects.hpp"
 #include "wul3d/output.hpp"
+#include "wul3d/stop.hpp"
 
 namespace wul3d {
 namespace fs = std::filesystem;
@@ -56,7 +62,7 @@ nlohmann::json parameters_json(const PipelineParams& params, const std::string& 
             {"preset", preset.empty() ? "default" : preset}};
 }
 
-/// One frame's line of summary.json's "per_frame".
+/// One frame's line of OUT/frames.jsonl.
 nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
     return {{"name", name},
             {"points", r.stats.points},
@@ -74,31 +80,87 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"objects", r.object_list.size()}};
 }
 
-/// The stage times of every frame, for summary.json's medians.
+/// A bounded sample of a run's values for their median: every value up to kKeep, then a
+/// uniform sample of kKeep (reservoir sampling, fixed seed), so that memory stays flat over
+/// a run of days. Exact for the first kKeep frames.
+class MedianSample {
+public:
+    static constexpr std::size_t kKeep = 4096;
+    void add(double v) {
+        ++seen_;
+        if (values_.size() < kKeep) {
+            values_.push_back(v);
+            return;
+        }
+        const std::uint64_t j = std::uniform_int_distribution<std::uint64_t>(0, seen_ - 1)(rng_);
+        if (j < kKeep) values_[j] = v;
+    }
+    double median() const { return wul3d::median(values_); }
+
+private:
+    std::vector<double> values_;
+    std::uint64_t seen_ = 0;
+    std::mt19937_64 rng_{1};
+};
+
+/// The stage times of the frames, for summary.json's medians.
 struct StageLog {
-    std::map<std::string, std::vector<double>> stage_ms;
-    std::vector<double> compute_ms;
+    std::map<std::string, MedianSample> stage_ms;
+    MedianSample compute_ms;
 
     void add(const StageTimes& t, double output_ms) {
-        stage_ms["registration"].push_back(t.registration);
-        stage_ms["decimation"].push_back(t.decimation);
-        stage_ms["backprojection"].push_back(t.backprojection);
-        stage_ms["normals"].push_back(t.normals);
-        stage_ms["background"].push_back(t.background);
-        stage_ms["clustering"].push_back(t.clustering);
-        stage_ms["colors"].push_back(t.colors);
-        stage_ms["plane"].push_back(t.plane);
-        stage_ms["segmentation"].push_back(t.segmentation);
-        stage_ms["objects"].push_back(t.objects);
-        stage_ms["overlap"].push_back(t.overlap);
-        stage_ms["output"].push_back(output_ms);
-        compute_ms.push_back(t.total());
+        stage_ms["registration"].add(t.registration);
+        stage_ms["decimation"].add(t.decimation);
+        stage_ms["backprojection"].add(t.backprojection);
+        stage_ms["normals"].add(t.normals);
+        stage_ms["background"].add(t.background);
+        stage_ms["clustering"].add(t.clustering);
+        stage_ms["colors"].add(t.colors);
+        stage_ms["plane"].add(t.plane);
+        stage_ms["segmentation"].add(t.segmentation);
+        stage_ms["objects"].add(t.objects);
+        stage_ms["overlap"].add(t.overlap);
+        stage_ms["output"].add(output_ms);
+        compute_ms.add(t.total());
     }
     nlohmann::json medians() const {
-        nlohmann::json m;
-        for (const auto& [stage, values] : stage_ms) m[stage] = median(values);
+        nlohmann::json m = nlohmann::json::object();
+        for (const auto& [stage, values] : stage_ms) m[stage] = values.median();
         return m;
     }
+};
+
+/// OUT/frames.jsonl: one line per frame written, appended and flushed as each frame is
+/// done, so that it is complete up to the last frame however the run ends, and nothing of
+/// it stays in memory.
+class FramesLog {
+public:
+    explicit FramesLog(const std::string& path) : path_(path) {
+        // O_APPEND on a fresh file: each line lands whole at its end.
+        const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
+        if (fd < 0) throw IoError(path + ": cannot write (" + std::strerror(errno) + ")");
+        fd_ = fd;
+    }
+    ~FramesLog() { ::close(fd_); }
+    FramesLog(const FramesLog&) = delete;
+    FramesLog& operator=(const FramesLog&) = delete;
+
+    void append(const nlohmann::json& line) {
+        const std::string text = line.dump() + "\n";
+        std::size_t done = 0;
+        while (done < text.size()) {
+            const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0)
+                throw IoError(path_ + ": cannot write (" +
+                              (n < 0 ? std::string(std::strerror(errno)) : "short write") + ")");
+            done += static_cast<std::size_t>(n);
+        }
+    }
+
+private:
+    std::string path_;
+    int fd_ = -1;
 };
 
 /// The user's picked object (--select): its cluster and its object, followed over frames.
@@ -140,73 +202,47 @@ struct Selection {
     }
 };
 
-void create_out_dir(const std::string& out) {
-    const fs::path out_dir(out);
+/// `p` absolute, with symbolic links resolved as far as it exists, for comparing folders.
+fs::path resolved(const std::string& p) {
     std::error_code ec;
-    fs::create_directories(out_dir, ec);
-    if (ec || !fs::is_directory(out_dir))
-        throw IoError(out + ": cannot create output folder" + (ec ? ": " + ec.message() : ""));
+    const fs::path abs = fs::absolute(p, ec).lexically_normal();
+    const fs::path c = fs::weakly_canonical(abs, ec);
+    fs::path r = ec ? abs : c;
+    if (r.filename().empty()) r = r.parent_path();  // no trailing separator
+    return r;
 }
 
-}  // namespace
+/// Whether `inner` is `outer` or lies under it.
+bool within(const fs::path& inner, const fs::path& outer) {
+    auto o = outer.begin(), i = inner.begin();
+    for (; o != outer.end(); ++o, ++i)
+        if (i == inner.end() || *i != *o) return false;
+    return true;
+}
 
-RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
-    RunObserver silent;
-    RunObserver& obs = observer ? *observer : silent;
-    FrameFeed feed(o.feed, o.stop);
-    // A recording has a known length; a camera runs until max_frames, a stop or its end.
-    const std::size_t n_total =
-        feed.live() ? o.max_frames
-                    : (o.max_frames ? std::min(o.max_frames, feed.size()) : feed.size());
-    create_out_dir(o.out_dir);
-
-    Pipeline pipeline(o.params);
-    Selection selection(o.select);
-    SourceItem item;
-    StageLog log;
-    nlohmann::json per_frame = nlohmann::json::array();
-    bool said_depth_only = false;
-    using Clock = std::chrono::steady_clock;
-    const auto run_start = Clock::now();
-    obs.started(n_total);
-
-    RunSummary s;
-    std::exception_ptr lost;  // DeviceLost: rethrown once the outputs are final
-    for (;;) {
-        if (n_total && s.frames >= n_total) {
-            s.stopped_by = feed.live() || n_total < feed.size() ? "frames" : "end";
-            break;
-        }
-        if (!feed.next_frame(item, s.stopped_by, lost)) break;
-        const std::string name = feed.name();
-        const FrameResult& r =
-            item.is_raw ? pipeline.process(item.raw, *feed.calibration(), o.feed.source.registration)
-                        : pipeline.process(item.frame);
-        const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
-        if (!frame.has_color() && !said_depth_only) {
-            obs.note(name + " has no colour image; clustering on position and normals only");
-            said_depth_only = true;
-        }
-        selection.update(r);
-
-        const auto t_out = Clock::now();
-        write_frame(o.out_dir, name, pipeline, frame, r, selection.outputs(o.ply, o.overlay));
-        log.add(r.times, std::chrono::duration<double, std::milli>(Clock::now() - t_out).count());
-        nlohmann::json f = frame_json(name, r);
-        if (selection.cluster) f["selected_pixels"] = selection.cluster->pixels();
-        per_frame.push_back(std::move(f));
-        const double fps = 1000.0 / std::max(1e-9, median(log.compute_ms));
-        obs.frame(RunFrame{name, s.frames, n_total, frame, r,
-                           selection.cluster ? &selection.cluster_mask : nullptr,
-                           selection.object_selected ? selection.object->label() : 0, fps});
-        ++s.frames;
+/// Refuses an output folder that is, holds or lies in an input: the outputs would replace
+/// the recording's files (a frame's folder and OUT/<frame>/ would be one).
+void check_out_apart_from_inputs(const RunOptions& o) {
+    const fs::path out = resolved(o.out_dir);
+    std::vector<std::string> inputs;
+    if (!o.feed.input.empty()) inputs.push_back(o.feed.input);
+    const std::string& calib = o.feed.source.calibration;
+    if (!calib.empty() && calib != "kinect_v2") inputs.push_back(calib);
+    for (const std::string& input : inputs) {
+        const fs::path in = resolved(input);
+        const char* how = out == in            ? "is the input"
+                          : within(out, in)    ? "lies inside the input"
+                          : within(in, out)    ? "contains the input"
+                                               : nullptr;
+        if (how)
+            throw ParamError("output folder " + o.out_dir + " " + how + " " + input +
+                             "; the outputs would overwrite it: choose an output folder apart");
     }
-    obs.frames_done();
+}
 
-    s.ms_per_frame_median = median(log.compute_ms);
-    s.fps = s.ms_per_frame_median > 0 ? 1000.0 / s.ms_per_frame_median : 0.0;
-    s.peak_rss_mb = peak_rss_mb();
-    s.wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
+/// summary.json's frame-independent part.
+nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const RunSummary& s,
+                            const StageLog& log, const Selection& selection) {
     nlohmann::json summary;
     if (feed.live()) {
         summary["input"] = nullptr;
@@ -220,8 +256,10 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     }
     summary["format"] = feed.format();
     summary["stopped_by"] = s.stopped_by;
+    summary["error"] = s.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.error);
     summary["parameters"] = parameters_json(o.params, o.preset);
     summary["frames"] = s.frames;
+    summary["frames_file"] = kFramesFile;
     summary["threads"] = omp_get_max_threads();
     summary["stage_ms_median"] = log.medians();
     summary["ms_per_frame_median"] = s.ms_per_frame_median;
@@ -229,8 +267,105 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     summary["wall_s"] = s.wall_s;
     summary["peak_rss_mb"] = s.peak_rss_mb;
     if (selection.cluster) summary["selected_cluster"] = selection.cluster->cluster();
-    summary["per_frame"] = per_frame;
-    write_text_file((fs::path(o.out_dir) / "summary.json").string(), summary.dump(2) + "\n");
+    return summary;
+}
+
+}  // namespace
+
+RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
+    RunObserver silent;
+    RunObserver& obs = observer ? *observer : silent;
+    FrameFeed feed(o.feed, o.stop);
+    if (!feed.live()) {
+        check_out_apart_from_inputs(o);
+        // Every name before the first frame: a run must not fail at frame 50,000 for it.
+        for (std::size_t i = 0; i < feed.size(); ++i) check_frame_name(feed.source()->name(i));
+    }
+    // A recording has a known length; a camera runs until max_frames, a stop or its end.
+    const std::size_t n_total =
+        feed.live() ? o.max_frames
+                    : (o.max_frames ? std::min(o.max_frames, feed.size()) : feed.size());
+    prepare_out_dir(o.out_dir, o.overwrite);
+    const fs::path out_dir(o.out_dir);
+
+    Pipeline pipeline(o.params);
+    Selection selection(o.select);
+    SourceItem item;
+    StageLog log;
+    bool said_depth_only = false;
+    using Clock = std::chrono::steady_clock;
+    const auto run_start = Clock::now();
+    obs.started(n_total);  // may refuse the run (a video writer that cannot start)
+    FramesLog frames_log((out_dir / kFramesFile).string());
+
+    RunSummary s;
+    std::exception_ptr lost;    // DeviceLost: rethrown once the outputs are final
+    std::exception_ptr failed;  // any other error: rethrown once summary.json is written
+    try {
+        for (;;) {
+            if (n_total && s.frames >= n_total) {
+                s.stopped_by = feed.live() || n_total < feed.size() ? "frames" : "end";
+                break;
+            }
+            if (!feed.next_frame(item, s.stopped_by, lost)) break;
+            const std::string name = feed.name();
+            if (feed.live()) check_frame_name(name);
+            const FrameResult* result = nullptr;
+            try {
+                result = item.is_raw ? &pipeline.process(item.raw, *feed.calibration(),
+                                                         o.feed.source.registration)
+                                     : &pipeline.process(item.frame);
+            } catch (const Stopped&) {  // SIGINT/SIGTERM mid-frame: this frame is not written
+                s.stopped_by = "signal";
+                break;
+            }
+            const FrameResult& r = *result;
+            const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
+            if (!frame.has_color() && !said_depth_only) {
+                obs.note(name + " has no colour image; clustering on position and normals only");
+                said_depth_only = true;
+            }
+            selection.update(r);
+
+            const auto t_out = Clock::now();
+            write_frame(o.out_dir, name, pipeline, frame, r, selection.outputs(o.ply, o.overlay));
+            log.add(r.times, std::chrono::duration<double, std::milli>(Clock::now() - t_out).count());
+            nlohmann::json f = frame_json(name, r);
+            if (selection.cluster) f["selected_pixels"] = selection.cluster->pixels();
+            frames_log.append(f);
+            const double fps = 1000.0 / std::max(1e-9, log.compute_ms.median());
+            obs.frame(RunFrame{name, s.frames, n_total, frame, r,
+                               selection.cluster ? &selection.cluster_mask : nullptr,
+                               selection.object_selected ? selection.object->label() : 0, fps});
+            ++s.frames;
+        }
+    } catch (const std::exception& e) {
+        // A bad frame, a full disk: the frames before it are complete, and summary.json says
+        // what ended the run.
+        failed = std::current_exception();
+        s.stopped_by = "error";
+        s.error = e.what();
+    }
+    obs.frames_done();
+
+    s.ms_per_frame_median = log.compute_ms.median();
+    s.fps = s.ms_per_frame_median > 0 ? 1000.0 / s.ms_per_frame_median : 0.0;
+    s.peak_rss_mb = peak_rss_mb();
+    s.wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
+    if (lost) {
+        try {
+            std::rethrow_exception(lost);
+        } catch (const std::exception& e) {
+            s.error = e.what();
+        }
+    }
+    try {
+        write_text_file((out_dir / kSummaryFile).string(),
+                        summary_json(o, feed, s, log, selection).dump(2) + "\n");
+    } catch (const std::exception&) {
+        if (!failed) throw;  // the first error is the one to report (a full disk, twice)
+    }
+    if (failed) std::rethrow_exception(failed);
     obs.finished(s);
 
     if (lost) std::rethrow_exception(lost);

@@ -57,6 +57,14 @@ nlohmann::json read_json(const fs::path& p) {
     return nlohmann::json::parse(f);
 }
 
+/// OUT/frames.jsonl: one JSON object per frame written.
+std::vector<nlohmann::json> read_frames(const fs::path& out) {
+    std::vector<nlohmann::json> frames;
+    std::ifstream f(out / "frames.jsonl");
+    for (std::string line; std::getline(f, line);) frames.push_back(nlohmann::json::parse(line));
+    return frames;
+}
+
 /// Share of pixels with the same label in two label PNGs.
 double label_agreement(const fs::path& a, const fs::path& b) {
     const wul3d::LabelImage la = wul3d::read_label_png(a.string());
@@ -208,7 +216,9 @@ TEST_F(FakenectReplay, NewestWins_EveryFrameProcessedOrCounted) {
     EXPECT_EQ(s["frames_captured"], 4);
     EXPECT_EQ(s["frames"].get<int>() + s["frames_dropped"].get<int>(), 4);
     EXPECT_EQ(s["stopped_by"], "end");
-    for (const auto& f : s["per_frame"])
+    const auto frames = read_frames(out);
+    EXPECT_EQ(frames.size(), s["frames"].get<std::size_t>());
+    for (const auto& f : frames)
         EXPECT_TRUE(fs::exists(out / f["name"].get<std::string>() / "labels.png"));
 }
 
@@ -229,7 +239,9 @@ TEST(CaptureCli, Sigint_StopsCleanly_AndFinalizesTheOutputs) {
     const nlohmann::json s = read_json(out / "summary.json");
     EXPECT_EQ(s["stopped_by"], "signal");
     EXPECT_LT(s["frames"].get<int>(), 4);
-    for (const auto& f : s["per_frame"])
+    const auto frames = read_frames(out);
+    EXPECT_EQ(frames.size(), s["frames"].get<std::size_t>());
+    for (const auto& f : frames)
         EXPECT_TRUE(fs::exists(out / f["name"].get<std::string>() / "objects.json"));
     for (const auto& e : fs::directory_iterator(out))
         EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos);

@@ -2,6 +2,7 @@
 // byte and JPEGs made with libjpeg, every reader error, atomic writes, and open_source on the
 // shipped samples and on small sequences written here.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdio>  // before jpeglib.h, which needs FILE and size_t
 #include <jpeglib.h>
@@ -976,3 +977,67 @@ TEST(OpenSource, Unregistered) {
 }
 
 }  // namespace
+
+// ---- limits (issue 24): regular files only, sizes checked before allocation ----------------
+
+TEST(IoLimits, FifoAndFolderAreRefusedByType) {
+    wul3d::test::TempDir tmp;
+    const fs::path fifo = tmp / "intrinsics.json";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    try {
+        wul3d::read_intrinsics_json(fifo.string());  // would block in open() if opened
+        FAIL() << "no error";
+    } catch (const wul3d::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("FIFO"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(wul3d::read_depth_png(fifo.string(), 0.001f), wul3d::InputError);
+    EXPECT_THROW(wul3d::read_color_image(tmp.path().string()), wul3d::InputError);
+    EXPECT_THROW(wul3d::read_label_png("/dev/zero"), wul3d::InputError);
+}
+
+TEST(IoLimits, OversizedJsonIsRefusedBeforeReading) {
+    wul3d::test::TempDir tmp;
+    const fs::path big = tmp / "intrinsics.json";
+    {
+        std::ofstream out(big, std::ios::binary);
+        out << R"({"fx": 500, "fy": 500, "cx": 320, "cy": 240, "width": 640, "height": 480})";
+    }
+    EXPECT_NO_THROW(wul3d::read_intrinsics_json(big.string()));
+    fs::resize_file(big, wul3d::kMaxJsonBytes + 1);  // sparse: no disk used
+    try {
+        wul3d::read_intrinsics_json(big.string());
+        FAIL() << "no error";
+    } catch (const wul3d::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("1 MiB"), std::string::npos) << e.what();
+    }
+}
+
+TEST(IoLimits, ImageLimitComesFromTheHeader) {
+    const std::string depth =
+        (wul3d::test::sample_dir() / "uois_tabletop" / "image_0000" / "depth.png").string();
+    ASSERT_EQ(wul3d::max_image_pixels(), wul3d::kDefaultMaxImagePixels);
+    wul3d::set_max_image_pixels(640 * 480 - 1);
+    EXPECT_THROW(wul3d::read_depth_png(depth, 0.001f), wul3d::InputError);
+    wul3d::set_max_image_pixels(640 * 480);
+    EXPECT_EQ(wul3d::read_depth_png(depth, 0.001f).width, 640);
+    EXPECT_THROW(wul3d::set_max_image_pixels(0), wul3d::ParamError);
+    EXPECT_THROW(wul3d::set_max_image_pixels(wul3d::kMaxImagePixelsCeiling + 1), wul3d::ParamError);
+    wul3d::set_max_image_pixels(wul3d::kDefaultMaxImagePixels);
+}
+
+TEST(IoLimits, IntrinsicsMustBePhysical) {
+    wul3d::PinholeIntrinsics K{640, 480, 525, 525, 319.5, 239.5};
+    EXPECT_NO_THROW(K.validate());
+    for (double bad : {1e-300, 1e300, std::nan(""), double{INFINITY}, 10.0, 1e7}) {
+        wul3d::PinholeIntrinsics k = K;
+        k.fx = bad;
+        EXPECT_THROW(k.validate(), wul3d::ParamError) << bad;
+        k = K;
+        k.cx = bad * 100;
+        if (!(bad * 100 >= -640 && bad * 100 <= 1280)) {
+            EXPECT_THROW(k.validate(), wul3d::ParamError) << bad;
+        }
+    }
+    K.width = 100000;
+    EXPECT_THROW(K.validate(), wul3d::ParamError);
+}

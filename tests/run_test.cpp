@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string>
 
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
@@ -77,7 +78,16 @@ TEST(RunSequence, WritesEveryFrameAndTheSummary_ObserverHearsEach) {
     }
     const auto summary = nlohmann::json::parse(slurp(dir / "out" / "summary.json"));
     EXPECT_EQ(summary["frames"].get<std::size_t>(), s.frames);
-    EXPECT_EQ(summary["per_frame"].size(), s.frames);
+    // One line per frame in frames.jsonl, in order; summary.json keeps none of them.
+    std::ifstream lines(dir / "out" / "frames.jsonl");
+    std::size_t i = 0;
+    for (std::string line; std::getline(lines, line); ++i)
+        if (i < rec.names.size()) {
+            EXPECT_EQ(nlohmann::json::parse(line)["name"], rec.names[i]);
+        }
+    EXPECT_EQ(i, s.frames);
+    EXPECT_FALSE(summary.contains("per_frame"));
+    EXPECT_EQ(summary["frames_file"], "frames.jsonl");
     EXPECT_EQ(summary["parameters"]["preset"], "default");
     EXPECT_EQ(summary["input"], o.feed.input);
 }
@@ -87,7 +97,7 @@ TEST(RunSequence, MaxFramesAndStopEndTheRun) {
     RunOptions o = sample_run(dir / "a");
     o.max_frames = 1;
     EXPECT_EQ(run_sequence(o).stopped_by, "frames");
-    EXPECT_EQ(test::list_files(dir / "a").size(), 5u);  // 4 files of one frame + summary.json
+    EXPECT_EQ(test::list_files(dir / "a").size(), 6u);  // 4 of one frame, summary, frames.jsonl
 
     RunOptions stop = sample_run(dir / "b");
     int polls = 0;
@@ -109,7 +119,7 @@ TEST(RunSequence, SameBytesAsTheCommand) {
     const auto files = test::list_files(dir / "lib");
     ASSERT_EQ(files, test::list_files(dir / "cli"));
     for (const std::string& f : files) {
-        if (f == "summary.json") continue;  // timings differ
+        if (f == "summary.json" || f == "frames.jsonl") continue;  // timings differ
         EXPECT_EQ(slurp(dir / "lib" / f), slurp(dir / "cli" / f)) << f;
     }
 }
@@ -205,10 +215,12 @@ TEST(WriteFolderAtomic, CompleteOrAbsent) {
                  IoError);
     // The old folder stays as it was and no partial folder is left.
     EXPECT_EQ(test::list_files(dir.path()), std::vector<std::string>{"frame/a.txt"});
-    write_folder_atomic(target, [](const std::string& tmp) {
-        write_text_file(tmp + "/b.txt", "two\n");
-    });
-    EXPECT_EQ(test::list_files(dir.path()), std::vector<std::string>{"frame/b.txt"});
+    // Replacing: the writer's own files (a.txt, b.txt) go, anything else in the folder stays.
+    write_text_file((dir / "frame" / "mine.txt").string(), "the user's\n");
+    write_folder_atomic(
+        target, [](const std::string& tmp) { write_text_file(tmp + "/b.txt", "two\n"); },
+        {"a.txt", "b.txt"});
+    EXPECT_EQ(test::list_files(dir.path()), (std::vector<std::string>{"frame/b.txt", "frame/mine.txt"}));
 }
 
 TEST(WriteFileAtomic, UnwritablePathIsAnIoErrorNamingIt) {

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -132,16 +133,36 @@ void measure_one(const BenchOptions& o) {
               << ',' << std::setprecision(1) << static_cast<double>(usage.ru_maxrss) / 1024.0 << '\n';
 }
 
-/// Runs this program again as `bench ... --single-k k` and returns the row it printed.
+/// Reads `fd` to its end.
+std::string read_all(int fd) {
+    std::string text;
+    char buf[512];
+    for (;;) {
+        const ssize_t got = ::read(fd, buf, sizeof buf);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) break;
+        text.append(buf, static_cast<std::size_t>(got));
+    }
+    return text;
+}
+
+/// Runs this program again as `bench ... --single-k k` and returns the row it printed. A
+/// failed measurement throws the child's own one-line error with its kind (so its exit code:
+/// 2 bad input, 3 lost device, 1 otherwise), with the k it was measuring.
 std::string run_child(const BenchOptions& o, int k) {
-    int fd[2];
-    if (::pipe(fd) != 0) throw Error("bench: cannot create a pipe");
+    int out[2], err[2];
+    if (::pipe(out) != 0) throw Error("bench: cannot create a pipe");
+    if (::pipe(err) != 0) {
+        ::close(out[0]);
+        ::close(out[1]);
+        throw Error("bench: cannot create a pipe");
+    }
     const pid_t pid = ::fork();
     if (pid < 0) throw Error("bench: cannot fork");
     if (pid == 0) {
-        ::dup2(fd[1], STDOUT_FILENO);
-        ::close(fd[0]);
-        ::close(fd[1]);
+        ::dup2(out[1], STDOUT_FILENO);
+        ::dup2(err[1], STDERR_FILENO);
+        for (int fd : {out[0], out[1], err[0], err[1]}) ::close(fd);
         std::vector<std::string> args = {"wul3d", "bench", o.input, "--single-k", std::to_string(k),
                                          "--resolution", o.resolution, "--frames",
                                          std::to_string(o.frames), "--passes",
@@ -155,16 +176,32 @@ std::string run_child(const BenchOptions& o, int k) {
         ::execv("/proc/self/exe", argv.data());
         ::_exit(127);
     }
-    ::close(fd[1]);
-    std::string text;
-    char buf[512];
-    ssize_t got;
-    while ((got = ::read(fd[0], buf, sizeof buf)) > 0) text.append(buf, static_cast<std::size_t>(got));
-    ::close(fd[0]);
+    ::close(out[1]);
+    ::close(err[1]);
+    // The child writes its one error line at its end, far below a pipe's buffer: stdout to
+    // its end first cannot block it.
+    std::string text = read_all(out[0]);
+    std::string error = read_all(err[0]);
+    ::close(out[0]);
+    ::close(err[0]);
     int status = 0;
-    ::waitpid(pid, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || text.empty())
-        throw Error("bench: the measurement of k = " + std::to_string(k) + " failed");
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    const std::string what = " (bench, measuring k = " + std::to_string(k) + ")";
+    if (WIFSIGNALED(status))
+        throw Error("bench: the measurement of k = " + std::to_string(k) + " was killed by signal " +
+                    std::to_string(WTERMSIG(status)));
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+    if (code != 0 || text.empty()) {
+        // The child's last line, without its "wul3d: ".
+        while (!error.empty() && (error.back() == '\n' || error.back() == '\r')) error.pop_back();
+        error = error.substr(error.find_last_of('\n') == std::string::npos ? 0 : error.find_last_of('\n') + 1);
+        if (error.rfind("wul3d: ", 0) == 0) error.erase(0, 7);
+        if (error.empty()) error = "the measurement failed with exit code " + std::to_string(code);
+        if (code == 2) throw InputError(error + what);
+        if (code == 3) throw DeviceLost(error + what);
+        throw Error(error + what);
+    }
     while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
     return text;
 }

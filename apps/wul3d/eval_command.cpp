@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "pipeline_options.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/eval.hpp"
 #include "wul3d/io.hpp"
@@ -282,11 +283,15 @@ void add_eval_command(CLI::App& app) {
     cmd->add_option("--gt-background-max", opts->gt_background_max,
                     "Ground-truth labels up to this value are background (9 for OSD's "
                     "label_parts.png, whose 1-9 are the table)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(CLI::Range(0, 65535));
     cmd->add_option("--only", opts->only,
                     "Score only frames whose name starts with this prefix (repeatable)");
     cmd->add_option("--tolerance", opts->tolerance_px,
-                    "Boundary tolerance in pixels (default: ceil(0.003 x image diagonal))");
+                    "Boundary tolerance in pixels, [0, 50] (default: ceil(0.003 x image "
+                    "diagonal), at most 50)")
+        ->check(CLI::Range(0, kMaxBoundaryTolerancePx));
+    add_max_pixels_option(cmd);
     cmd->add_option("--json", opts->json, "Write the summary and per-image scores as JSON");
     cmd->add_flag("--per-image", opts->per_image, "Print one line per image");
     cmd->add_flag("--temporal", opts->temporal,

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "pipeline_options.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/kinect_v1.hpp"
@@ -81,6 +82,7 @@ void add_export_fakenect_command(CLI::App& app) {
         ->check(CLI::Range(1, 1 << 30));
     cmd->add_option("--fps", o->fps, "Replay rate, frames per second")
         ->check(CLI::Range(1.0, 120.0))->capture_default_str();
+    add_max_pixels_option(cmd);
     cmd->callback([o]() { export_fakenect(*o); });
 }
 

@@ -2,18 +2,25 @@
 
 #include <csignal>
 
+#include "wul3d/stop.hpp"
+
 namespace wul3d::cli {
 
 namespace {
 
 volatile std::sig_atomic_t g_stop_signal = 0;
 
-extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
+// Also the library's stop request, which the pipeline's stages check mid-frame.
+extern "C" void on_stop_signal(int sig) {
+    g_stop_signal = sig;
+    wul3d::request_stop();
+}
 
 }  // namespace
 
 void install_stop_signals() {
     g_stop_signal = 0;
+    wul3d::clear_stop_request();
     struct sigaction sa {};
     sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);

@@ -29,7 +29,14 @@ std::vector<double> parse_numbers(const std::string& flag, const std::string& te
     return values;
 }
 
+void add_max_pixels_option(CLI::App* cmd) {
+    cmd->add_option_function<std::uint64_t>(
+        "--max-pixels", [](const std::uint64_t& n) { set_max_image_pixels(n); },
+        "Largest image read, width x height (default 2^24 = 16777216; at most 2^30)");
+}
+
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
+    add_max_pixels_option(cmd);
     cmd->add_option("input", o.input,
                     "Frame folder(s), TUM RGB-D sequence, or unregistered frames (or --camera)");
     cmd->add_option("--camera", o.camera,
@@ -59,8 +66,8 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     cmd->add_option("--min-points", o.min_points, "Smallest object, pixels (default 300)");
     cmd->add_option("--object-psi", o.object_psi,
                     "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
-    cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)")
-        ->check(CLI::Range(1, 1 << 30));
+    cmd->add_option("--threads", o.threads, "Worker threads, [1, 1024] (default: all cores)")
+        ->check(CLI::Range(1, 1024));
     cmd->add_option("--decimate", o.decimate,
                     "N in [1, 8]: run the stages on every N-th pixel in u and v (N^2 times fewer "
                     "points), results at the input's size (default 2; 1 with --preset paper)");
@@ -111,13 +118,12 @@ SourceOptions make_source_options(const PipelineOptions& o) {
     s.registration = parse_registration_mode(o.registration);
     if (!o.intrinsics.empty()) {
         const auto v = parse_numbers("--intrinsics", o.intrinsics, 4);
-        if (!(v[0] > 0 && v[1] > 0))
-            throw ParamError("--intrinsics '" + o.intrinsics + "': fx and fy must be > 0");
-        PinholeIntrinsics K;  // width and height 0: each frame's own size
+        PinholeIntrinsics K;  // width and height 0: each frame's own size, checked then
         K.fx = v[0];
         K.fy = v[1];
         K.cx = v[2];
         K.cy = v[3];
+        K.validate_unsized("--intrinsics '" + o.intrinsics + "'");
         s.intrinsics = K;
     }
     return s;
@@ -126,6 +132,11 @@ SourceOptions make_source_options(const PipelineOptions& o) {
 std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o) {
     if (o.select.empty()) return std::nullopt;
     const auto uv = parse_numbers("--select", o.select, 2);
+    // Checked before the conversion: a double outside int's range has no int value.
+    for (const double c : uv)
+        if (!(c >= 0 && c < kMaxSidePx))
+            throw ParamError("--select '" + o.select + "': U and V must be pixels in [0, " +
+                             std::to_string(kMaxSidePx) + ")");
     return std::make_pair(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
 }
 

@@ -34,6 +34,10 @@ struct PipelineOptions {
     std::optional<std::uint64_t> seed;
 };
 
+/// Registers --max-pixels on `cmd`: the largest image the readers decode (io.hpp), set as
+/// it is parsed (ParamError, exit 2, outside [1, 2^30]).
+void add_max_pixels_option(CLI::App* cmd);
+
 /// Registers the input positional (or --camera) and every shared option on `cmd`.
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o);
 

@@ -27,6 +27,7 @@ struct RunCommandOptions {
     bool ply = false;
     bool overlay = false;        // --overlay: OUT/<frame>/overlay.png
     bool quiet = false;
+    bool overwrite = false;
 };
 
 /// A one-line progress bar on stderr, only when stderr is a terminal.
@@ -110,6 +111,7 @@ void run(const RunCommandOptions& o) {
     r.max_frames = o.max_frames;
     r.ply = o.ply;
     r.overlay = o.overlay;
+    r.overwrite = o.overwrite;
     r.stop = stop_requested;
     apply_threads(o.pipeline);
 
@@ -141,6 +143,9 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("--video", opts->video,
                     "Also write a video: colour | objects | clusters (e.g. out.mp4)");
     cmd->add_flag("-q,--quiet", opts->quiet, "No progress bar");
+    cmd->add_flag("--overwrite", opts->overwrite,
+                  "Write into an output folder that holds other files too (only wul3d's own "
+                  "files there are replaced)");
     cmd->callback([opts]() { run(*opts); });
 }
 

@@ -6,6 +6,10 @@
 
 namespace wul3d {
 
+inline constexpr int kMaxSidePx = 65536;        ///< the longest image side of any intrinsics
+inline constexpr double kMinFocalPx = 0.01;     ///< bounds of validate_unsized
+inline constexpr double kMaxFocalPx = 1e8;
+
 /// Pinhole intrinsics of an undistorted camera, in pixels.
 /// Projection: u = fx * x / z + cx, v = fy * y / z + cy (x right, y down, z forward, metres).
 struct PinholeIntrinsics {
@@ -13,8 +17,15 @@ struct PinholeIntrinsics {
     int height = 0;
     double fx = 0, fy = 0, cx = 0, cy = 0;
 
-    /// Throws ParamError unless width, height, fx, fy are positive and finite.
+    /// Throws ParamError (one line starting with `what`) unless every value is finite and in
+    /// its physical range (docs/INPUTS.md, "Limits"): width and height in [1, 65536]; fx in
+    /// [width / 20, 1000 max(width, height)], fy likewise with height (a field of view from
+    /// about 170 down to 0.06 degrees); cx in [-width, 2 width], cy in [-height, 2 height].
     void validate(const std::string& what = "intrinsics") const;
+    /// The checks that need no image size, for intrinsics given before the frames' sizes are
+    /// known: finite, fx and fy in [0.01, 1e8], |cx| and |cy| <= 1e8.
+    void validate_unsized(const std::string& what = "intrinsics") const;
+    bool sized() const { return width != 0 || height != 0; }
     bool same_size(int w, int h) const { return width == w && height == h; }
 };
 

@@ -28,6 +28,11 @@ struct IoError : Error {
     using Error::Error;
 };
 
+/// A stop request (stop.hpp: SIGINT, SIGTERM) ended a computation before its end.
+struct Stopped : Error {
+    using Error::Error;
+};
+
 /// A live camera disappeared mid-run.
 struct DeviceLost : Error {
     using Error::Error;

@@ -15,13 +15,18 @@
 
 namespace wul3d {
 
+/// The largest boundary tolerance, in pixels: the work per boundary pixel grows with its
+/// square (50 px: 7845 neighbours; the reference's is 3 px at 640x480, 7 at 1920x1080).
+inline constexpr int kMaxBoundaryTolerancePx = 50;
+
 /// Parameters of the metric; the defaults are the reference's.
 struct EvalParams {
     /// Boundary tolerance as a fraction of the image diagonal: tol = ceil(fraction * diag) px
-    /// (3 px at 640x480). > 0.
+    /// (3 px at 640x480), at most kMaxBoundaryTolerancePx. In (0, 0.01].
     double boundary_fraction = 0.003;
-    /// >= 0: the boundary tolerance in pixels, overriding boundary_fraction (0 = boundary
-    /// pixels must coincide); -1 (default): from boundary_fraction.
+    /// In [0, kMaxBoundaryTolerancePx]: the boundary tolerance in pixels, overriding
+    /// boundary_fraction (0 = boundary pixels must coincide); -1 (default): from
+    /// boundary_fraction.
     int boundary_tolerance_px = -1;
     /// A ground-truth object counts as detected (%>=75) when its matched overlap F is
     /// strictly above this; [0, 1].
@@ -31,7 +36,8 @@ struct EvalParams {
 };
 
 /// The boundary tolerance in pixels for a width x height image: boundary_tolerance_px when
-/// >= 0, else ceil(boundary_fraction * sqrt(width^2 + height^2)).
+/// >= 0, else ceil(boundary_fraction * sqrt(width^2 + height^2)), at most
+/// kMaxBoundaryTolerancePx.
 int boundary_tolerance_px(const EvalParams& params, int width, int height);
 
 /// One matched (ground truth, prediction) pair of an image.

@@ -16,6 +16,31 @@
 
 namespace wul3d {
 
+// ---- limits -------------------------------------------------------------------------
+// Every reader opens regular files only (a FIFO, device or folder is refused by its type
+// before it is opened, so nothing blocks), checks a file's size before reading it, and an
+// image's size from its header before decoding it: no input can make wul3d allocate more
+// than these limits allow (docs/INPUTS.md, "Limits").
+
+/// The default largest image, width x height: 2^24 pixels (4096 x 4096, 5472 x 3072).
+inline constexpr std::uint64_t kDefaultMaxImagePixels = std::uint64_t{1} << 24;
+/// The most set_max_image_pixels accepts (and the old fixed limit): 2^30 pixels.
+inline constexpr std::uint64_t kMaxImagePixelsCeiling = std::uint64_t{1} << 30;
+/// The longest side of an image, in pixels.
+inline constexpr std::uint64_t kMaxImageSide = std::uint64_t{1} << 16;
+/// The largest JSON file read (intrinsics.json, a calibration): 1 MiB.
+inline constexpr std::uint64_t kMaxJsonBytes = std::uint64_t{1} << 20;
+/// The largest TUM list (rgb.txt, depth.txt): 256 MiB, some 6 million frames.
+inline constexpr std::uint64_t kMaxListBytes = std::uint64_t{1} << 28;
+
+/// Sets the largest image the readers decode, process-wide (the CLI's --max-pixels).
+/// ParamError outside [1, kMaxImagePixelsCeiling].
+void set_max_image_pixels(std::uint64_t pixels);
+std::uint64_t max_image_pixels();
+/// The largest image file read: 64 MiB plus 8 bytes per pixel of the image limit (a PNG
+/// stored without compression is at most about 6 bytes per 16-bit RGB pixel).
+std::uint64_t max_image_file_bytes();
+
 // ---- single files -------------------------------------------------------------------
 
 /// A 16-bit single-channel PNG. Throws InputError if missing, unreadable, truncated or not

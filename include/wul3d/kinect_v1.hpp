@@ -63,17 +63,26 @@ void kinect_v1_depth_to_raw(const DepthImage& depth, RegistrationWorkspace& ws,
 /// bytes libfreenect's depth callback receives; not a standard big-endian PGM).
 class FakenectDumpWriter {
 public:
-    /// Creates `dir` (it must not exist or be an empty folder). Throws IoError.
+    /// Writes into a new temporary folder beside `dir`, which finish() renames to `dir`
+    /// (which must not exist or be an empty folder): the dump is complete or absent. Throws
+    /// IoError.
     explicit FakenectDumpWriter(const std::string& dir, double fps = 30.0);
+    /// Without finish(), removes the files it wrote and its temporary folder.
+    ~FakenectDumpWriter();
+    FakenectDumpWriter(const FakenectDumpWriter&) = delete;
+    FakenectDumpWriter& operator=(const FakenectDumpWriter&) = delete;
     /// Appends one frame: colour first, then depth 1 ms later, both at frame time i / fps.
     /// Throws InputError if `color` is not 640x480 or `raw_depth` has not 640 * 480 values.
     void add(const ColorImage& color, const std::vector<std::uint16_t>& raw_depth);
-    /// Writes INDEX.txt. Without it fakenect has nothing to replay.
+    /// Writes INDEX.txt and renames the folder to `dir`. Without it fakenect has nothing to
+    /// replay.
     void finish();
     std::size_t frames() const { return frames_; }
 
 private:
     std::string dir_;
+    std::string tmp_;  ///< where the files go until finish()
+    bool finished_ = false;
     double fps_;
     std::size_t frames_ = 0;
     std::vector<std::string> index_;

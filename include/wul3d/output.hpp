@@ -15,15 +15,40 @@
 
 namespace wul3d {
 
-/// Writes `size` bytes to `path` through `<path>.tmp-<pid>` and a rename, so a failure never
-/// leaves a partial file under the final name. Throws IoError naming the path.
+/// The files wul3d writes directly in OUT, besides the frame folders: the run's summary
+/// and the per-frame statistics, one JSON line per frame, appended as frames are written.
+inline constexpr const char* kSummaryFile = "summary.json";
+inline constexpr const char* kFramesFile = "frames.jsonl";
+
+/// Writes `size` bytes to `path` through a temporary sibling `.wul3d.tmp-<pid>-<n>` (short
+/// whatever the name's length) and a rename, so a failure never leaves a partial file under
+/// the final name. Throws IoError naming the path.
 void write_file_atomic(const std::string& path, const void* data, std::size_t size);
 
-/// Makes the folder `dir` complete or not at all: `fill` writes into the hidden sibling
-/// `.<name>.partial` (created empty), which is then renamed to `dir`, replacing any folder
-/// of that name. If `fill` throws, the partial folder is removed and the exception goes on.
+/// Makes the folder `dir` complete or not at all: `fill` writes into a new hidden sibling
+/// `.wul3d.partial-<pid>-<n>`, which is then renamed to `dir`. Where `dir` exists already,
+/// the new files replace theirs one by one, those of `own_names` that the new folder lacks
+/// are removed, and nothing else in it is touched: a folder is never removed with files
+/// wul3d did not write. If `fill` throws, the partial folder is removed and the exception
+/// goes on; a failed rename is an IoError naming `dir`.
 void write_folder_atomic(const std::string& dir,
-                         const std::function<void(const std::string& tmp_dir)>& fill);
+                         const std::function<void(const std::string& tmp_dir)>& fill,
+                         const std::vector<std::string>& own_names = {});
+
+/// The files write_frame may write in OUT/<frame>/.
+const std::vector<std::string>& frame_output_files();
+
+/// Throws InputError unless `name` can be a frame folder in OUT: one path component (not
+/// empty, ".", ".." nor with '/'), at most 255 bytes, not starting with '.' (wul3d's
+/// temporaries), and neither kSummaryFile nor kFramesFile.
+void check_frame_name(const std::string& name);
+
+/// Makes OUT ready for a run: creates it if missing. An existing OUT may hold only what
+/// wul3d writes (kSummaryFile, kFramesFile, its temporaries, frame folders of
+/// frame_output_files()); anything else is an InputError naming it, unless `overwrite`,
+/// and even then only wul3d's own files are replaced (write_folder_atomic). Throws IoError
+/// when OUT cannot be created or listed.
+void prepare_out_dir(const std::string& out, bool overwrite);
 
 /// objects.json of one frame: every object with its boxes, colour and sources, and the
 /// support plane (null when none was found). `selected_id` != 0 adds "selected" to every

@@ -92,7 +92,8 @@ public:
     Pipeline(Pipeline&&) noexcept;
     Pipeline& operator=(Pipeline&&) noexcept;
 
-    /// Runs every stage on a registered frame.
+    /// Runs every stage on a registered frame. Throws Stopped when a stop is requested
+    /// (stop.hpp) during the frame; the Pipeline is then not to be used again.
     const FrameResult& process(const RgbdFrame& frame);
     /// The same on the caller's memory (image_view.hpp): read in place when its layout is the
     /// stages' own (packed rows, RGB, 16-bit depth), else converted once into the pipeline's

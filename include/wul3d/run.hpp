@@ -30,8 +30,12 @@ struct RunOptions {
     /// Follow the object under pixel (u, v) of the first frame: selected.png (its cluster),
     /// selected_object.png (its object) and "selected" in objects.json.
     std::optional<std::pair<int, int>> select;
-    /// Polled between frames: true ends the run as "signal" (outputs still complete).
+    /// Polled between frames: true ends the run as "signal" (outputs still complete). A stop
+    /// request (stop.hpp) also ends it, even mid-frame.
     std::function<bool()> stop;
+    /// An existing OUT may hold what wul3d did not write; only wul3d's own files there are
+    /// replaced (prepare_out_dir). Without it such an OUT is refused.
+    bool overwrite = false;
 };
 
 /// One processed frame, as the observer sees it (valid during the call only).
@@ -49,8 +53,10 @@ struct RunFrame {
 /// What a run did; also in summary.json.
 struct RunSummary {
     std::size_t frames = 0;
-    /// "end", "frames" (max_frames reached), "signal" (stop), "device_lost".
+    /// "end", "frames" (max_frames reached), "signal" (stop), "device_lost", "error" (a bad
+    /// frame, a full disk: the exception is rethrown after summary.json is written).
     std::string stopped_by = "end";
+    std::string error;  ///< the error line of "error" and "device_lost"; empty otherwise
     double ms_per_frame_median = 0;  ///< the pipeline's time, no disk I/O
     double fps = 0;
     double wall_s = 0;
@@ -74,9 +80,13 @@ public:
 };
 
 /// Runs `options.feed` through a Pipeline into `options.out_dir` exactly as `wul3d run`.
-/// Throws ParamError, InputError (unreadable input; a camera that ended before its first
-/// frame), IoError; DeviceLost when the camera disappears, after the outputs of the frames
-/// before are final and summary.json is written.
+/// OUT may not be, hold or lie in an input (ParamError), nor hold what wul3d did not write
+/// unless `overwrite` (InputError); every frame name must pass check_frame_name. Each frame's
+/// statistics are appended to OUT/frames.jsonl as it is written; OUT/summary.json is written
+/// however the run ends once OUT is prepared, with "stopped_by" and "error". Throws
+/// ParamError, InputError (unreadable input or frame; a camera that ended before its first
+/// frame), IoError (disk full); DeviceLost when the camera disappears. Every error but the
+/// first three checks is thrown after summary.json is written.
 RunSummary run_sequence(const RunOptions& options, RunObserver* observer = nullptr);
 
 }  // namespace wul3d
