@@ -33,7 +33,8 @@ FrameArrays check_frame_arrays(const py::object& color, const py::object& depth)
 /// there must match the arrays when given). Finite values, fx, fy > 0, else ValueError.
 PinholeIntrinsics to_intrinsics(const py::object& intrinsics, int width, int height);
 
-/// Copies the arrays into `frame`'s reused buffers (no allocation after the first frame of a
+/// Copies the arrays into `frame`'s reused buffers (float32 depth; uint16 depth goes through
+/// the library's frame view instead, module.cpp) (no allocation after the first frame of a
 /// size). float32 metres are stored in units of 0.1 mm, or coarser when the farthest depth
 /// would not fit 16 bits; NaN, infinite and non-positive depths become 0 (no depth). Runs
 /// without the GIL.

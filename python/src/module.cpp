@@ -24,6 +24,13 @@
 #include "wul3d/pipeline.hpp"
 #include "wul3d/registration.hpp"
 
+#if __has_include("wul3d/image_view.hpp")
+#include "wul3d/image_view.hpp"
+#define WUL3D_PYTHON_HAS_VIEW 1
+#else
+#define WUL3D_PYTHON_HAS_VIEW 0
+#endif
+
 namespace wul3d::python {
 namespace {
 
@@ -104,6 +111,28 @@ struct RunningScope {
     RunningScope& operator=(const RunningScope&) = delete;
 };
 
+#if WUL3D_PYTHON_HAS_VIEW
+/// The checked arrays as the library's frame view (image_view.hpp): C-contiguous uint16
+/// depth and RGB colour are the stages' own layout, read in place.
+FrameView frame_view(const FrameArrays& a, const PinholeIntrinsics& K, float depth_scale) {
+    FrameView v;
+    v.name = "frame";
+    v.intrinsics = K;
+    v.depth.data = a.depth.data();
+    v.depth.width = a.width;
+    v.depth.height = a.height;
+    v.depth.format = DepthFormat::U16;
+    v.depth.scale_m_per_unit = depth_scale;
+    if (a.has_color) {
+        v.color.data = static_cast<const std::uint8_t*>(a.color.data());
+        v.color.width = a.width;
+        v.color.height = a.height;
+        v.color.order = ColorOrder::RGB;
+    }
+    return v;
+}
+#endif
+
 /// wul3d.Pipeline: the C++ Pipeline, its reused input frame, and a lock so that two Python
 /// threads sharing one pipeline take turns (its state carries from frame to frame).
 class PyPipeline {
@@ -126,11 +155,22 @@ public:
             py::gil_scoped_release release;
             lock.lock();
             const RunningScope running;
-            frame_.name = "frame";
-            frame_.intrinsics = K;
-            fill_frame(arrays, static_cast<float>(depth_scale), frame_);
-            const auto t0 = std::chrono::steady_clock::now();
-            r = &pipeline_.process(frame_);
+            auto t0 = std::chrono::steady_clock::now();
+#if WUL3D_PYTHON_HAS_VIEW
+            if (!arrays.depth_is_float) {  // the caller's memory as it is: no copy
+                const FrameView view = frame_view(arrays, K, static_cast<float>(depth_scale));
+                t0 = std::chrono::steady_clock::now();
+                r = &pipeline_.process(view);
+            } else
+#endif
+            {
+                // float32 metres: converted here (0.1 mm steps, coarser beyond 6.55 m).
+                frame_.name = "frame";
+                frame_.intrinsics = K;
+                fill_frame(arrays, static_cast<float>(depth_scale), frame_);
+                t0 = std::chrono::steady_clock::now();
+                r = &pipeline_.process(frame_);
+            }
             call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
         Result out = make_result(*r);
@@ -484,8 +524,9 @@ Args:
     depth_scale (float): metres per unit of a uint16 depth (default 0.001, millimetres).
 
 C-contiguous arrays are required (TypeError for a wrong dtype, ValueError for a wrong shape
-or order). The GIL is released while the pipeline runs: pipelines in other threads run at
-the same time.
+or order). uint16 depth and RGB colour are read in place, not copied; float32 depth is
+converted once. The GIL is released while the pipeline runs: pipelines in other threads
+run at the same time (do not write to the arrays meanwhile).
 )doc")
         .def_property_readonly("params", [](const PyPipeline& p) { return params_dict(p.params()); },
                                "The parameters in force, as a dict (summary.json's names).");
