@@ -7,12 +7,21 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/plane.hpp"
 
 namespace wul3d {
+
+Scope parse_scope(const std::string& name) {
+    if (name == "support") return Scope::Support;
+    if (name == "scene") return Scope::Scene;
+    throw ParamError("--scope '" + name + "': unknown (known: support, scene)");
+}
+
+const char* scope_name(Scope s) { return s == Scope::Support ? "support" : "scene"; }
 
 Segmenter parse_segmenter(const std::string& name) {
     if (name == "geometric") return Segmenter::Geometric;
@@ -65,6 +74,9 @@ void SegmentParams::validate() const {
     require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
     require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
     require(gap_max_px >= 0, "gap_max_px", gap_max_px, ">= 0");
+    require(scope_contact_m > 0, "scope_contact_m", scope_contact_m, "> 0");
+    require(scope_max_height_m > 0, "scope_max_height_m", scope_max_height_m, "> 0");
+    require(scope_max_outside >= 0 && scope_max_outside <= 1, "scope_max_outside", scope_max_outside, "in [0, 1]");
 }
 
 namespace {
@@ -755,6 +767,141 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     return splits;
 }
 
+/// Scope::Support (docs/DESIGN.md, "Scope"): keeps the segments the support holds and
+/// clears the others' labels in ws.label. In: ws.label (1..n with gaps), the support, the
+/// plane's classes. Out: the number of segments of min_points or more left out. Cost: one
+/// pass over the pixels (heights, outlines, touching pairs), then a few passes over the
+/// touching pairs until "rests on" stops spreading.
+int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    const int W = x.W, H = x.H;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.scope_lo.assign(L, std::numeric_limits<float>::max());
+    ws.scope_hi.assign(L, -std::numeric_limits<float>::max());
+    ws.scope_high.assign(L, 0);
+    ws.scope_outline.assign(L, 0);
+    ws.scope_outside.assign(L, 0);
+    ws.sizes.assign(L, 0);
+    ws.edges.clear();
+    const int* const label = ws.label.data();
+    const SegmentParams& prm = x.prm;
+    auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
+    // A removed point clearly above the support (by more than the depth noise at its depth)
+    // was removed for lying off the support's hull: the segment that runs on into it, with
+    // continuous depth, continues beyond the support's volume.
+    auto beyond = [&](std::size_t q, std::size_t p) {
+        if (!x.c.valid[q] || x.cls[q] != kPlaneRemoved || !x.connected(p, q)) return false;
+        const float z = x.c.z[q];
+        return height(q) > prm.depth_jump_m + prm.depth_jump_rel * z * z;
+    };
+    // The frame's edge: the image border and the rows and columns with no depth at all that
+    // reach it, when they are a narrow band (a sensor's registration border: 48 rows and 63
+    // columns of a Kinect v1's 640x480). A segment cut there goes on out of view. A wider
+    // band without depth is a view past the depth range or a crop, which says nothing of
+    // what the segment does there.
+    int top = 0, bottom = H, left = 0, right = W;
+    auto row_empty = [&](int v) {
+        for (int u = 0; u < W; ++u)
+            if (x.c.valid[static_cast<std::size_t>(v) * W + u]) return false;
+        return true;
+    };
+    auto col_empty = [&](int u) {
+        for (int v = 0; v < H; ++v)
+            if (x.c.valid[static_cast<std::size_t>(v) * W + u]) return false;
+        return true;
+    };
+    while (top < H && row_empty(top)) ++top;
+    while (bottom > top && row_empty(bottom - 1)) --bottom;
+    while (left < W && col_empty(left)) ++left;
+    while (right > left && col_empty(right - 1)) --right;
+    const int band_rows = H / 8, band_cols = W / 8;
+    const int edge_top = top <= band_rows ? top : -1, edge_bottom = H - bottom <= band_rows ? bottom - 1 : -1;
+    const int edge_left = left <= band_cols ? left : -1, edge_right = W - right <= band_cols ? right - 1 : -1;
+    // The support's middle in depth: the mean depth of the removed points on it. Walls and
+    // furniture leave the volume beyond it; on the near half an object cut by the frame (at
+    // the bottom or the sides of a tabletop view), or by the hull where the frame hides the
+    // table's near edge, is still on the table.
+    double table_z = 0, table_n = 0;
+    for (std::size_t p = 0; p < x.c.size(); ++p) {
+        if (!x.c.valid[p] || x.cls[p] != kPlaneRemoved) continue;
+        const float z = x.c.z[p];
+        if (std::fabs(height(p)) > prm.depth_jump_m + prm.depth_jump_rel * z * z) continue;
+        table_z += z;
+        table_n += 1;
+    }
+    const float far_z = table_n > 0 ? static_cast<float>(table_z / table_n) : 0.0f;
+    // Outline pairs: touching segment pairs, and the pairs that lead out of the volume.
+    auto pair = [&](std::size_t p, std::size_t q) {
+        const int a = label[p], b = label[q];
+        if (a == b) return;
+        if (a) ++ws.scope_outline[static_cast<std::size_t>(a)];
+        if (b) ++ws.scope_outline[static_cast<std::size_t>(b)];
+        if (a && b) {
+            ws.edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
+                               static_cast<std::uint64_t>(std::max(a, b)) << 1);
+        } else if (a) {
+            ws.scope_outside[static_cast<std::size_t>(a)] += x.c.z[p] > far_z && beyond(q, p);
+        } else {
+            ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
+        }
+    };
+    for (int v = top; v < bottom; ++v)
+        for (int u = left; u < right; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            if (const int l = label[p]) {
+                const float h = height(p);
+                const auto li = static_cast<std::size_t>(l);
+                ws.scope_lo[li] = std::min(ws.scope_lo[li], h);
+                ws.scope_hi[li] = std::max(ws.scope_hi[li], h);
+                ws.scope_high[li] += h > prm.scope_max_height_m;
+                ++ws.sizes[li];
+                // On the frame's edge, beyond the support's middle.
+                const int on_edge = x.c.z[p] > far_z ? (v == edge_top) + (u == edge_left) +
+                                                           (u == edge_right) + (v == edge_bottom)
+                                                     : 0;
+                ws.scope_outline[li] += on_edge;
+                ws.scope_outside[li] += on_edge;
+            }
+            if (u + 1 < right) pair(p, p + 1);
+            if (v + 1 < bottom) pair(p, p + static_cast<std::size_t>(W));
+        }
+    std::sort(ws.edges.begin(), ws.edges.end());
+    ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
+    // Inside the volume: under the height limit (2 % of the points may be noise) and not
+    // running on past the hull or out of view. Stands: the lowest point touches the support.
+    // scope_keep: bit 0 inside, bit 1 kept.
+    auto& keep = ws.scope_keep;
+    keep.assign(L, 0);
+    for (std::size_t l = 1; l < L; ++l) {
+        if (ws.sizes[l] == 0) continue;
+        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
+                            static_cast<float>(ws.scope_outside[l]) <=
+                                prm.scope_max_outside * static_cast<float>(ws.scope_outline[l]);
+        keep[l] = static_cast<std::uint8_t>(inside ? (ws.scope_lo[l] <= prm.scope_contact_m ? 3 : 1) : 0);
+    }
+    // Rests on: touches a kept segment in the image (a box on a box, a lid on a tin, an
+    // object behind another with its foot hidden). No height test: a supported object's
+    // visible bottom can lie well above its supporter's visible top (a tin's lid overhangs
+    // what it stands on), and what hangs or is fixed to a wall has already left the volume.
+    // Spreads until nothing changes.
+    for (bool grew = true; grew;) {
+        grew = false;
+        for (const std::uint64_t e : ws.edges) {
+            const auto a = static_cast<std::size_t>(e >> 33), b = static_cast<std::size_t>((e >> 1) & 0xffffffffu);
+            for (const auto& [s, t] : {std::pair{a, b}, std::pair{b, a}}) {
+                if (keep[s] != 3 || keep[t] != 1) continue;
+                keep[t] = 3;
+                grew = true;
+            }
+        }
+    }
+    int left_out = 0;
+    for (std::size_t l = 1; l < L; ++l)
+        left_out += keep[l] != 3 && ws.sizes[l] >= prm.min_points;
+    for (int& l : ws.label)
+        if (l && keep[static_cast<std::size_t>(l)] != 3) l = 0;
+    return left_out;
+}
+
 }  // namespace
 
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
@@ -901,6 +1048,11 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     if (params.segmenter != Segmenter::Kmeans) {
         stats.gaps_filled = fill_container_gaps(x, ws);
         stats.ms.gaps = ms_since();
+    }
+    if (support && params.scope == Scope::Support) {
+        stats.support_scope = true;
+        stats.out_of_scope = restrict_to_support(x, *support, ws, n);
+        stats.ms.scope = ms_since();
     }
     out.width = W;
     out.height = H;

@@ -105,7 +105,9 @@ std::string objects_json(const FrameResult& r, int selected_id) {
         if (selected_id != 0) o["selected"] = d.id == selected_id;
         objs.push_back(std::move(o));
     }
-    nlohmann::json j = {{"objects", objs}, {"support_plane", nullptr}};
+    nlohmann::json j = {{"objects", objs},
+                        {"scope", r.segment_stats.support_scope ? "support" : "scene"},
+                        {"support_plane", nullptr}};
     if (r.plane.found) {
         const Plane& pl = r.plane.support;
         j["support_plane"] = {{"normal", {pl.nx, pl.ny, pl.nz}}, {"d_m", pl.d}};
@@ -257,6 +259,8 @@ void run(const RunOptions& o) {
                             {"containers", r.segment_stats.containers},
                             {"gaps_filled", r.segment_stats.gaps_filled},
                             {"color_splits", r.segment_stats.color_splits},
+                            {"scope", r.segment_stats.support_scope ? "support" : "scene"},
+                            {"out_of_scope", r.segment_stats.out_of_scope},
                             {"objects", r.object_list.size()}};
         if (selection) f["selected_pixels"] = selection->pixels();
         per_frame.push_back(std::move(f));
@@ -301,6 +305,7 @@ void run(const RunOptions& o) {
                              {"zmax_m", params.range.zmax_m},
                              {"normal_radius_px", params.normals.radius_px},
                              {"segmenter", segmenter_name(params.segmentation.segmenter)},
+                             {"scope", scope_name(params.segmentation.scope)},
                              {"remove_plane", params.remove_plane},
                              {"min_points", params.segmentation.min_points},
                              {"object_psi", params.objects.psi},
