@@ -66,8 +66,9 @@ void SegmentParams::validate() const {
             "in [0.002, 0.1] (the paper's range of alpha)");
     require(color_min_distance > 0, "color_min_distance", color_min_distance, "> 0");
     require(color_min_share > 0 && color_min_share <= 0.5f, "color_min_share", color_min_share, "in (0, 0.5]");
-    require(color_max_boundary > 0, "color_max_boundary", color_max_boundary, "> 0");
+    require(color_max_boundary > 0 && color_max_boundary <= 1, "color_max_boundary", color_max_boundary, "in (0, 1]");
     require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
+    require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
     require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");
     require(rim_max_residual_m > 0, "rim_max_residual_m", rim_max_residual_m, "> 0");
     require(rim_min_arc > 0 && rim_min_arc <= 1, "rim_min_arc", rim_min_arc, "in (0, 1]");
@@ -614,15 +615,28 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     ws.feature.resize(6 * M);
     float* f[6];
     for (int q = 0; q < 6; ++q) f[q] = ws.feature.data() + static_cast<std::size_t>(q) * M;
+    // The colour term is the chromaticity, rgb / (r + g + b), at the scale of 8-bit colour
+    // (a grey pixel of any brightness: 85, 85, 85): light falling on two faces of one box at
+    // other angles scales their colour and leaves it, so the two parts are two materials,
+    // not a lit face and a shaded one. kDark keeps the chromaticity of dark, noisy pixels
+    // near grey.
+    constexpr float kDark = 30.0f;
+    auto chroma = [&](std::size_t p, float* out) {
+        const float r = x.c.r[p], g = x.c.g[p], b = x.c.b[p];
+        const float k = 255.0f / (r + g + b + kDark);
+        out[0] = k * (r + kDark / 3), out[1] = k * (g + kDark / 3), out[2] = k * (b + kDark / 3);
+    };
 #pragma omp parallel for schedule(static)
     for (int i = first; i < last; ++i) {
         const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
         f[0][i - first] = cp.delta * x.c.x[p];
         f[1][i - first] = cp.delta * x.c.y[p];
         f[2][i - first] = cp.delta * x.c.z[p];
-        f[3][i - first] = cp.alpha * x.c.r[p];
-        f[4][i - first] = cp.alpha * x.c.g[p];
-        f[5][i - first] = cp.alpha * x.c.b[p];
+        float c[3];
+        chroma(p, c);
+        f[3][i - first] = cp.alpha * c[0];
+        f[4][i - first] = cp.alpha * c[1];
+        f[5][i - first] = cp.alpha * c[2];
     }
     const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
     const int s = prm.crease_step_px;
@@ -645,17 +659,19 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         const int m = size_of(l);
         const int fo = o - first;  // the segment's first position in the feature planes
         std::uint8_t* part = ws.part.data();
-        // Seeds: the pixel farthest in colour from the mean, then the one farthest from it.
+        // Seeds: the pixel farthest in colour (the feature's) from the mean, then the one
+        // farthest from it.
+        const float *const cr = f[3] + fo, *const cg = f[4] + fo, *const cb = f[5] + fo;
         double mr = 0, mg = 0, mb = 0;
         for (int i = 0; i < m; ++i) {
-            mr += x.c.r[px[i]]; mg += x.c.g[px[i]]; mb += x.c.b[px[i]];
+            mr += cr[i]; mg += cg[i]; mb += cb[i];
         }
         mr /= m; mg /= m; mb /= m;
         auto farthest = [&](double r, double g, double b) {
             int best = 0;
             double bd = -1;
             for (int i = 0; i < m; ++i) {
-                const double dr = x.c.r[px[i]] - r, dg = x.c.g[px[i]] - g, db = x.c.b[px[i]] - b;
+                const double dr = cr[i] - r, dg = cg[i] - g, db = cb[i] - b;
                 const double d = dr * dr + dg * dg + db * db;
                 if (d > bd) { bd = d; best = i; }
             }
@@ -666,10 +682,10 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         // segment's colour diameter apart, at most twice the farthest colour from the mean:
         // below the minimum distance no split can be kept.
         {
-            const double dr = x.c.r[px[a0]] - mr, dg = x.c.g[px[a0]] - mg, db = x.c.b[px[a0]] - mb;
-            if (2 * std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
+            const double dr = cr[a0] - mr, dg = cg[a0] - mg, db = cb[a0] - mb;
+            if (2 * std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance * cp.alpha) continue;
         }
-        const int b0 = farthest(x.c.r[px[a0]], x.c.g[px[a0]], x.c.b[px[a0]]);
+        const int b0 = farthest(cr[a0], cg[a0], cb[a0]);
         float cen[2][6];
         for (int q = 0; q < 6; ++q) {
             cen[0][q] = f[q][fo + a0];
@@ -727,10 +743,18 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
         // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
         // crease step away on either side tell a smooth surface from a fold.
-        int boundary = 0, with_normals = 0, smooth = 0;
+        // The smaller part's outline: 4-neighbour pairs from it to anything else.
+        const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
+        int boundary = 0, with_normals = 0, smooth = 0, small_outline = 0;
         for (int i = 0; i < m; ++i) {
             const int p = px[i];
             const int u = p % W, v = p / W;
+            if (part[p] == small_part) {
+                const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
+                                   v + 1 < x.H ? p + W : -1};
+                for (const int q : nb)
+                    small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
+            }
             const int dirs[2][2] = {{1, 0}, {0, 1}};
             for (const auto& dd : dirs) {
                 if (u + dd[0] >= W || v + dd[1] >= x.H) continue;
@@ -746,10 +770,22 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
                 ++with_normals;
             }
         }
-        if (static_cast<float>(boundary) > prm.color_max_boundary * std::sqrt(static_cast<float>(small))) continue;
+        // A contact between two objects is one side of the smaller one's outline; a split
+        // along a texture (stripes, print) runs round most of each piece.
+        if (static_cast<float>(boundary) > prm.color_max_boundary * static_cast<float>(small_outline)) continue;
         // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
-        // straddle its edge).
-        if (with_normals == 0 || 10 * smooth < 7 * with_normals) continue;
+        // straddle its edge), or the parts must differ in chromaticity: light falling on two
+        // faces of one box at other angles scales their colour, it does not turn it, so
+        // across a fold (a flat box on another, flush boxes of two heights) only a change of
+        // material turns the mean colour by color_min_hue_deg.
+        const bool across_smooth = with_normals > 0 && 10 * smooth >= 7 * with_normals;
+        if (!across_smooth) {
+            const float r0 = cen[0][3], g0 = cen[0][4], b0c = cen[0][5];
+            const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
+            const float dot = r0 * r1 + g0 * g1 + b0c * b1c;
+            const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
+            if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) continue;
+        }
         ws.split[static_cast<std::size_t>(l)] = 1;
     }
     int splits = 0, next = n;

@@ -349,3 +349,34 @@ TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
     EXPECT_NE(ib, 0);
     EXPECT_EQ(stats.out_of_scope, 0);
 }
+
+// Two flush boxes of different colours and heights: the colour boundary runs up the front
+// faces and then along the lower box's top edge, a fold, so it is not "across a smooth
+// surface" for most of its length. The parts' colours differ in chromaticity, which shading
+// alone cannot do, and their boundary is one side of the smaller part: the colour cue
+// splits them.
+TEST(SegmentObjects, FlushBoxesOfTwoHeights_SeparatedAcrossTheFold) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 5;
+    SceneBox tall;
+    tall.x = -0.06f;
+    tall.z = 1.0f;
+    tall.w = 0.12f;
+    tall.h = 0.16f;
+    tall.d = 0.12f;
+    tall.r = 40; tall.g = 170; tall.b = 60;
+    SceneBox low = tall;
+    low.x = 0.06f;
+    low.h = 0.07f;
+    low.r = 220; low.g = 40; low.b = 160;
+    s.boxes = {tall, low};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage hyb = segment(s, Segmenter::Hybrid, truth, &stats);
+    int a = 0, b = 0;
+    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(b, 0);
+    EXPECT_NE(a, b) << "the two boxes are one object";
+}

@@ -65,9 +65,14 @@ struct SegmentParams {
     float color_alpha = 0.02f;      ///< alpha of eq. (4) for the split; [0.002, 0.1]
     float color_min_distance = 45;  ///< RGB distance (0-255) between the parts' means; > 0
     float color_min_share = 0.15f;  ///< each part holds at least this share; (0, 0.5]
-    float color_max_boundary = 2.5f;  ///< boundary pairs / sqrt(smaller part) at most; > 0
+    float color_max_boundary = 0.5f;  ///< boundary pairs / the smaller part's outline pairs
+                                      ///< at most: a contact is one side of it; (0, 1]
     float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
                                       ///< step away on either side) within this angle; > 0
+    float color_min_hue_deg = 10;     ///< ... or else (the boundary follows a fold) the parts'
+                                      ///< mean RGB vectors differ by this angle: shading
+                                      ///< scales a colour, only another material turns it;
+                                      ///< (0, 90)
     // Containers (needs the support plane): a bowl or a cup seen from above shows its outer
     // wall and, over the front rim, its inside; the rim hides the inside's lower part, so
     // the two meet only across a depth step, where no crease test or merge can join them.
