@@ -100,12 +100,17 @@ def main():
         run(a.wul3d, whole, out, flags)
         names = sorted(p.name for p in whole.iterdir() if (p / "depth.png").is_file())
         rows.append(("whole frames (osd_uncropped)", score(a.wul3d, out, whole)))
-        cropped = a.work / f"osd_mosd_cropped.{tag}"
         if "osd" in sets:
             cropped = a.work / f"osd_mosd.{tag}"
         else:
+            # The cropped frames alone: a folder of links to them, run as one input.
+            links = a.work / "osd_mosd_cropped_frames"
+            links.mkdir(exist_ok=True)
             for n in names:
-                run(a.wul3d, osd / n, cropped / n, flags)
+                if not (links / n).exists():
+                    (links / n).symlink_to((osd / n).resolve())
+            cropped = a.work / f"osd_mosd_cropped.{tag}"
+            run(a.wul3d, links, cropped, flags)
         rows.append(("the same scenes cropped (osd_mosd)", score(a.wul3d, cropped, osd, names)))
     for key, seeds in (("tune", a.tune), ("report", a.report)):
         if key not in sets:
