@@ -14,6 +14,8 @@
 #   libgtest-dev libgmock-dev                      the test suite (tests/)
 #   libbenchmark-dev                               the benchmarks (bench/)
 #   python3 python3-matplotlib                     helper scripts; the bench plot (scripts/plot-bench.py)
+#   python3-numpy python3-pil                      eval/scenegen.py (generated scenes) and its test;
+#                                                  named, though python3-matplotlib brings them
 #   libglfw3-dev libgl-dev libimgui-dev            `wul3d view` (GLFW 3, OpenGL, Dear ImGui with its
 #                                                  GLFW/OpenGL 3 backends); built only when found
 #   xvfb xauth libgl1-mesa-dri                     the viewer's test: a virtual X server (xvfb-run)
@@ -51,6 +53,8 @@ packages=(
   libtbb-dev
   python3
   python3-matplotlib
+  python3-numpy
+  python3-pil
   libglfw3-dev
   libgl-dev
   libimgui-dev

@@ -189,7 +189,9 @@ std::string objects_json(const FrameResult& r, int selected_id) {
         if (selected_id != 0) o["selected"] = d.id == selected_id;
         objs.push_back(std::move(o));
     }
-    nlohmann::json j = {{"objects", objs}, {"support_plane", nullptr}};
+    nlohmann::json j = {{"objects", objs},
+                        {"scope", r.segment_stats.support_scope ? "support" : "scene"},
+                        {"support_plane", nullptr}};
     if (r.plane.found) {
         const Plane& pl = r.plane.support;
         j["support_plane"] = {{"normal", {pl.nx, pl.ny, pl.nz}}, {"d_m", pl.d}};

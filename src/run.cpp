@@ -55,6 +55,7 @@ nlohmann::json parameters_json(const PipelineParams& params, const std::string& 
             {"zmax_m", params.range.zmax_m},
             {"normal_radius_px", params.normals.radius_px},
             {"segmenter", segmenter_name(params.segmentation.segmenter)},
+            {"scope", scope_name(params.segmentation.scope)},
             {"remove_plane", params.remove_plane},
             {"min_points", params.segmentation.min_points},
             {"object_psi", params.objects.psi},
@@ -77,6 +78,8 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"containers", r.segment_stats.containers},
             {"gaps_filled", r.segment_stats.gaps_filled},
             {"color_splits", r.segment_stats.color_splits},
+            {"scope", r.segment_stats.support_scope ? "support" : "scene"},
+            {"out_of_scope", r.segment_stats.out_of_scope},
             {"objects", r.object_list.size()}};
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "param_check.hpp"
 #include "wul3d/clustering.hpp"  // distance_f, ClusterParams: the kmeans segmenter
@@ -15,6 +16,14 @@
 #include "wul3d/plane.hpp"
 
 namespace wul3d {
+
+Scope parse_scope(const std::string& name) {
+    if (name == "support") return Scope::Support;
+    if (name == "scene") return Scope::Scene;
+    throw ParamError("--scope '" + name + "': unknown (known: support, scene)");
+}
+
+const char* scope_name(Scope s) { return s == Scope::Support ? "support" : "scene"; }
 
 Segmenter parse_segmenter(const std::string& name) {
     if (name == "geometric") return Segmenter::Geometric;
@@ -59,14 +68,18 @@ void SegmentParams::validate() const {
             "in [0.002, 0.1] (the paper's range of alpha)");
     require(color_min_distance > 0, "color_min_distance", color_min_distance, "> 0");
     require(color_min_share > 0 && color_min_share <= 0.5f, "color_min_share", color_min_share, "in (0, 0.5]");
-    require(color_max_boundary > 0, "color_max_boundary", color_max_boundary, "> 0");
+    require(color_max_boundary > 0 && color_max_boundary <= 1, "color_max_boundary", color_max_boundary, "in (0, 1]");
     require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
+    require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
     require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");
     require(rim_max_residual_m > 0, "rim_max_residual_m", rim_max_residual_m, "> 0");
     require(rim_min_arc > 0 && rim_min_arc <= 1, "rim_min_arc", rim_min_arc, "in (0, 1]");
     require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
     require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
     require(gap_max_px >= 0, "gap_max_px", gap_max_px, ">= 0");
+    require(scope_contact_m > 0, "scope_contact_m", scope_contact_m, "> 0");
+    require(scope_max_height_m > 0, "scope_max_height_m", scope_max_height_m, "> 0");
+    require(scope_max_outside >= 0 && scope_max_outside <= 1, "scope_max_outside", scope_max_outside, "in [0, 1]");
 }
 
 namespace {
@@ -604,15 +617,28 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
     ws.feature.resize(6 * M);
     float* f[6];
     for (int q = 0; q < 6; ++q) f[q] = ws.feature.data() + static_cast<std::size_t>(q) * M;
+    // The colour term is the chromaticity, rgb / (r + g + b), at the scale of 8-bit colour
+    // (a grey pixel of any brightness: 85, 85, 85): light falling on two faces of one box at
+    // other angles scales their colour and leaves it, so the two parts are two materials,
+    // not a lit face and a shaded one. kDark keeps the chromaticity of dark, noisy pixels
+    // near grey.
+    constexpr float kDark = 30.0f;
+    auto chroma = [&](std::size_t p, float* out) {
+        const float r = x.c.r[p], g = x.c.g[p], b = x.c.b[p];
+        const float k = 255.0f / (r + g + b + kDark);
+        out[0] = k * (r + kDark / 3), out[1] = k * (g + kDark / 3), out[2] = k * (b + kDark / 3);
+    };
 #pragma omp parallel for schedule(static)
     for (int i = first; i < last; ++i) {
         const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
         f[0][i - first] = cp.delta * x.c.x[p];
         f[1][i - first] = cp.delta * x.c.y[p];
         f[2][i - first] = cp.delta * x.c.z[p];
-        f[3][i - first] = cp.alpha * x.c.r[p];
-        f[4][i - first] = cp.alpha * x.c.g[p];
-        f[5][i - first] = cp.alpha * x.c.b[p];
+        float c[3];
+        chroma(p, c);
+        f[3][i - first] = cp.alpha * c[0];
+        f[4][i - first] = cp.alpha * c[1];
+        f[5][i - first] = cp.alpha * c[2];
     }
     const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
     const int s = prm.crease_step_px;
@@ -635,17 +661,19 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         const int m = size_of(l);
         const int fo = o - first;  // the segment's first position in the feature planes
         std::uint8_t* part = ws.part.data();
-        // Seeds: the pixel farthest in colour from the mean, then the one farthest from it.
+        // Seeds: the pixel farthest in colour (the feature's) from the mean, then the one
+        // farthest from it.
+        const float *const cr = f[3] + fo, *const cg = f[4] + fo, *const cb = f[5] + fo;
         double mr = 0, mg = 0, mb = 0;
         for (int i = 0; i < m; ++i) {
-            mr += x.c.r[px[i]]; mg += x.c.g[px[i]]; mb += x.c.b[px[i]];
+            mr += cr[i]; mg += cg[i]; mb += cb[i];
         }
         mr /= m; mg /= m; mb /= m;
         auto farthest = [&](double r, double g, double b) {
             int best = 0;
             double bd = -1;
             for (int i = 0; i < m; ++i) {
-                const double dr = x.c.r[px[i]] - r, dg = x.c.g[px[i]] - g, db = x.c.b[px[i]] - b;
+                const double dr = cr[i] - r, dg = cg[i] - g, db = cb[i] - b;
                 const double d = dr * dr + dg * dg + db * db;
                 if (d > bd) { bd = d; best = i; }
             }
@@ -656,10 +684,10 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         // segment's colour diameter apart, at most twice the farthest colour from the mean:
         // below the minimum distance no split can be kept.
         {
-            const double dr = x.c.r[px[a0]] - mr, dg = x.c.g[px[a0]] - mg, db = x.c.b[px[a0]] - mb;
-            if (2 * std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
+            const double dr = cr[a0] - mr, dg = cg[a0] - mg, db = cb[a0] - mb;
+            if (2 * std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance * cp.alpha) continue;
         }
-        const int b0 = farthest(x.c.r[px[a0]], x.c.g[px[a0]], x.c.b[px[a0]]);
+        const int b0 = farthest(cr[a0], cg[a0], cb[a0]);
         float cen[2][6];
         for (int q = 0; q < 6; ++q) {
             cen[0][q] = f[q][fo + a0];
@@ -717,10 +745,18 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) continue;
         // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
         // crease step away on either side tell a smooth surface from a fold.
-        int boundary = 0, with_normals = 0, smooth = 0;
+        // The smaller part's outline: 4-neighbour pairs from it to anything else.
+        const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
+        int boundary = 0, with_normals = 0, smooth = 0, small_outline = 0;
         for (int i = 0; i < m; ++i) {
             const int p = px[i];
             const int u = p % W, v = p / W;
+            if (part[p] == small_part) {
+                const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
+                                   v + 1 < x.H ? p + W : -1};
+                for (const int q : nb)
+                    small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
+            }
             const int dirs[2][2] = {{1, 0}, {0, 1}};
             for (const auto& dd : dirs) {
                 if (u + dd[0] >= W || v + dd[1] >= x.H) continue;
@@ -736,10 +772,22 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
                 ++with_normals;
             }
         }
-        if (static_cast<float>(boundary) > prm.color_max_boundary * std::sqrt(static_cast<float>(small))) continue;
+        // A contact between two objects is one side of the smaller one's outline; a split
+        // along a texture (stripes, print) runs round most of each piece.
+        if (static_cast<float>(boundary) > prm.color_max_boundary * static_cast<float>(small_outline)) continue;
         // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
-        // straddle its edge).
-        if (with_normals == 0 || 10 * smooth < 7 * with_normals) continue;
+        // straddle its edge), or the parts must differ in chromaticity: light falling on two
+        // faces of one box at other angles scales their colour, it does not turn it, so
+        // across a fold (a flat box on another, flush boxes of two heights) only a change of
+        // material turns the mean colour by color_min_hue_deg.
+        const bool across_smooth = with_normals > 0 && 10 * smooth >= 7 * with_normals;
+        if (!across_smooth) {
+            const float r0 = cen[0][3], g0 = cen[0][4], b0c = cen[0][5];
+            const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
+            const float dot = r0 * r1 + g0 * g1 + b0c * b1c;
+            const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
+            if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) continue;
+        }
         ws.split[static_cast<std::size_t>(l)] = 1;
     }
     int splits = 0, next = n;
@@ -755,6 +803,141 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         ++splits;
     }
     return splits;
+}
+
+/// Scope::Support (docs/DESIGN.md, "Scope"): keeps the segments the support holds and
+/// clears the others' labels in ws.label. In: ws.label (1..n with gaps), the support, the
+/// plane's classes. Out: the number of segments of min_points or more left out. Cost: one
+/// pass over the pixels (heights, outlines, touching pairs), then a few passes over the
+/// touching pairs until "rests on" stops spreading.
+int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    const int W = x.W, H = x.H;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.scope_lo.assign(L, std::numeric_limits<float>::max());
+    ws.scope_hi.assign(L, -std::numeric_limits<float>::max());
+    ws.scope_high.assign(L, 0);
+    ws.scope_outline.assign(L, 0);
+    ws.scope_outside.assign(L, 0);
+    ws.sizes.assign(L, 0);
+    ws.edges.clear();
+    const int* const label = ws.label.data();
+    const SegmentParams& prm = x.prm;
+    auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
+    // A removed point clearly above the support (by more than the depth noise at its depth)
+    // was removed for lying off the support's hull: the segment that runs on into it, with
+    // continuous depth, continues beyond the support's volume.
+    auto beyond = [&](std::size_t q, std::size_t p) {
+        if (!x.c.valid[q] || x.cls[q] != kPlaneRemoved || !x.connected(p, q)) return false;
+        const float z = x.c.z[q];
+        return height(q) > prm.depth_jump_m + prm.depth_jump_rel * z * z;
+    };
+    // The frame's edge: the image border and the rows and columns with no depth at all that
+    // reach it, when they are a narrow band (a sensor's registration border: 48 rows and 63
+    // columns of a Kinect v1's 640x480). A segment cut there goes on out of view. A wider
+    // band without depth is a view past the depth range or a crop, which says nothing of
+    // what the segment does there.
+    int top = 0, bottom = H, left = 0, right = W;
+    auto row_empty = [&](int v) {
+        for (int u = 0; u < W; ++u)
+            if (x.c.valid[static_cast<std::size_t>(v) * W + u]) return false;
+        return true;
+    };
+    auto col_empty = [&](int u) {
+        for (int v = 0; v < H; ++v)
+            if (x.c.valid[static_cast<std::size_t>(v) * W + u]) return false;
+        return true;
+    };
+    while (top < H && row_empty(top)) ++top;
+    while (bottom > top && row_empty(bottom - 1)) --bottom;
+    while (left < W && col_empty(left)) ++left;
+    while (right > left && col_empty(right - 1)) --right;
+    const int band_rows = H / 8, band_cols = W / 8;
+    const int edge_top = top <= band_rows ? top : -1, edge_bottom = H - bottom <= band_rows ? bottom - 1 : -1;
+    const int edge_left = left <= band_cols ? left : -1, edge_right = W - right <= band_cols ? right - 1 : -1;
+    // The support's middle in depth: the mean depth of the removed points on it. Walls and
+    // furniture leave the volume beyond it; on the near half an object cut by the frame (at
+    // the bottom or the sides of a tabletop view), or by the hull where the frame hides the
+    // table's near edge, is still on the table.
+    double table_z = 0, table_n = 0;
+    for (std::size_t p = 0; p < x.c.size(); ++p) {
+        if (!x.c.valid[p] || x.cls[p] != kPlaneRemoved) continue;
+        const float z = x.c.z[p];
+        if (std::fabs(height(p)) > prm.depth_jump_m + prm.depth_jump_rel * z * z) continue;
+        table_z += z;
+        table_n += 1;
+    }
+    const float far_z = table_n > 0 ? static_cast<float>(table_z / table_n) : 0.0f;
+    // Outline pairs: touching segment pairs, and the pairs that lead out of the volume.
+    auto pair = [&](std::size_t p, std::size_t q) {
+        const int a = label[p], b = label[q];
+        if (a == b) return;
+        if (a) ++ws.scope_outline[static_cast<std::size_t>(a)];
+        if (b) ++ws.scope_outline[static_cast<std::size_t>(b)];
+        if (a && b) {
+            ws.edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
+                               static_cast<std::uint64_t>(std::max(a, b)) << 1);
+        } else if (a) {
+            ws.scope_outside[static_cast<std::size_t>(a)] += x.c.z[p] > far_z && beyond(q, p);
+        } else {
+            ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
+        }
+    };
+    for (int v = top; v < bottom; ++v)
+        for (int u = left; u < right; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            if (const int l = label[p]) {
+                const float h = height(p);
+                const auto li = static_cast<std::size_t>(l);
+                ws.scope_lo[li] = std::min(ws.scope_lo[li], h);
+                ws.scope_hi[li] = std::max(ws.scope_hi[li], h);
+                ws.scope_high[li] += h > prm.scope_max_height_m;
+                ++ws.sizes[li];
+                // On the frame's edge, beyond the support's middle.
+                const int on_edge = x.c.z[p] > far_z ? (v == edge_top) + (u == edge_left) +
+                                                           (u == edge_right) + (v == edge_bottom)
+                                                     : 0;
+                ws.scope_outline[li] += on_edge;
+                ws.scope_outside[li] += on_edge;
+            }
+            if (u + 1 < right) pair(p, p + 1);
+            if (v + 1 < bottom) pair(p, p + static_cast<std::size_t>(W));
+        }
+    std::sort(ws.edges.begin(), ws.edges.end());
+    ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
+    // Inside the volume: under the height limit (2 % of the points may be noise) and not
+    // running on past the hull or out of view. Stands: the lowest point touches the support.
+    // scope_keep: bit 0 inside, bit 1 kept.
+    auto& keep = ws.scope_keep;
+    keep.assign(L, 0);
+    for (std::size_t l = 1; l < L; ++l) {
+        if (ws.sizes[l] == 0) continue;
+        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
+                            static_cast<float>(ws.scope_outside[l]) <=
+                                prm.scope_max_outside * static_cast<float>(ws.scope_outline[l]);
+        keep[l] = static_cast<std::uint8_t>(inside ? (ws.scope_lo[l] <= prm.scope_contact_m ? 3 : 1) : 0);
+    }
+    // Rests on: touches a kept segment in the image (a box on a box, a lid on a tin, an
+    // object behind another with its foot hidden). No height test: a supported object's
+    // visible bottom can lie well above its supporter's visible top (a tin's lid overhangs
+    // what it stands on), and what hangs or is fixed to a wall has already left the volume.
+    // Spreads until nothing changes.
+    for (bool grew = true; grew;) {
+        grew = false;
+        for (const std::uint64_t e : ws.edges) {
+            const auto a = static_cast<std::size_t>(e >> 33), b = static_cast<std::size_t>((e >> 1) & 0xffffffffu);
+            for (const auto& [s, t] : {std::pair{a, b}, std::pair{b, a}}) {
+                if (keep[s] != 3 || keep[t] != 1) continue;
+                keep[t] = 3;
+                grew = true;
+            }
+        }
+    }
+    int left_out = 0;
+    for (std::size_t l = 1; l < L; ++l)
+        left_out += keep[l] != 3 && ws.sizes[l] >= prm.min_points;
+    for (int& l : ws.label)
+        if (l && keep[static_cast<std::size_t>(l)] != 3) l = 0;
+    return left_out;
 }
 
 }  // namespace
@@ -903,6 +1086,11 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     if (params.segmenter != Segmenter::Kmeans) {
         stats.gaps_filled = fill_container_gaps(x, ws);
         stats.ms.gaps = ms_since();
+    }
+    if (support && params.scope == Scope::Support) {
+        stats.support_scope = true;
+        stats.out_of_scope = restrict_to_support(x, *support, ws, n);
+        stats.ms.scope = ms_since();
     }
     out.width = W;
     out.height = H;

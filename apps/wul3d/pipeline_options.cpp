@@ -61,6 +61,9 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     cmd->add_option("--select", o.select, "U,V: follow the object under this pixel of the first frame");
     cmd->add_option("--segmenter", o.segmenter,
                     "Object segmentation: geometric|kmeans|hybrid (default hybrid)");
+    cmd->add_option("--scope", o.scope,
+                    "Objects: support (what the support holds; the default, the whole scene "
+                    "when no support is found) or scene (every segment)");
     cmd->add_flag("--no-plane", o.no_plane,
                   "Keep the support plane (the paper's background step: depth range only)");
     cmd->add_option("--min-points", o.min_points, "Smallest object, pixels (default 300)");
@@ -102,6 +105,7 @@ PipelineParams make_pipeline_params(const PipelineOptions& o) {
     if (o.zmax) p.range.zmax_m = *o.zmax;
     if (o.normal_radius) p.normals.radius_px = *o.normal_radius;
     if (!o.segmenter.empty()) p.segmentation.segmenter = parse_segmenter(o.segmenter);
+    if (!o.scope.empty()) p.segmentation.scope = parse_scope(o.scope);
     if (o.no_plane) p.remove_plane = false;
     if (o.min_points) p.segmentation.min_points = *o.min_points;
     if (o.object_psi) p.objects.psi = *o.object_psi;

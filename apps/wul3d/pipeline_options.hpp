@@ -26,6 +26,7 @@ struct PipelineOptions {
     std::string registration = "depth-to-color";
     std::string select;
     std::string segmenter;
+    std::string scope;
     bool no_plane = false;
     int threads = 0;  // 0 = all cores
     // Parameters given on the command line override the preset; kept apart so we know.

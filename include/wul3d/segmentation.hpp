@@ -28,6 +28,15 @@ enum class Segmenter {
 Segmenter parse_segmenter(const std::string& name);  ///< geometric|kmeans|hybrid, else ParamError
 const char* segmenter_name(Segmenter s);
 
+/// Which segments are objects (--scope). Someone pointing a camera at a table wants what
+/// stands on the table, not the wall behind it or the chair beside it.
+enum class Scope {
+    Support,  ///< what the support holds (the default); the whole scene when no support is found
+    Scene,    ///< every segment
+};
+Scope parse_scope(const std::string& name);  ///< support|scene, else ParamError
+const char* scope_name(Scope s);
+
 struct SegmentParams {
     Segmenter segmenter = Segmenter::Hybrid;
     int min_points = 300;           ///< objects with fewer pixels are dropped; >= 1 (--min-points)
@@ -55,9 +64,14 @@ struct SegmentParams {
     float color_alpha = 0.02f;      ///< alpha of eq. (4) for the split; [0.002, 0.1]
     float color_min_distance = 45;  ///< RGB distance (0-255) between the parts' means; > 0
     float color_min_share = 0.15f;  ///< each part holds at least this share; (0, 0.5]
-    float color_max_boundary = 2.5f;  ///< boundary pairs / sqrt(smaller part) at most; > 0
+    float color_max_boundary = 0.5f;  ///< boundary pairs / the smaller part's outline pairs
+                                      ///< at most: a contact is one side of it; (0, 1]
     float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
                                       ///< step away on either side) within this angle; > 0
+    float color_min_hue_deg = 10;     ///< ... or else (the boundary follows a fold) the parts'
+                                      ///< mean RGB vectors differ by this angle: shading
+                                      ///< scales a colour, only another material turns it;
+                                      ///< (0, 90)
     // Containers (needs the support plane): a bowl or a cup seen from above shows its outer
     // wall and, over the front rim, its inside; the rim hides the inside's lower part, so
     // the two meet only across a depth step, where no crease test or merge can join them.
@@ -76,6 +90,19 @@ struct SegmentParams {
     /// plane's island test) joins that segment. A true hole (a mug's handle, the table seen
     /// through it) touches no inside and stays. Patches up to this many pixels; 0 = off.
     int gap_max_px = 500;
+    // Scope (needs the support plane; docs/DESIGN.md, "Scope"): with Scope::Support a segment
+    // is an object when it stands on the support, or rests on a segment that does, and stays
+    // within the support's volume: over its hull (PlaneParams::hull_margin_px) and up to a
+    // height limit. A segment that runs on, with continuous depth, into points the plane
+    // stage removed although they lie above the support (off its hull) is part of something
+    // bigger than the table holds: a wall, a chair, the next table.
+    Scope scope = Scope::Support;
+    float scope_contact_m = 0.03f;     ///< a segment whose lowest point is this close to the
+                                       ///< support stands on it; > 0
+    float scope_max_height_m = 0.5f;   ///< a segment with over 2 % of its points higher than
+                                       ///< this over the support is not held by it; > 0
+    float scope_max_outside = 0.1f;    ///< largest share of a segment's outline that continues
+                                       ///< into removed points above the support; [0, 1]
 
     void validate() const;  ///< throws ParamError naming the field
 };
@@ -118,6 +145,11 @@ struct SegmentWorkspace {
     // Floor gaps:
     std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
     std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
+    // Scope: per segment its lowest and highest point over the support, points above the
+    // height limit, outline pairs, and those that continue into removed points above it.
+    std::vector<float> scope_lo, scope_hi;
+    std::vector<int> scope_high, scope_outline, scope_outside;
+    std::vector<std::uint8_t> scope_keep;
 };
 
 /// What segmentation did, as data.
@@ -128,12 +160,14 @@ struct SegmentStats {
     int containers = 0;    ///< insides joined to their container across the rim
     std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached
+    bool support_scope = false;  ///< Scope::Support was applied (a support was found)
+    int out_of_scope = 0;        ///< segments of min_points or more the scope left out
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
     /// components, re-attachment, convexity merge, container rule, colour cue, floor gaps,
-    /// and the renumbering passes with the output. For the profile in bench/.
+    /// the scope, and the renumbering passes with the output. For the profile in bench/.
     struct Phases {
         double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
-               color = 0, gaps = 0, compact = 0;
+               color = 0, gaps = 0, scope = 0, compact = 0;
     } ms;
 };
 

@@ -464,6 +464,8 @@ Args:
     zmax (float): farthest depth kept, metres (default 4.5).
     normal_radius (int): normal neighbour distance, pixels (default 2).
     segmenter (str): "geometric", "kmeans" or "hybrid" (default).
+    scope (str): "support" (default: the objects the support surface holds; the whole scene
+        when no support is found) or "scene" (every segment).
     remove_plane (bool): False keeps the support plane (`--no-plane`).
     min_points (int): smallest object, pixels (default 300).
     object_psi (float): eq. 2's increment for object tracks, (0, 1] (default 0.5).
@@ -480,7 +482,8 @@ Example:
                          std::optional<int> iters, std::optional<int> stride,
                          std::optional<std::uint64_t> seed, std::optional<float> zmin,
                          std::optional<float> zmax, std::optional<int> normal_radius,
-                         std::optional<std::string> segmenter, bool remove_plane,
+                         std::optional<std::string> segmenter, std::optional<std::string> scope,
+                         bool remove_plane,
                          std::optional<int> min_points, std::optional<float> object_psi,
                          std::optional<int> decimate) {
                  ParamArgs a;
@@ -497,6 +500,7 @@ Example:
                  a.zmax = zmax;
                  a.normal_radius = normal_radius;
                  a.segmenter = segmenter;
+                 a.scope = scope;
                  a.remove_plane = remove_plane;
                  a.min_points = min_points;
                  a.object_psi = object_psi;
@@ -509,7 +513,8 @@ Example:
              py::arg("iters") = py::none(), py::arg("stride") = py::none(),
              py::arg("seed") = py::none(), py::arg("zmin") = py::none(),
              py::arg("zmax") = py::none(), py::arg("normal_radius") = py::none(),
-             py::arg("segmenter") = py::none(), py::arg("remove_plane") = true,
+             py::arg("segmenter") = py::none(), py::arg("scope") = py::none(),
+             py::arg("remove_plane") = true,
              py::arg("min_points") = py::none(), py::arg("object_psi") = py::none(),
              py::arg("decimate") = py::none())
         .def("process", &PyPipeline::process, py::arg("color"), py::arg("depth"),

@@ -27,6 +27,7 @@ PipelineParams make_params(const ParamArgs& a) {
     if (a.zmax) p.range.zmax_m = *a.zmax;
     if (a.normal_radius) p.normals.radius_px = *a.normal_radius;
     if (a.segmenter) p.segmentation.segmenter = parse_segmenter(*a.segmenter);
+    if (a.scope) p.segmentation.scope = parse_scope(*a.scope);
     p.remove_plane = a.remove_plane;
     if (a.min_points) p.segmentation.min_points = *a.min_points;
     if (a.object_psi) p.objects.psi = *a.object_psi;
@@ -50,6 +51,7 @@ py::dict params_dict(const PipelineParams& p) {
     d["zmax"] = p.range.zmax_m;
     d["normal_radius"] = p.normals.radius_px;
     d["segmenter"] = segmenter_name(p.segmentation.segmenter);
+    d["scope"] = scope_name(p.segmentation.scope);
     d["remove_plane"] = p.remove_plane;
     d["min_points"] = p.segmentation.min_points;
     d["object_psi"] = p.objects.psi;

@@ -15,7 +15,7 @@ namespace py = pybind11;
 /// The keyword arguments of wul3d.Pipeline, as the flags of `wul3d run`: None keeps the
 /// preset's value.
 struct ParamArgs {
-    std::optional<std::string> preset, segmenter;
+    std::optional<std::string> preset, segmenter, scope;
     std::optional<int> k, iters, stride, normal_radius, min_points, decimate;
     std::optional<float> alpha, delta, gamma, psi, zmin, zmax, object_psi;
     std::optional<std::uint64_t> seed;

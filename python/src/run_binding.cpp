@@ -88,6 +88,7 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     a.zmax = take<float>(o, "zmax");
     a.normal_radius = take<int>(o, "normal_radius");
     a.segmenter = take<std::string>(o, "segmenter");
+    a.scope = take<std::string>(o, "scope");
     a.min_points = take<int>(o, "min_points");
     a.object_psi = take<float>(o, "object_psi");
     a.decimate = take<int>(o, "decimate");
@@ -117,6 +118,8 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     if (frames && *frames < 1) throw ParamError("--frames " + std::to_string(*frames) + ": must be >= 1");
     r.max_frames = frames ? static_cast<std::size_t>(*frames) : 0;
     r.ply = take<bool>(o, "ply").value_or(false);
+    r.overlay = take<bool>(o, "overlay").value_or(false);
+    r.overwrite = take<bool>(o, "overwrite").value_or(false);
     r.out_dir = out;
     if (!o.empty()) {
         std::string keys;

@@ -33,11 +33,11 @@ DONE_MARKER = "summary.json"  # written last by the run loop
 RUN_OPTIONS = {
     "preset": str, "k": int, "alpha": float, "delta": float, "gamma": float, "psi": float,
     "iters": int, "stride": int, "seed": int, "zmin": float, "zmax": float,
-    "normal_radius": int, "segmenter": str, "min_points": int, "object_psi": float,
+    "normal_radius": int, "segmenter": str, "scope": str, "min_points": int, "object_psi": float,
     "decimate": int, "format": str, "tum_camera": str, "intrinsics": str, "calibration": str,
     "registration": str, "select": str, "frames": int,
 }
-RUN_FLAGS = {"no_plane", "ply"}
+RUN_FLAGS = {"no_plane", "ply", "overlay"}
 
 
 # ---- discovery ----------------------------------------------------------------------------
@@ -362,6 +362,7 @@ def _parser():
                          help=f"as `wul3d run {flag}`")
     run.add_argument("--no-plane", action="store_true", help="as `wul3d run --no-plane`")
     run.add_argument("--ply", action="store_true", help="as `wul3d run --ply`")
+    run.add_argument("--overlay", action="store_true", help="as `wul3d run --overlay`")
     return p
 
 
