@@ -65,6 +65,8 @@ void write_folder_atomic(const std::string& dir,
     const fs::path final_dir(dir);
     const fs::path tmp_dir = temp_name(final_dir.parent_path(), "partial");
     std::error_code ec;
+    // The parent may not exist yet (a recording's first frame): made here, never removed.
+    if (!final_dir.parent_path().empty()) fs::create_directories(final_dir.parent_path(), ec);
     if (!fs::create_directory(tmp_dir, ec) || ec)
         throw IoError(tmp_dir.string() + ": cannot create folder" + (ec ? ": " + ec.message() : ""));
     try {
@@ -96,7 +98,7 @@ const std::vector<std::string>& frame_output_files() {
     static const std::vector<std::string> names = {"labels.png",      "colors.png",
                                                    "selected.png",    "objects.png",
                                                    "objects.json",    "selected_object.png",
-                                                   "cloud.ply"};
+                                                   "cloud.ply",       "overlay.png"};
     return names;
 }
 

@@ -282,6 +282,20 @@ TEST(RobustCli, ForeignOutputFolderIsRefusedUnlessOverwrite) {
     EXPECT_TRUE(fs::is_regular_file(out / "image_0000" / "labels.png"));
 }
 
+// Every file a run writes is wul3d's own: running again into the same folder needs no
+// --overwrite, with every optional output on (overlay.png was once left off the list).
+TEST(RobustCli, RunAgainIntoItsOwnOutputNeedsNoOverwrite) {
+    TempDir tmp;
+    const fs::path out = tmp / "out";
+    const std::vector<std::string> args = {"run",  tabletop_frame().string(), "--out", out.string(),
+                                           "-q",   "--overlay", "--ply", "--select", "320,240"};
+    CommandResult r = run_bounded(args);
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    ASSERT_TRUE(fs::is_regular_file(out / "image_0000" / "overlay.png"));
+    r = run_bounded(args);
+    EXPECT_EQ(r.exit_code, 0) << describe(r);
+}
+
 TEST(RobustCli, LongAndReservedFrameNames) {
     TempDir tmp;
     const std::string long_name(250, 'f');

@@ -97,6 +97,11 @@ PinholeIntrinsics to_intrinsics(const py::object& intrinsics, int width, int hei
                              "cx, cy, got " +
                              py::str(py::type::of(intrinsics).attr("__name__")).cast<std::string>());
     }
+    if (width == 0 && height == 0) {  // an override for frames of any size (--intrinsics)
+        K.width = K.height = 0;
+        K.validate_unsized("intrinsics");
+        return K;
+    }
     if ((K.width != 0 || K.height != 0) && !K.same_size(width, height))
         throw py::value_error("intrinsics: for a " + std::to_string(K.width) + "x" +
                               std::to_string(K.height) + " image, the arrays are " +

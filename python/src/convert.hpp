@@ -31,6 +31,7 @@ FrameArrays check_frame_arrays(const py::object& color, const py::object& depth)
 
 /// wul3d.Intrinsics, or a dict with fx, fy, cx, cy (as in intrinsics.json; width and height
 /// there must match the arrays when given). Finite values, fx, fy > 0, else ValueError.
+/// width = height = 0: an override for frames of any size, checked without a size.
 PinholeIntrinsics to_intrinsics(const py::object& intrinsics, int width, int height);
 
 /// Copies the arrays into `frame`'s reused buffers (float32 depth; uint16 depth goes through

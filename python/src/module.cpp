@@ -559,8 +559,7 @@ void bind_reading(py::module_& m) {
                  o.calibration = calibration;
                  o.registration = parse_registration_mode(registration);
                  if (!intrinsics.is_none()) {
-                     o.intrinsics = to_intrinsics(intrinsics, 1, 1);
-                     o.intrinsics->width = o.intrinsics->height = 0;  // each frame's own size
+                     o.intrinsics = to_intrinsics(intrinsics, 0, 0);  // each frame's own size
                  }
                  return std::make_unique<Reader>(path, o);
              }),

@@ -52,11 +52,10 @@ PinholeIntrinsics intrinsics_option(const py::object& v) {
         K.fy = x[1];
         K.cx = x[2];
         K.cy = x[3];
+        K.validate_unsized("--intrinsics '" + text + "'");
         return K;
     }
-    PinholeIntrinsics K = to_intrinsics(v, 1, 1);
-    K.width = K.height = 0;  // each frame's own size
-    return K;
+    return to_intrinsics(v, 0, 0);  // each frame's own size
 }
 
 std::pair<int, int> select_option(const py::object& v) {

@@ -36,6 +36,15 @@ def test_single_frame_and_intrinsics_override():
     assert (K.width, K.height) == frames[0].depth.shape[::-1]
 
 
+def test_meaningless_intrinsics_override_is_refused():
+    """As `--intrinsics 600,600,nan,nan`: a ValueError, not a run that labels nothing."""
+    path = SAMPLES / "pcl_kinect" / "region_growing_rgb_tutorial"
+    with pytest.raises(ValueError, match="intrinsics"):
+        wul3d.read(path, intrinsics={"fx": 600.0, "fy": 600.0, "cx": float("nan"), "cy": 200.0})
+    with pytest.raises(ValueError, match="intrinsics"):
+        wul3d.run(path, "/nonexistent-never-written", intrinsics="600,600,nan,nan")
+
+
 def test_bad_inputs():
     with pytest.raises(wul3d.InputError, match="no_such_folder"):
         wul3d.read(SAMPLES / "no_such_folder")
