@@ -2,6 +2,9 @@
 # Runs every libFuzzer harness of fuzz/ for a bounded time on seeds made from the shipped
 # samples, and prints each one's executions and executions per second.
 #   scripts/run-fuzzers.sh BUILD_DIR [SECONDS_PER_HARNESS]   (default 20)
+# The mutations follow WUL3D_FUZZ_SEED (default 1), so that CI explores the inputs a
+# developer's run explored before landing; WUL3D_FUZZ_SEED=0 lets libFuzzer pick one (a
+# longer hunt).
 # BUILD_DIR was configured with -DWUL3D_BUILD_FUZZERS=ON and built with --target fuzzers.
 # Any crash, sanitizer report, leak, timeout (10 s) or memory blow-up (2 GB) fails the script;
 # libFuzzer leaves the input as BUILD_DIR/fuzz-out/crash-* (or leak-, timeout-, oom-): add it
@@ -10,6 +13,7 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 build=${1:?usage: scripts/run-fuzzers.sh BUILD_DIR [SECONDS]}
 seconds=${2:-20}
+seed=${WUL3D_FUZZ_SEED:-1}
 seeds=$build/fuzz-seeds
 out=$build/fuzz-out
 rm -rf "$seeds" "$out"
@@ -24,7 +28,7 @@ for fuzzer in png jpeg intrinsics_json calibration_json tum_list fakenect frame;
   log=$out/$fuzzer.log
   # One process, -max_total_time bounded; the corpus it grows is thrown away with $out.
   if ! ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      "$build/fuzz/fuzz_$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      "$build/fuzz/fuzz_$fuzzer" -max_total_time="$seconds" -seed="$seed" -timeout=10 -rss_limit_mb=2048 \
       -max_len=400000 -print_final_stats=1 -artifact_prefix="$out/$fuzzer-" \
       "$corpus" "$seeds/$fuzzer" >"$log" 2>&1; then
     echo "fuzz_$fuzzer FAILED; its log:" >&2

@@ -87,6 +87,22 @@ void expect_no_temp_files(const fs::path& dir) {
 
 // ---- single files -------------------------------------------------------------------
 
+// Found by fuzz/fuzz_jpeg.cpp in CI: an 80 x 60 JPEG with a second frame header after its
+// scan. Finishing the decode rewrote libjpeg's size, and the image came back as 0 x 55296
+// over 80 x 60 pixels. The size is the first header's, and matches the pixels.
+TEST(IoImages, JpegWithASecondFrameHeaderKeepsItsSize) {
+    const std::string path =
+        (fs::path(WUL3D_TEST_DATA_DIR) / "fuzz" / "jpeg-second-frame-header.jpg").string();
+    try {
+        const wul3d::ColorImage c = wul3d::read_color_image(path);
+        EXPECT_EQ(c.width, 80);
+        EXPECT_EQ(c.height, 60);
+        EXPECT_EQ(c.rgb.size(), 3u * 80u * 60u);
+    } catch (const wul3d::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+}
+
 TEST(IoImages, DepthRoundTrip) {
     TempDir tmp;
     const wul3d::DepthImage d = ramp_depth(37, 23);
