@@ -66,7 +66,6 @@ packages=(
   libopenni2-dev
   pybind11-dev
   python3-dev
-  python3-numpy
   python3-pytest
   python3-open3d
   python3-dask
