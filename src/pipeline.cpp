@@ -42,7 +42,7 @@ PipelineParams PipelineParams::stage_params() const {
     // the same object at every N; 0 keeps meaning "off". The neighbourhoods (normal radius,
     // crease step and smoothing, re-attachment, depth jumps), the seeds' size and the plane's
     // grid step stay in the decimated pixels: scaling the neighbourhoods cost up to 7 points
-    // of Boundary F on osd_mosd's learn frames (README, "Decimation"); a grid that kept its
+    // of Boundary F on osd_mosd's learn frames (docs/SPEED.md, "Decimation"); a grid that kept its
     // points scored about the same as one with N^2 fewer (docs/DESIGN.md) and cost 0.6-0.9 ms
     // more at N = 2.
     auto length = [n](int px, int at_least) { return px == 0 ? 0 : std::max(at_least, (px + n / 2) / n); };

@@ -3,7 +3,7 @@
 /// The optional first and last stage (PipelineParams::decimation, `--decimate N`): the frame
 /// shrinks by N in u and v before back-projection, every later stage runs on N^2 times fewer
 /// pixels, and each per-pixel result is carried back to the input's pixels at the end.
-/// The speed/quality trade-off is measured in the README ("Decimation").
+/// The speed/quality trade-off is measured in docs/SPEED.md ("Decimation").
 #include <algorithm>
 #include <cmath>
 #include <cstdint>

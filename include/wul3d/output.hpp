@@ -3,7 +3,7 @@
 /// What `wul3d run` writes for one frame, as library calls an embedding program can make:
 /// the frame folder OUT/<frame>/ (labels.png, colors.png, objects.png, objects.json, and on
 /// request selected.png, selected_object.png, overlay.png, cloud.ply), the objects.json schema, and the
-/// one atomic-write helper every writer of wul3d goes through (README, "Outputs").
+/// one atomic-write helper every writer of wul3d goes through (docs/OUTPUTS.md).
 #include <cstddef>
 #include <cstdint>
 #include <functional>

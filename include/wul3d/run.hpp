@@ -3,7 +3,7 @@
 /// A whole run, as `wul3d run` does it: every frame of a recording or a live camera through
 /// the pipeline, each frame's outputs written to OUT/<frame>/ (output.hpp) and, at the end,
 /// OUT/summary.json. A RunObserver hears of each frame (for a progress bar or a video);
-/// the outputs are the same whoever calls (README, "Outputs"; docs/LIBRARY.md).
+/// the outputs are the same whoever calls (docs/OUTPUTS.md; docs/LIBRARY.md).
 #include <cstddef>
 #include <cstdint>
 #include <exception>

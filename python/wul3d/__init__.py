@@ -135,7 +135,7 @@ def evaluate(pred, gt, boundary_fraction=0.003, boundary_tolerance_px=-1, detect
 
 def run(input, out, **options) -> dict:
     """Runs a whole recording as `wul3d run INPUT --out OUT [options]` does, with the same
-    outputs (OUT/<frame>/ and OUT/summary.json, the README's outputs list), in this process.
+    outputs (OUT/<frame>/ and OUT/summary.json, docs/OUTPUTS.md), in this process.
 
     Args:
         input: any input `wul3d run` reads (frame folders, TUM, unregistered frames).
