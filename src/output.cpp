@@ -207,24 +207,7 @@ namespace {
 /// (near bright) for a depth-only frame.
 void overlay_picture(const RgbdFrame& frame, const FrameResult& r, ColorImage& out) {
     ColorImage base;
-    if (frame.has_color()) {
-        base = frame.color;
-    } else {
-        base.width = frame.depth.width;
-        base.height = frame.depth.height;
-        base.rgb.assign(frame.depth.data.size() * 3, 0);
-        std::uint16_t lo = 0xffff, hi = 0;
-        for (const std::uint16_t d : frame.depth.data)
-            if (d) lo = std::min(lo, d), hi = std::max(hi, d);
-        const float span = std::max(1.0f, static_cast<float>(hi) - static_cast<float>(lo));
-        for (std::size_t p = 0; p < frame.depth.data.size(); ++p) {
-            const std::uint16_t d = frame.depth.data[p];
-            if (d == 0) continue;
-            const auto g = static_cast<std::uint8_t>(
-                235.0f - 180.0f * (static_cast<float>(d) - static_cast<float>(lo)) / span);
-            base.rgb[3 * p] = base.rgb[3 * p + 1] = base.rgb[3 * p + 2] = g;
-        }
-    }
+    render_frame_picture(frame, base);
     if (r.objects.labels.size() != base.rgb.size() / 3) {
         out = std::move(base);  // no object stages ran (PipelineParams::detect_objects)
         return;

@@ -201,4 +201,25 @@ void render_object_overlay(const ColorImage& base, const LabelImage& objects,
     }
 }
 
+void render_frame_picture(const RgbdFrame& frame, ColorImage& out) {
+    if (frame.has_color()) {
+        out = frame.color;
+        return;
+    }
+    out.width = frame.depth.width;
+    out.height = frame.depth.height;
+    out.rgb.resize(frame.depth.data.size() * 3);
+    std::uint16_t lo = 0xffff, hi = 0;
+    for (const std::uint16_t d : frame.depth.data)
+        if (d) lo = std::min(lo, d), hi = std::max(hi, d);
+    const float span = std::max(1.0f, static_cast<float>(hi) - static_cast<float>(lo));
+    for (std::size_t p = 0; p < frame.depth.data.size(); ++p) {
+        const std::uint16_t d = frame.depth.data[p];
+        const auto g = d ? static_cast<std::uint8_t>(
+                               235.0f - 180.0f * (static_cast<float>(d) - static_cast<float>(lo)) / span)
+                         : std::uint8_t{0};
+        out.rgb[3 * p] = out.rgb[3 * p + 1] = out.rgb[3 * p + 2] = g;
+    }
+}
+
 }  // namespace wul3d

@@ -76,26 +76,6 @@ std::pair<float, float> render_depth_panel(const DepthImage& depth, float zmin_m
     return {lo, hi};
 }
 
-void render_color_panel(const RgbdFrame& frame, ColorImage& out) {
-    if (frame.has_color()) {
-        out = frame.color;
-        return;
-    }
-    // Depth-only: grey by depth over the depth's own range, near bright.
-    resize_like(frame.depth.width, frame.depth.height, out);
-    std::uint16_t lo = 0xffff, hi = 0;
-    for (const std::uint16_t d : frame.depth.data)
-        if (d) lo = std::min(lo, d), hi = std::max(hi, d);
-    const float span = std::max(1.0f, static_cast<float>(hi) - static_cast<float>(lo));
-    for (std::size_t p = 0; p < frame.depth.data.size(); ++p) {
-        const std::uint16_t d = frame.depth.data[p];
-        const auto g = d ? static_cast<std::uint8_t>(
-                               235.0f - 180.0f * (static_cast<float>(d) - lo) / span)
-                         : std::uint8_t{0};
-        out.rgb[3 * p] = out.rgb[3 * p + 1] = out.rgb[3 * p + 2] = g;
-    }
-}
-
 void highlight_mask(const ColorImage& base, const std::vector<std::uint8_t>& mask,
                     const std::uint8_t outline[3], ColorImage& out) {
     out = base;
@@ -253,7 +233,7 @@ void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
         impl_->canvas.create(size, CV_8UC3);
     }
     const cv::Size panel = impl_->panel;
-    render_color_panel(frame, colour_);
+    render_frame_picture(frame, colour_);
     paste(colour_, impl_->canvas, 0, panel);
     // Objects: tinted and numbered over the colour, with their oriented boxes.
     OverlayStyle style;

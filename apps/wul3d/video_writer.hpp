@@ -23,9 +23,6 @@ namespace wul3d::cli {
 std::pair<float, float> render_depth_panel(const DepthImage& depth, float zmin_m, float zmax_m,
                                            ColorImage& out);
 
-/// The frame's colour, or a grey depth picture for a depth-only frame.
-void render_color_panel(const RgbdFrame& frame, ColorImage& out);
-
 /// `base` with the pixels outside `mask` (255 = object) darkened and the object's outline
 /// drawn in `outline`; `mask` empty: `base` unchanged.
 void highlight_mask(const ColorImage& base, const std::vector<std::uint8_t>& mask,

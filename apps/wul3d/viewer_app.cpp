@@ -338,7 +338,7 @@ void Viewer::apply_pending() {
 
 void Viewer::refresh_views() {
     const FrameResult& r = *result_;
-    render_color_panel(*frame_, img_color_);
+    render_frame_picture(*frame_, img_color_);
     depth_ramp_ = render_depth_panel(frame_->depth, params_.range.zmin_m, params_.range.zmax_m,
                                      img_depth_);
     if (r.objects.labels.size() == img_color_.rgb.size() / 3) {
