@@ -1,0 +1,92 @@
+#pragma once
+// Private to src/segmentation*.cpp: the context every phase of segment_objects reads, the
+// union-find over segments, and the rules (segmentation_rules.cpp) the driver calls.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "wul3d/cloud.hpp"
+#include "wul3d/normals.hpp"
+#include "wul3d/plane.hpp"
+#include "wul3d/segmentation.hpp"
+
+namespace wul3d::detail {
+
+constexpr float kDegToRad = 3.14159265358979f / 180.0f;
+
+/// What every phase reads: the parameters, the frame and the normals of the crease tests
+/// (smoothed when normal_smooth_px > 0), the plane's classes per pixel.
+struct Ctx {
+    const SegmentParams& prm;
+    const OrganizedCloud& c;
+    const NormalMap& n;
+    const std::vector<std::uint8_t>& cls;
+    int W, H;
+
+    bool connected(std::size_t p, std::size_t q, float steps = 1.0f) const {
+        const float z = c.z[p];
+        return std::fabs(z - c.z[q]) <= steps * (prm.depth_jump_m + prm.depth_jump_rel * z * z);
+    }
+    /// Paper-free LCCP test between two surface points: concave when the normals face
+    /// each other across the step, (n_p - n_q) . (X_q - X_p) > 0.
+    float concavity(std::size_t p, std::size_t q) const {
+        const float dx = c.x[q] - c.x[p], dy = c.y[q] - c.y[p], dz = c.z[q] - c.z[p];
+        const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+        if (!(len > 1e-6f)) return 0.0f;
+        return ((n.nx[p] - n.nx[q]) * dx + (n.ny[p] - n.ny[q]) * dy + (n.nz[p] - n.nz[q]) * dz) / len;
+    }
+};
+
+// ---- union-find over segments (the merge and container rules join segments) -------------
+
+inline int find_root(std::vector<int>& parent, int a) {
+    while (parent[static_cast<std::size_t>(a)] != a) {
+        parent[static_cast<std::size_t>(a)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(a)])];
+        a = parent[static_cast<std::size_t>(a)];
+    }
+    return a;
+}
+
+/// Union-find over segments 0..n, each its own set.
+inline void reset_sets(std::vector<int>& parent, int n) {
+    parent.resize(static_cast<std::size_t>(n) + 1);
+    for (int l = 0; l <= n; ++l) parent[static_cast<std::size_t>(l)] = l;
+}
+
+/// Joins the sets of segments a and b (the smaller root stays root); false when already one.
+inline bool join_sets(std::vector<int>& parent, int a, int b) {
+    const int ra = find_root(parent, a), rb = find_root(parent, b);
+    if (ra == rb) return false;
+    parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    return true;
+}
+
+/// Every labelled pixel takes its set's root.
+inline void relabel_to_roots(SegmentWorkspace& ws) {
+    for (int& l : ws.label)
+        if (l) l = find_root(ws.parent, l);
+}
+
+// ---- the rules (segmentation_rules.cpp) ----------------------------------------------------
+// Each works on ws.label, segments numbered 1..n with gaps, and returns its count for
+// SegmentStats.
+
+/// Containers (SegmentParams, "Containers"): joins a container's inside, seen over its rim,
+/// to the container. Returns the joins.
+int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
+
+/// Floor gaps (SegmentParams::gap_max_px): small unlabelled patches beside a container's
+/// inside, enclosed by one segment, join it. Returns the points filled.
+std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
+
+/// The colour cue (hybrid): splits segments in two by colour; the new parts are numbered
+/// n + 1, n + 2, ... in segment order. Returns the splits.
+int color_splits(const Ctx& x, SegmentWorkspace& ws, int n);
+
+/// Scope::Support (docs/DESIGN.md, "Scope"): clears the labels of the segments the support
+/// does not hold. Returns the segments of min_points or more left out.
+int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
+
+}  // namespace wul3d::detail

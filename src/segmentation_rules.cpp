@@ -1,0 +1,820 @@
+// The rules of segment_objects that go beyond components and the convexity merge: the
+// container rule, floor gaps, the colour cue and the support's scope (docs/DESIGN.md,
+// "Objects", 2). Each is a short driver over named phases; every phase states what it reads,
+// what it writes and what it costs. Scratch lives in SegmentWorkspace: once its vectors have
+// grown to a frame's size, a phase allocates nothing.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "segmentation_internal.hpp"
+#include "wul3d/clustering.hpp"  // ClusterParams: the colour cue's alpha and delta
+
+namespace wul3d::detail {
+
+// ---- containers ----------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::uint64_t kPairMask = ~std::uint64_t{15};  ///< BoundaryStep::key's segment pair
+
+/// One pass: the boundary pairs of two segments into ws.steps, keyed (lo, hi, depth step,
+/// lo is nearer) with the nearer pixel, sorted by key; each segment's first and last row into
+/// ws.rim_rows. In: ws.label (0..n). Cost: O(pixels), then a sort of the boundary pairs.
+void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const int W = x.W, H = x.H;
+    const auto& label = ws.label;
+    ws.steps.clear();
+    ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            const int a = label[p];
+            if (a == 0) continue;
+            int* rows = ws.rim_rows.data() + 2 * static_cast<std::size_t>(a);
+            if (rows[0] < 0) rows[0] = v;
+            rows[1] = v;
+            const std::size_t qs[2] = {u + 1 < W ? p + 1 : p, v + 1 < H ? p + static_cast<std::size_t>(W) : p};
+            for (std::size_t q : qs) {
+                const int b = label[q];
+                if (b == 0 || b == a) continue;
+                const bool step = !x.connected(p, q);
+                const bool p_nearer = x.c.z[p] < x.c.z[q];
+                const bool lo_nearer = (a < b) == p_nearer;
+                const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 34) |
+                                          (static_cast<std::uint64_t>(std::max(a, b)) << 4) |
+                                          (std::uint64_t{step} << 1) | std::uint64_t{lo_nearer};
+                ws.steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
+            }
+        }
+    std::sort(ws.steps.begin(), ws.steps.end(),
+              [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
+}
+
+/// Coordinates on the support plane: e1, e2 orthogonal to its normal (a foot's position is
+/// the point's).
+struct PlaneAxes {
+    Eigen::Vector3d e1, e2;
+
+    explicit PlaneAxes(const Plane& pl) {
+        const Eigen::Vector3d nrm(pl.nx, pl.ny, pl.nz);
+        int least = 0;  // the axis least aligned with the normal: a well-conditioned cross product
+        nrm.cwiseAbs().minCoeff(&least);
+        e1 = nrm.cross(Eigen::Vector3d::Unit(least)).normalized();
+        e2 = nrm.cross(e1);
+    }
+    Eigen::Vector2d operator()(const OrganizedCloud& c, std::size_t p) const {
+        const Eigen::Vector3d X(c.x[p], c.y[p], c.z[p]);
+        return Eigen::Vector2d(X.dot(e1), X.dot(e2));
+    }
+};
+
+/// A circle fitted to the front segment's edge along the steps ws.steps[i0, i1) (the nearer
+/// pixels of the depth steps that lie in `front`), on the plane: algebraic least squares
+/// (Kasa), centred on the edge's mean for conditioning. Appends {front, back, centre (2),
+/// radius, rim height} to ws.rim_fits when the edge lies on the circle and spans enough of
+/// it. Cost: four passes over the pair's boundary pairs; no allocation but the append.
+void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+             std::size_t i0, std::size_t i1, int front, int back) {
+    const SegmentParams& prm = x.prm;
+    const auto& label = ws.label;
+    auto for_edge = [&](auto&& visit) {
+        for (std::size_t j = i0; j < i1; ++j)
+            if (((ws.steps[j].key >> 1) & 1) && label[ws.steps[j].near] == front) visit(ws.steps[j].near);
+    };
+    double m = 0, height = 0;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for_edge([&](std::size_t p) {
+        ++m;
+        mean += plane_xy(x.c, p);
+        height += pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+    });
+    if (m < 3) return;
+    mean /= m;
+    height /= m;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for_edge([&](std::size_t p) {
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
+        const Eigen::Vector3d row(d.x(), d.y(), 1.0);
+        A += row * row.transpose();
+        rhs -= row * d.squaredNorm();
+    });
+    const Eigen::Vector3d sol = A.ldlt().solve(rhs);
+    const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
+    const double R2 = centre.squaredNorm() - sol.z();
+    if (!(R2 > 0) || !std::isfinite(R2)) return;
+    const double R = std::sqrt(R2);
+    // Geometric residual, and the widest chord: the farthest edge pixel from the mean,
+    // then the farthest from that one.
+    double res = 0, far_d = -1, chord = 0;
+    Eigen::Vector2d far = Eigen::Vector2d::Zero();
+    for_edge([&](std::size_t p) {
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
+        const double r = (d - centre).norm() - R;
+        res += r * r;
+        if (d.norm() > far_d) {
+            far_d = d.norm();
+            far = d;
+        }
+    });
+    for_edge([&](std::size_t p) { chord = std::max(chord, (plane_xy(x.c, p) - mean - far).norm()); });
+    if (std::sqrt(res / m) > prm.rim_max_residual_m || chord < prm.rim_min_arc * 2 * R) return;
+    ws.rim_fits.push_back({static_cast<double>(front), static_cast<double>(back), centre.x() + mean.x(),
+                           centre.y() + mean.y(), R, height});
+}
+
+/// Candidates: segment pairs that meet (almost) only across depth steps; the front is the
+/// segment nearer along them, and its edge must be a circular arc (fit_rim). In: ws.steps,
+/// sorted. Out: ws.rim_fits. Cost: one pass over the boundary pairs, then fit_rim's passes
+/// over each candidate's.
+void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws) {
+    const SegmentParams& prm = x.prm;
+    ws.rim_fits.clear();
+    for (std::size_t i = 0; i < ws.steps.size();) {
+        const std::size_t i0 = i;
+        const std::uint64_t k = ws.steps[i].key & kPairMask;
+        int steps = 0, lo_nearer = 0;
+        for (; i < ws.steps.size() && (ws.steps[i].key & kPairMask) == k; ++i) {
+            if (!((ws.steps[i].key >> 1) & 1)) continue;
+            ++steps;
+            lo_nearer += static_cast<int>(ws.steps[i].key & 1);
+        }
+        const int pairs = static_cast<int>(i - i0);
+        if (steps < prm.rim_min_boundary || 5 * steps < 4 * pairs) continue;
+        const int lo = static_cast<int>(k >> 34), hi = static_cast<int>((k >> 4) & ((1u << 30) - 1));
+        if (2 * lo_nearer == steps) continue;  // neither is in front
+        const int front = 2 * lo_nearer > steps ? lo : hi, back = front == lo ? hi : lo;
+        fit_rim(x, pl, plane_xy, ws, i0, i, front, back);
+    }
+}
+
+/// The back segments' feet: per candidate the back's pixels, those inside the circle and the
+/// back's top, into ws.rim_back. A back segment may sit behind several fronts: ws.remap holds
+/// each segment's first candidate and ws.rim_next links the rest. Cost: one pass over the
+/// rows the back segments span, O(candidates) per back pixel (one in practice).
+void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws, int n) {
+    const int W = x.W, H = x.H;
+    const int C = static_cast<int>(ws.rim_fits.size());
+    ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
+    ws.rim_next.assign(static_cast<std::size_t>(C), -1);
+    int v0 = H, v1 = -1;
+    for (int c = C - 1; c >= 0; --c) {
+        const int back = static_cast<int>(ws.rim_fits[static_cast<std::size_t>(c)][1]);
+        int& head = ws.remap[static_cast<std::size_t>(back)];
+        ws.rim_next[static_cast<std::size_t>(c)] = head;
+        head = c;
+        v0 = std::min(v0, ws.rim_rows[2 * static_cast<std::size_t>(back)]);
+        v1 = std::max(v1, ws.rim_rows[2 * static_cast<std::size_t>(back) + 1]);
+    }
+    ws.rim_back.assign(static_cast<std::size_t>(C), {0, 0, -1e9});
+    for (std::size_t p = static_cast<std::size_t>(v0) * W; p < static_cast<std::size_t>(v1 + 1) * W; ++p) {
+        const int l = ws.label[p];
+        if (l == 0) continue;
+        int c = ws.remap[static_cast<std::size_t>(l)];
+        if (c < 0) continue;
+        const Eigen::Vector2d f = plane_xy(x.c, p);
+        const double h = pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+        for (; c >= 0; c = ws.rim_next[static_cast<std::size_t>(c)]) {
+            const auto& fit = ws.rim_fits[static_cast<std::size_t>(c)];
+            auto& b = ws.rim_back[static_cast<std::size_t>(c)];
+            b[0] += 1;
+            b[1] += (f - Eigen::Vector2d(fit[2], fit[3])).norm() <= 1.1 * fit[4] + 0.01;
+            b[2] = std::max(b[2], h);
+        }
+    }
+}
+
+/// Joins each candidate's back to its front when the back's feet lie inside the circle and
+/// its top reaches the rim, and relabels. Returns the joins. Cost: O(candidates), then one
+/// pass over the pixels when anything joined.
+int join_insides(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    reset_sets(ws.parent, n);
+    int joins = 0;
+    for (std::size_t c = 0; c < ws.rim_fits.size(); ++c) {
+        const auto& fit = ws.rim_fits[c];
+        const auto& b = ws.rim_back[c];
+        if (b[1] < prm.rim_inside_share * b[0] || std::fabs(b[2] - fit[5]) > prm.rim_height_tol_m) continue;
+        joins += join_sets(ws.parent, static_cast<int>(fit[0]), static_cast<int>(fit[1]));
+    }
+    if (joins > 0) relabel_to_roots(ws);
+    return joins;
+}
+
+}  // namespace
+
+/// The container rule (SegmentParams, "Containers"): a segment seen over another's circular,
+/// level edge across a depth step, lying inside that circle and reaching up to it, is the
+/// other's inside (a bowl's or a cup's) and joins it. In: ws.label (1..n with gaps). Out:
+/// ws.label with the insides joined. Cost: one pass over the pixels and a sort of the
+/// boundary pairs; then per candidate a few passes over its boundary, and one over the rows
+/// of the candidates' insides.
+int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    if (x.prm.rim_min_boundary <= 0 || n < 2) return 0;
+    collect_boundary_steps(x, ws, n);
+    const PlaneAxes plane_xy(pl);
+    find_rims(x, pl, plane_xy, ws);
+    if (ws.rim_fits.empty()) return 0;
+    measure_insides(x, pl, plane_xy, ws, n);
+    return join_insides(x, ws, n);
+}
+
+// ---- floor gaps ----------------------------------------------------------------------------
+
+/// Gaps in a container's floor (SegmentParams::gap_max_px): each patch of unlabelled pixels
+/// beside a labelled kPlaneInside pixel is explored breadth-first; when it is enclosed by one
+/// segment (no image border, no other segment) and small, its points join that segment.
+/// Only the inside pixels are visited to find the patches, and the marks are cleared behind
+/// each search: the cost follows the insides, not the image. Returns the points filled.
+std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws) {
+    const int max_px = x.prm.gap_max_px;
+    if (max_px <= 0) return 0;
+    const int W = x.W, H = x.H;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    ws.gap_seen.resize(N, 0);  // all 0 between calls
+    std::uint8_t* const seen = ws.gap_seen.data();
+    std::size_t filled = 0;
+    // Explores the patch of unlabelled pixels holding `seed`; fills it when enclosed and small.
+    auto explore = [&](std::size_t seed) {
+        int head = 0, tail = 0, owner = 0;
+        bool enclosed = true;
+        ws.queue[tail++] = static_cast<int>(seed);
+        seen[seed] = 1;
+        while (head < tail && enclosed) {
+            const int p = ws.queue[head++];
+            const int pu = p % W, pv = p / W;
+            if (pu == 0 || pv == 0 || pu == W - 1 || pv == H - 1) enclosed = false;
+            const int nb[4] = {pu > 0 ? p - 1 : -1, pu + 1 < W ? p + 1 : -1, pv > 0 ? p - W : -1,
+                               pv + 1 < H ? p + W : -1};
+            for (int q : nb) {
+                if (q < 0) continue;
+                const int l = ws.label[static_cast<std::size_t>(q)];
+                if (l) {
+                    if (owner == 0) owner = l;
+                    else if (l != owner) enclosed = false;
+                } else if (!seen[q]) {
+                    seen[q] = 1;
+                    ws.queue[tail++] = q;
+                }
+            }
+            if (tail > max_px) enclosed = false;  // too large: the rest stays unexplored
+        }
+        for (int i = 0; i < tail; ++i) {
+            const auto p = static_cast<std::size_t>(ws.queue[i]);
+            // A patch that failed stays marked until the end (explored once); a point-less
+            // pixel stays out of every object.
+            if (!enclosed || owner == 0 || !x.c.valid[p]) continue;
+            ws.label[p] = owner;
+            seen[p] = 0;
+            ++filled;
+        }
+        if (enclosed && owner != 0)
+            for (int i = 0; i < tail; ++i) seen[static_cast<std::size_t>(ws.queue[i])] = 0;
+        return tail;
+    };
+    ws.gap_touched.clear();  // seeds explored, to clear their marks at the end
+    for (int v = 0; v < H; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * W;
+        const std::uint8_t* const cls = x.cls.data() + row;
+        for (const std::uint8_t* c = std::find(cls, cls + W, kPlaneInside); c != cls + W;
+             c = std::find(c + 1, cls + W, kPlaneInside)) {
+            const int u = static_cast<int>(c - cls);
+            const std::size_t p = row + static_cast<std::size_t>(u);
+            if (!ws.label[p]) continue;
+            const std::size_t nb[4] = {u > 0 ? p - 1 : p, u + 1 < W ? p + 1 : p, v > 0 ? p - W : p,
+                                       v + 1 < H ? p + W : p};
+            for (std::size_t q : nb) {
+                if (q == p || ws.label[q] || seen[q]) continue;
+                const int visited = explore(q);
+                if (seen[q]) ws.gap_touched.insert(ws.gap_touched.end(), ws.queue.begin(), ws.queue.begin() + visited);
+            }
+        }
+    }
+    for (int p : ws.gap_touched) seen[static_cast<std::size_t>(p)] = 0;
+    return filled;
+}
+
+// ---- the colour cue ------------------------------------------------------------------------
+
+namespace {
+
+/// Counting sort of the segments' pixels by segment (background left out): segment l's
+/// pixels are ws.order[ws.offsets[l], ws.offsets[l + 1]), in raster order. Per fixed band of
+/// rows in parallel: counts per band, then each band writes from its own start (segment by
+/// segment, bands in order). In: ws.label (0..n). Cost: two parallel passes over the pixels,
+/// O(8 n) between them.
+void sort_pixels_by_segment(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const int W = x.W;
+    constexpr int kSortBands = 8;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.remap.assign(kSortBands * L, 0);  // per band: counts, then write positions
+    const int H = x.H;
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kSortBands; ++band) {
+        int* const count = ws.remap.data() + static_cast<std::size_t>(band) * L;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
+        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p)
+            ++count[static_cast<std::size_t>(ws.label[p])];
+    }
+    ws.offsets.assign(L + 1, 0);  // segment l's pixels: order[offsets[l], offsets[l + 1])
+    int position = 0;
+    for (std::size_t l = 1; l < L; ++l) {
+        ws.offsets[l] = position;
+        for (int band = 0; band < kSortBands; ++band) {
+            int& slot = ws.remap[static_cast<std::size_t>(band) * L + l];
+            const int count = slot;
+            slot = position;
+            position += count;
+        }
+    }
+    ws.offsets[L] = position;
+    ws.order.resize(static_cast<std::size_t>(position));
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kSortBands; ++band) {
+        int* const next = ws.remap.data() + static_cast<std::size_t>(band) * L;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
+        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p) {
+            const int l = ws.label[p];
+            if (l) ws.order[static_cast<std::size_t>(next[l]++)] = static_cast<int>(p);
+        }
+    }
+}
+
+int segment_size(const SegmentWorkspace& ws, int l) {
+    return ws.offsets[static_cast<std::size_t>(l) + 1] - ws.offsets[static_cast<std::size_t>(l)];
+}
+
+/// The 2-means features of the segments' pixels, one plane each in segment order so that
+/// every pass over a segment reads contiguous memory.
+struct ColourFeatures {
+    const float* f[6];  ///< delta x, y, z, then alpha times the chromaticity r, g, b
+    int first;          ///< the position in ws.order of every plane's element 0
+};
+
+/// Gathers ColourFeatures into ws.feature, scaled by the paper's delta and alpha (eq. 4) so
+/// that a squared distance is a sum. Only the segments' pixels (order positions first..last)
+/// are gathered: plane q holds position i at f[q][i - first], sized by the object pixels, not
+/// the image. In: ws.order, ws.offsets. Cost: one parallel pass over the object pixels.
+ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWorkspace& ws, int n) {
+    const int first = ws.offsets[1], last = ws.offsets[static_cast<std::size_t>(n) + 1];
+    const std::size_t M = static_cast<std::size_t>(last - first);
+    ws.feature.resize(6 * M);
+    float* f[6];
+    for (int q = 0; q < 6; ++q) f[q] = ws.feature.data() + static_cast<std::size_t>(q) * M;
+    // The colour term is the chromaticity, rgb / (r + g + b), at the scale of 8-bit colour
+    // (a grey pixel of any brightness: 85, 85, 85): light falling on two faces of one box at
+    // other angles scales their colour and leaves it, so the two parts are two materials,
+    // not a lit face and a shaded one. kDark keeps the chromaticity of dark, noisy pixels
+    // near grey.
+    constexpr float kDark = 30.0f;
+    auto chroma = [&](std::size_t p, float* out) {
+        const float r = x.c.r[p], g = x.c.g[p], b = x.c.b[p];
+        const float k = 255.0f / (r + g + b + kDark);
+        out[0] = k * (r + kDark / 3), out[1] = k * (g + kDark / 3), out[2] = k * (b + kDark / 3);
+    };
+#pragma omp parallel for schedule(static)
+    for (int i = first; i < last; ++i) {
+        const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
+        f[0][i - first] = cp.delta * x.c.x[p];
+        f[1][i - first] = cp.delta * x.c.y[p];
+        f[2][i - first] = cp.delta * x.c.z[p];
+        float c[3];
+        chroma(p, c);
+        f[3][i - first] = cp.alpha * c[0];
+        f[4][i - first] = cp.alpha * c[1];
+        f[5][i - first] = cp.alpha * c[2];
+    }
+    return {{f[0], f[1], f[2], f[3], f[4], f[5]}, first};
+}
+
+/// The segments large enough to split (2 x min_points), largest first, into ws.by_size: tried
+/// in parallel, no thread is left with a big one at the end. Cost: O(n log n).
+void order_by_size(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+    ws.by_size.clear();
+    for (int l = 1; l <= n; ++l)
+        if (segment_size(ws, l) >= 2 * prm.min_points) ws.by_size.push_back(l);
+    std::stable_sort(ws.by_size.begin(), ws.by_size.end(),
+                     [&](int a, int b) { return segment_size(ws, a) > segment_size(ws, b); });
+}
+
+/// The position among the m pixels of one segment's planes `f` farthest in colour from
+/// (r, g, b); the first on ties.
+int farthest_colour(const float* const* f, int m, double r, double g, double b) {
+    const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
+    int best = 0;
+    double bd = -1;
+    for (int i = 0; i < m; ++i) {
+        const double dr = cr[i] - r, dg = cg[i] - g, db = cb[i] - b;
+        const double d = dr * dr + dg * dg + db * db;
+        if (d > bd) { bd = d; best = i; }
+    }
+    return best;
+}
+
+/// 2-means seeds for one segment (planes `f`, m pixels) in `cen`: the pixel farthest in colour
+/// from the mean, then the one farthest from it. False, and no seeds, when the colour
+/// spread cannot hold parts `min_spread` apart (feature units). Cost: three passes over the
+/// segment's colour planes.
+bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6]) {
+    const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
+    double mr = 0, mg = 0, mb = 0;
+    for (int i = 0; i < m; ++i) {
+        mr += cr[i]; mg += cg[i]; mb += cb[i];
+    }
+    mr /= m; mg /= m; mb /= m;
+    const int a0 = farthest_colour(f, m, mr, mg, mb);
+    // The parts' mean colours lie among the segment's colours, so they are at most the
+    // segment's colour diameter apart, at most twice the farthest colour from the mean:
+    // below the minimum distance no split can be kept.
+    {
+        const double dr = cr[a0] - mr, dg = cg[a0] - mg, db = cb[a0] - mb;
+        if (2 * std::sqrt(dr * dr + dg * dg + db * db) < min_spread) return false;
+    }
+    const int b0 = farthest_colour(f, m, cr[a0], cg[a0], cb[a0]);
+    for (int q = 0; q < 6; ++q) {
+        cen[0][q] = f[q][a0];
+        cen[1][q] = f[q][b0];
+    }
+    return true;
+}
+
+/// 2-means (eq. 4 squared) on one segment's feature planes, m pixels, from the centres `cen`:
+/// side[i] gets pixel i's part, `cen` the parts' means and `count` their sizes (the last
+/// iteration's; a part may be empty). Cost: at most 6 passes over the 6 planes, stopping when
+/// no pixel changes part; float sums per block of 1024, added up in double; no allocation.
+void two_means(const float* const* planes, int m, std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+    const float* f[6];  // a local copy: the stores to `side` cannot alias it
+    for (int q = 0; q < 6; ++q) f[q] = planes[q];
+    // Totals once: part 0's sums are the totals minus part 1's.
+    double total[6] = {};
+    for (int q = 0; q < 6; ++q)
+        for (int i = 0; i < m; ++i) total[q] += f[q][i];
+    for (int it = 0; it < 6; ++it) {
+        // Nearer centre 1 than centre 0 (eq. 4 squared): |f - c1|^2 < |f - c0|^2, i.e.
+        // 2 f . (c0 - c1) < |c0|^2 - |c1|^2, a linear test per pixel.
+        float w[6], bias = 0;
+        for (int q = 0; q < 6; ++q) {
+            w[q] = 2.0f * (cen[0][q] - cen[1][q]);
+            bias += cen[0][q] * cen[0][q] - cen[1][q] * cen[1][q];
+        }
+        double sum1[6] = {};
+        int ones = 0, changed = 0;
+        constexpr int kBlock = 1024;  // float partial sums per block, added up in double
+        for (int i0 = 0; i0 < m; i0 += kBlock) {
+            const int i1 = std::min(m, i0 + kBlock);
+            float block[6] = {};
+            int block_ones = 0, block_changed = 0;
+            for (int i = i0; i < i1; ++i) {
+                float dot = 0;
+                for (int q = 0; q < 6; ++q) dot += w[q] * f[q][i];
+                const std::uint8_t j = dot < bias;
+                block_changed += j != side[i];
+                side[i] = j;
+                block_ones += j;
+                const float mask = j;
+                for (int q = 0; q < 6; ++q) block[q] += mask * f[q][i];
+            }
+            for (int q = 0; q < 6; ++q) sum1[q] += block[q];
+            ones += block_ones;
+            changed += block_changed;
+        }
+        count[1] = ones;
+        count[0] = m - ones;
+        if (count[0] == 0 || count[1] == 0) break;
+        for (int q = 0; q < 6; ++q) {
+            cen[1][q] = static_cast<float>(sum1[q] / count[1]);
+            cen[0][q] = static_cast<float>((total[q] - sum1[q]) / count[0]);
+        }
+        if (it > 0 && changed == 0) break;  // converged: further iterations repeat this one
+    }
+}
+
+/// Where the parts of a split segment meet.
+struct SplitBoundary {
+    int boundary = 0;       ///< 4-neighbour pairs inside the segment with different parts
+    int with_normals = 0;   ///< ... with normals a crease step away on either side
+    int smooth = 0;         ///< ... whose normals lie within color_max_crease_deg
+    int small_outline = 0;  ///< 4-neighbour pairs from the smaller part to anything else
+};
+
+/// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part) and the
+/// smaller part's outline. Cost: one pass over the segment's pixels and their neighbours.
+SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
+                             std::uint8_t small_part, float cos_crease) {
+    const int W = x.W, s = x.prm.crease_step_px;
+    const std::uint8_t* const part = ws.part.data();
+    SplitBoundary sb;
+    for (int i = 0; i < m; ++i) {
+        const int p = px[i];
+        const int u = p % W, v = p / W;
+        if (part[p] == small_part) {
+            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
+                               v + 1 < x.H ? p + W : -1};
+            for (const int q : nb)
+                sb.small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
+        }
+        const int dirs[2][2] = {{1, 0}, {0, 1}};
+        for (const auto& dd : dirs) {
+            if (u + dd[0] >= W || v + dd[1] >= x.H) continue;
+            const int q = p + dd[0] + dd[1] * W;
+            if (ws.label[q] != l || part[q] == part[p]) continue;
+            ++sb.boundary;
+            const int pu = u - s * dd[0], pv = v - s * dd[1];
+            const int qu = u + dd[0] + s * dd[0], qv = v + dd[1] + s * dd[1];
+            if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) continue;
+            const int a = pv * W + pu, b = qv * W + qu;
+            if (!x.n.valid[a] || !x.n.valid[b]) continue;
+            sb.smooth += x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b] >= cos_crease;
+            ++sb.with_normals;
+        }
+    }
+    return sb;
+}
+
+/// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
+/// "Colour cue"). Writes ws.part at the segment's pixels once 2-means ran. True when the
+/// split is kept. Cost: O(segment pixels) per 2-means iteration and for the boundary; no
+/// allocation (called in parallel, one segment per call).
+bool try_colour_split(const Ctx& x, const ColourFeatures& ft, const ClusterParams& cp, float cos_crease,
+                      SegmentWorkspace& ws, int l) {
+    const SegmentParams& prm = x.prm;
+    const int o = ws.offsets[static_cast<std::size_t>(l)];
+    const int* px = ws.order.data() + o;
+    const int m = segment_size(ws, l);
+    const float* f[6];  // the segment's features
+    for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
+    float cen[2][6];
+    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen)) return false;
+    std::uint8_t* const side = ws.part_in_order.data() + o;
+    int count[2] = {0, 0};
+    two_means(f, m, side, cen, count);
+    std::uint8_t* part = ws.part.data();
+    for (int i = 0; i < m; ++i) part[px[i]] = side[i];
+    const int small = std::min(count[0], count[1]);
+    if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m)) return false;
+    const float dr = (cen[0][3] - cen[1][3]) / cp.alpha, dg = (cen[0][4] - cen[1][4]) / cp.alpha,
+                db = (cen[0][5] - cen[1][5]) / cp.alpha;
+    if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) return false;
+    // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
+    // crease step away on either side tell a smooth surface from a fold.
+    const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
+    const SplitBoundary sb = split_boundary(x, ws, l, px, m, small_part, cos_crease);
+    // A contact between two objects is one side of the smaller one's outline; a split
+    // along a texture (stripes, print) runs round most of each piece.
+    if (static_cast<float>(sb.boundary) > prm.color_max_boundary * static_cast<float>(sb.small_outline)) return false;
+    // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
+    // straddle its edge), or the parts must differ in chromaticity: light falling on two
+    // faces of one box at other angles scales their colour, it does not turn it, so
+    // across a fold (a flat box on another, flush boxes of two heights) only a change of
+    // material turns the mean colour by color_min_hue_deg.
+    const bool across_smooth = sb.with_normals > 0 && 10 * sb.smooth >= 7 * sb.with_normals;
+    if (!across_smooth) {
+        const float r0 = cen[0][3], g0 = cen[0][4], b0c = cen[0][5];
+        const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
+        const float dot = r0 * r1 + g0 * g1 + b0c * b1c;
+        const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
+        if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) return false;
+    }
+    return true;
+}
+
+/// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
+/// thread order). Returns the splits. Cost: one pass over the split segments' pixels.
+int number_splits(SegmentWorkspace& ws, int n) {
+    int splits = 0, next = n;
+    for (int l = 1; l <= n; ++l) {
+        if (!ws.split[static_cast<std::size_t>(l)]) continue;
+        const int id = ++next;
+        const int o = ws.offsets[static_cast<std::size_t>(l)];
+        const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
+        for (int i = 0; i < m; ++i) {
+            const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(o + i)]);
+            if (ws.part[p] == 1) ws.label[p] = id;
+        }
+        ++splits;
+    }
+    return splits;
+}
+
+}  // namespace
+
+/// The colour cue: tries to split each segment in two by 2-means under the paper's distance
+/// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
+/// are large, meet along a short boundary across a smooth surface. In: ws.label (1..n with
+/// gaps). Out: ws.label with part 1 of each split segment numbered n + 1, n + 2, ... in
+/// segment order. Cost: a counting sort and a gather of the object pixels (parallel passes),
+/// then O(segment pixels) per 2-means iteration per segment tried, segments in parallel.
+int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    sort_pixels_by_segment(x, ws, n);
+    // part is written for a segment's pixels before anything reads them: no clearing.
+    ws.part.resize(static_cast<std::size_t>(x.W) * x.H);
+    ws.part_in_order.resize(static_cast<std::size_t>(ws.offsets[static_cast<std::size_t>(n) + 1]));
+    ws.split.assign(static_cast<std::size_t>(n) + 1, 0);
+    ClusterParams cp;
+    cp.alpha = prm.color_alpha;
+    cp.delta = 1.0f - prm.color_alpha;
+    const ColourFeatures features = gather_features(x, cp, ws, n);
+    const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
+    // Each segment is tried on its own; split ids are given out in segment order afterwards
+    // so that the labels do not depend on the threads.
+    order_by_size(prm, ws, n);
+    const auto n_tried = static_cast<std::ptrdiff_t>(ws.by_size.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::ptrdiff_t t = 0; t < n_tried; ++t) {
+        const int l = ws.by_size[static_cast<std::size_t>(t)];
+        if (try_colour_split(x, features, cp, cos_crease, ws, l)) ws.split[static_cast<std::size_t>(l)] = 1;
+    }
+    return number_splits(ws, n);
+}
+
+// ---- scope ---------------------------------------------------------------------------------
+
+namespace {
+
+/// The frame's edge: the image border and the rows and columns with no depth at all that
+/// reach it, when they are a narrow band (a sensor's registration border: 48 rows and 63
+/// columns of a Kinect v1's 640x480). A segment cut there goes on out of view. A wider band
+/// without depth is a view past the depth range or a crop, which says nothing of what the
+/// segment does there.
+struct FrameEdge {
+    int top, bottom, left, right;  ///< the rows [top, bottom) and columns [left, right) with depth
+    int edge_top, edge_bottom, edge_left, edge_right;  ///< the edge's rows and columns; -1: none
+};
+
+/// FrameEdge of the frame. Cost: a pass over each row and column without depth at the
+/// border, and over the first one with depth.
+FrameEdge find_frame_edge(const Ctx& x) {
+    const int W = x.W, H = x.H;
+    int top = 0, bottom = H, left = 0, right = W;
+    auto row_empty = [&](int v) {
+        for (int u = 0; u < W; ++u)
+            if (x.c.valid[static_cast<std::size_t>(v) * W + u]) return false;
+        return true;
+    };
+    auto col_empty = [&](int u) {
+        for (int v = 0; v < H; ++v)
+            if (x.c.valid[static_cast<std::size_t>(v) * W + u]) return false;
+        return true;
+    };
+    while (top < H && row_empty(top)) ++top;
+    while (bottom > top && row_empty(bottom - 1)) --bottom;
+    while (left < W && col_empty(left)) ++left;
+    while (right > left && col_empty(right - 1)) --right;
+    const int band_rows = H / 8, band_cols = W / 8;
+    const int edge_top = top <= band_rows ? top : -1, edge_bottom = H - bottom <= band_rows ? bottom - 1 : -1;
+    const int edge_left = left <= band_cols ? left : -1, edge_right = W - right <= band_cols ? right - 1 : -1;
+    return {top, bottom, left, right, edge_top, edge_bottom, edge_left, edge_right};
+}
+
+/// The support's middle in depth: the mean depth of the removed points on it. Walls and
+/// furniture leave the volume beyond it; on the near half an object cut by the frame (at
+/// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
+/// table's near edge, is still on the table. Cost: one pass over the pixels.
+float support_middle_depth(const Ctx& x, const Plane& pl) {
+    const SegmentParams& prm = x.prm;
+    double table_z = 0, table_n = 0;
+    for (std::size_t p = 0; p < x.c.size(); ++p) {
+        if (!x.c.valid[p] || x.cls[p] != kPlaneRemoved) continue;
+        const float z = x.c.z[p];
+        if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p])) > prm.depth_jump_m + prm.depth_jump_rel * z * z)
+            continue;
+        table_z += z;
+        table_n += 1;
+    }
+    return table_n > 0 ? static_cast<float>(table_z / table_n) : 0.0f;
+}
+
+/// Per segment, over the frame inside its edge: the lowest and highest point over the
+/// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
+/// (ws.sizes), outline pairs (scope_outline) and those that lead out of the volume
+/// (scope_outside: into removed points above the support, or into the frame's edge, beyond
+/// the support's middle `far_z`); the touching segment pairs, once each, into ws.edges. In:
+/// ws.label (1..n with gaps). Cost: one pass over the pixels, then a sort of the pairs.
+void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
+                   int n) {
+    const int W = x.W;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.scope_lo.assign(L, std::numeric_limits<float>::max());
+    ws.scope_hi.assign(L, -std::numeric_limits<float>::max());
+    ws.scope_high.assign(L, 0);
+    ws.scope_outline.assign(L, 0);
+    ws.scope_outside.assign(L, 0);
+    ws.sizes.assign(L, 0);
+    ws.edges.clear();
+    const int* const label = ws.label.data();
+    const SegmentParams& prm = x.prm;
+    auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
+    // A removed point clearly above the support (by more than the depth noise at its depth)
+    // was removed for lying off the support's hull: the segment that runs on into it, with
+    // continuous depth, continues beyond the support's volume.
+    auto beyond = [&](std::size_t q, std::size_t p) {
+        if (!x.c.valid[q] || x.cls[q] != kPlaneRemoved || !x.connected(p, q)) return false;
+        const float z = x.c.z[q];
+        return height(q) > prm.depth_jump_m + prm.depth_jump_rel * z * z;
+    };
+    // Outline pairs: touching segment pairs, and the pairs that lead out of the volume.
+    auto pair = [&](std::size_t p, std::size_t q) {
+        const int a = label[p], b = label[q];
+        if (a == b) return;
+        if (a) ++ws.scope_outline[static_cast<std::size_t>(a)];
+        if (b) ++ws.scope_outline[static_cast<std::size_t>(b)];
+        if (a && b) {
+            ws.edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
+                               static_cast<std::uint64_t>(std::max(a, b)) << 1);
+        } else if (a) {
+            ws.scope_outside[static_cast<std::size_t>(a)] += x.c.z[p] > far_z && beyond(q, p);
+        } else {
+            ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
+        }
+    };
+    for (int v = fe.top; v < fe.bottom; ++v)
+        for (int u = fe.left; u < fe.right; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            if (const int l = label[p]) {
+                const float h = height(p);
+                const auto li = static_cast<std::size_t>(l);
+                ws.scope_lo[li] = std::min(ws.scope_lo[li], h);
+                ws.scope_hi[li] = std::max(ws.scope_hi[li], h);
+                ws.scope_high[li] += h > prm.scope_max_height_m;
+                ++ws.sizes[li];
+                // On the frame's edge, beyond the support's middle.
+                const int on_edge = x.c.z[p] > far_z ? (v == fe.edge_top) + (u == fe.edge_left) +
+                                                           (u == fe.edge_right) + (v == fe.edge_bottom)
+                                                     : 0;
+                ws.scope_outline[li] += on_edge;
+                ws.scope_outside[li] += on_edge;
+            }
+            if (u + 1 < fe.right) pair(p, p + 1);
+            if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
+        }
+    std::sort(ws.edges.begin(), ws.edges.end());
+    ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
+}
+
+/// ws.scope_keep per segment, from measure_scope's counts: bit 0 inside the volume, bit 1
+/// kept. Inside: under the height limit (2 % of the points may be noise) and not running on
+/// past the hull or out of view. Kept: stands (the lowest point touches the support), or
+/// rests on a kept segment: touches it in the image (a box on a box, a lid on a tin, an
+/// object behind another with its foot hidden). No height test: a supported object's visible
+/// bottom can lie well above its supporter's visible top (a tin's lid overhangs what it
+/// stands on), and what hangs or is fixed to a wall has already left the volume. Cost: O(n),
+/// then passes over ws.edges until "rests on" stops spreading.
+void decide_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    auto& keep = ws.scope_keep;
+    keep.assign(L, 0);
+    for (std::size_t l = 1; l < L; ++l) {
+        if (ws.sizes[l] == 0) continue;
+        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
+                            static_cast<float>(ws.scope_outside[l]) <=
+                                prm.scope_max_outside * static_cast<float>(ws.scope_outline[l]);
+        keep[l] = static_cast<std::uint8_t>(inside ? (ws.scope_lo[l] <= prm.scope_contact_m ? 3 : 1) : 0);
+    }
+    for (bool grew = true; grew;) {
+        grew = false;
+        for (const std::uint64_t e : ws.edges) {
+            const auto a = static_cast<std::size_t>(e >> 33), b = static_cast<std::size_t>((e >> 1) & 0xffffffffu);
+            for (const auto& [s, t] : {std::pair{a, b}, std::pair{b, a}}) {
+                if (keep[s] != 3 || keep[t] != 1) continue;
+                keep[t] = 3;
+                grew = true;
+            }
+        }
+    }
+}
+
+/// Clears the labels of the segments not kept. Returns those of min_points or more (within
+/// the frame's edge). Cost: one pass over the pixels.
+int clear_out_of_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    const auto& keep = ws.scope_keep;
+    int left_out = 0;
+    for (std::size_t l = 1; l < L; ++l)
+        left_out += keep[l] != 3 && ws.sizes[l] >= prm.min_points;
+    for (int& l : ws.label)
+        if (l && keep[static_cast<std::size_t>(l)] != 3) l = 0;
+    return left_out;
+}
+
+
+}  // namespace
+
+/// Scope::Support (docs/DESIGN.md, "Scope"): keeps the segments the support holds and
+/// clears the others' labels in ws.label. In: ws.label (1..n with gaps), the support, the
+/// plane's classes. Out: the number of segments of min_points or more left out. Cost: one
+/// pass over the pixels (heights, outlines, touching pairs) and one over the depths, then a
+/// few passes over the touching pairs until "rests on" stops spreading.
+int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    const FrameEdge edge = find_frame_edge(x);
+    const float far_z = support_middle_depth(x, pl);
+    measure_scope(x, pl, edge, far_z, ws, n);
+    decide_scope(x.prm, ws, n);
+    return clear_out_of_scope(x.prm, ws, n);
+}
+
+
+}  // namespace wul3d::detail
