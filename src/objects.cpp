@@ -1,6 +1,8 @@
 #include "wul3d/objects.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "param_check.hpp"
@@ -65,14 +67,7 @@ void SelectedObject::update(const LabelImage& labels, std::vector<std::uint8_t>&
     if (pixels_ > 0) previous_ = mask;
 }
 
-}  // namespace wul3d
-
 // ---- objects and tracks -----------------------------------------------------------------
-
-#include <Eigen/Eigenvalues>
-#include <cmath>
-
-namespace wul3d {
 
 namespace {
 template <class T>
@@ -86,6 +81,8 @@ constexpr int kObjSums = detail::kMoments + 3;
 // The per-pixel passes are summed per fixed band of rows, then in band order, so that the
 // results do not depend on the number of threads.
 constexpr int kBands = 16;
+// Per object, the extents: aabb min (3), OBB projection min (3), aabb max (3), OBB max (3).
+constexpr int kExt = 12;
 }  // namespace
 
 void ObjectParams::validate() const {
@@ -127,87 +124,126 @@ void ObjectTracker::free_slot(int slot) {
     tracks_[static_cast<std::size_t>(slot)] = Track{};
 }
 
+// One frame, in phases. N pixels, S segments, K = max_tracks slots, O objects out, C the
+// largest cluster label, B = kBands. The per-pixel phases run on all threads; their sums
+// are made per band of rows and reduced in band order, so no result depends on the
+// number of threads.
 void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments,
                          const LabelImage& clusters, LabelImage& objects,
                          std::vector<DetectedObject>& out) {
-    const int W = cloud.width, H = cloud.height;
-    const std::size_t N = cloud.size();
-    const int K = params_.max_tracks;
-    const std::size_t Kz = static_cast<std::size_t>(K);
-    if (W != width_ || H != height_) {
-        width_ = W;
-        height_ = H;
-        mu_.assign(N, PixelWeights{});
-        has_mu_.assign(N, 0);
-        slot_of_.assign(N, 0);
-        prev_z_.assign(N, 0.0f);
-        prev_rgb_.assign(3 * N, 0);
-        changed_.assign(N, 0);
-        reset();
-    }
-    {
-        // A scene cut: most surfaces moved at once. Weights and tracks start afresh.
-        // A pixel whose surface changed (an object arrived, left or moved over it) forgets
-        // its weights: they are the history of another surface.
-        std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
-        const float rgb2 = params_.surface_change_rgb * params_.surface_change_rgb;
-        const float change_m = params_.surface_change_m, change_rel = params_.surface_change_rel;
-        // Raw pointers: byte stores would make the compiler reload every vector's data
-        // pointer on each pixel (a char store may alias anything).
-        const std::uint8_t* const valid = cloud.valid.data();
-        const float* const cz = cloud.z.data();
-        const std::uint8_t *const cr = cloud.r.data(), *const cg = cloud.g.data(),
-                           *const cb = cloud.b.data();
-        const std::uint8_t* const has_mu = has_mu_.data();
-        float* const prev_z = prev_z_.data();
-        std::uint8_t* const prev_rgb = prev_rgb_.data();
-        std::uint8_t* const changed = changed_.data();
-        const auto Nn = static_cast<std::ptrdiff_t>(N);
-#pragma omp parallel for schedule(static) reduction(+ : both, moved, held, held_moved)
-        for (std::ptrdiff_t i = 0; i < Nn; ++i) {
-            const std::size_t p = static_cast<std::size_t>(i);
-            const float z = valid[p] ? cz[p] : 0.0f;
-            std::uint8_t* rgb = prev_rgb + 3 * p;
-            if (z > 0 && prev_z[p] > 0) {
-                ++both;
-                const float dz = std::fabs(z - prev_z[p]);
-                moved += dz > 0.05f;
-                const int dr = cr[p] - rgb[0], dg = cg[p] - rgb[1], db = cb[p] - rgb[2];
-                const bool depth_moved = dz > change_m + change_rel * z * z;
-                held += has_mu[p];
-                held_moved += has_mu[p] && depth_moved;
-                // Reset after the votes below: the old weights still say which track was
-                // here, evidence of overlap for a moving object.
-                changed[p] = has_mu[p] && (depth_moved || static_cast<float>(dr * dr + dg * dg + db * db) > rgb2);
-            } else {
-                changed[p] = 0;
-            }
-            prev_z[p] = z;
-            rgb[0] = cr[p];
-            rgb[1] = cg[p];
-            rgb[2] = cb[p];
-        }
-        // Most of the surfaces the objects held moved: the objects were rearranged (a folder
-        // of separate scenes), not moved along.
-        const bool objects_moved = held > 0 && static_cast<double>(held_moved) >
-                                                   params_.rearranged_share * static_cast<double>(held);
-        if (tau_ > 0 && (both == 0 || objects_moved ||
-                         static_cast<double>(moved) > params_.scene_cut_share * static_cast<double>(both))) {
-            std::fill(mu_.begin(), mu_.end(), PixelWeights{});
-            std::fill(has_mu_.begin(), has_mu_.end(), 0);
-            std::fill(changed_.begin(), changed_.end(), 0);
-            tracks_.assign(Kz, Track{});
-            ++scene_cuts_;
-        }
-    }
+    if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
+    // Pixels whose surface changed forget their weights (in weigh_pixels, after the votes);
+    // a scene cut forgets everything.
+    if (mark_surface_changes(cloud)) start_afresh();
     ++tau_;
-    const int S = n_segments;
 
-    // 1. Each segment's votes for the track slots: the sum of its pixels' weights, i.e. the
-    //    overlap with the previous frames' objects as the paper's weights remember them.
-    //    Summed per fixed band of rows, then in band order: the same result whatever the
-    //    number of threads (votes in integer units of the weights: exact in any order).
-    const std::size_t S1 = static_cast<std::size_t>(S + 1);
+    // Segments to track slots: by the weight mass they overlap, else by distance, else new.
+    measure_segments(cloud, segments, n_segments);
+    match_by_overlap(n_segments);
+    match_by_distance_or_start(n_segments);
+
+    // The paper's weights on the slots give each pixel its object.
+    weigh_pixels(cloud, segments);
+
+    // The objects: sums, then their description, then the label image and what needs the
+    // description (extents along the oriented box's axes).
+    sum_objects(cloud);
+    describe_objects(out);
+    const std::size_t n_cluster_labels =
+        write_labels_and_extents(cloud, segments, n_segments, clusters, objects, out);
+    finish_objects(n_segments, n_cluster_labels, out);
+
+    // What the next frame matches against.
+    follow_tracks();
+}
+
+// New resolution: per-pixel state sized to N and everything forgotten, as reset().
+void ObjectTracker::allocate(int width, int height) {
+    const std::size_t N = static_cast<std::size_t>(width) * height;
+    width_ = width;
+    height_ = height;
+    mu_.assign(N, PixelWeights{});
+    has_mu_.assign(N, 0);
+    slot_of_.assign(N, 0);
+    prev_z_.assign(N, 0.0f);
+    prev_rgb_.assign(3 * N, 0);
+    changed_.assign(N, 0);
+    reset();
+}
+
+// In: the cloud, prev_z_, prev_rgb_, has_mu_. Out: changed_ (1 where a pixel that held
+// weights now sees another surface: an object arrived, left or moved over it), prev_z_ and
+// prev_rgb_ set to this frame. Returns true on a scene cut: most surfaces moved at once.
+// Cost: one pass over N pixels, no allocation.
+bool ObjectTracker::mark_surface_changes(const OrganizedCloud& cloud) {
+    const std::size_t N = cloud.size();
+    std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
+    const float rgb2 = params_.surface_change_rgb * params_.surface_change_rgb;
+    const float change_m = params_.surface_change_m, change_rel = params_.surface_change_rel;
+    // Raw pointers: byte stores would make the compiler reload every vector's data
+    // pointer on each pixel (a char store may alias anything).
+    const std::uint8_t* const valid = cloud.valid.data();
+    const float* const cz = cloud.z.data();
+    const std::uint8_t *const cr = cloud.r.data(), *const cg = cloud.g.data(),
+                       *const cb = cloud.b.data();
+    const std::uint8_t* const has_mu = has_mu_.data();
+    float* const prev_z = prev_z_.data();
+    std::uint8_t* const prev_rgb = prev_rgb_.data();
+    std::uint8_t* const changed = changed_.data();
+    const auto Nn = static_cast<std::ptrdiff_t>(N);
+#pragma omp parallel for schedule(static) reduction(+ : both, moved, held, held_moved)
+    for (std::ptrdiff_t i = 0; i < Nn; ++i) {
+        const std::size_t p = static_cast<std::size_t>(i);
+        const float z = valid[p] ? cz[p] : 0.0f;
+        std::uint8_t* rgb = prev_rgb + 3 * p;
+        if (z > 0 && prev_z[p] > 0) {
+            ++both;
+            const float dz = std::fabs(z - prev_z[p]);
+            moved += dz > 0.05f;
+            const int dr = cr[p] - rgb[0], dg = cg[p] - rgb[1], db = cb[p] - rgb[2];
+            const bool depth_moved = dz > change_m + change_rel * z * z;
+            held += has_mu[p];
+            held_moved += has_mu[p] && depth_moved;
+            // Reset after the votes: the old weights still say which track was here,
+            // evidence of overlap for a moving object.
+            changed[p] = has_mu[p] && (depth_moved || static_cast<float>(dr * dr + dg * dg + db * db) > rgb2);
+        } else {
+            changed[p] = 0;
+        }
+        prev_z[p] = z;
+        rgb[0] = cr[p];
+        rgb[1] = cg[p];
+        rgb[2] = cb[p];
+    }
+    // Most of the surfaces the objects held moved: the objects were rearranged (a folder
+    // of separate scenes), not moved along.
+    const bool objects_moved = held > 0 && static_cast<double>(held_moved) >
+                                               params_.rearranged_share * static_cast<double>(held);
+    return tau_ > 0 && (both == 0 || objects_moved ||
+                        static_cast<double>(moved) > params_.scene_cut_share * static_cast<double>(both));
+}
+
+// A scene cut: weights, changes and tracks forgotten; track ids go on counting.
+// Cost: O(N), no allocation.
+void ObjectTracker::start_afresh() {
+    std::fill(mu_.begin(), mu_.end(), PixelWeights{});
+    std::fill(has_mu_.begin(), has_mu_.end(), 0);
+    std::fill(changed_.begin(), changed_.end(), 0);
+    tracks_.assign(static_cast<std::size_t>(params_.max_tracks), Track{});
+    ++scene_cuts_;
+}
+
+// In: segments, the cloud, mu_. Out: votes_ ((S+1) x K: each segment's sum of its pixels'
+// weights per slot, i.e. its overlap with the previous frames' objects as the paper's
+// weights remember them) and seg_sums_ ((S+1) x kSegSums: pixel count and x, y, z sums).
+// Votes are summed in integer units of the weights: exact in any order.
+// Cost: one pass over N pixels (6 weights each), then O(B x S x K); allocates only when S
+// grows.
+void ObjectTracker::measure_segments(const OrganizedCloud& cloud, const LabelImage& segments,
+                                     int n_segments) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
+    const std::size_t S1 = static_cast<std::size_t>(n_segments + 1);
     band_votes_.assign(kBands * S1 * Kz, 0);
     band_seg_sums_.assign(kBands * S1 * kSegSums, 0.0);
 #pragma omp parallel for schedule(static)
@@ -239,8 +275,16 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         for (std::size_t i = 0; i < S1 * kSegSums; ++i) seg_sums_[i] += sums[i];
     }
     for (double& v : votes_) v /= static_cast<double>(PixelWeights::kOne);
+}
 
-    // 2. Greedy one-to-one matching by vote, largest first.
+// In: votes_, seg_sums_, tracks_. Out: seg_slot_ (S+1: the slot each segment continues,
+// -1 none yet) and slot_taken_ (K). A segment and a live track pair when the votes cover
+// min_overlap of the smaller; pairs are taken greedily, one to one, largest vote first
+// (ties: smaller segment, then smaller slot).
+// Cost: O(S x K log(S x K)); allocates the list of pairs.
+void ObjectTracker::match_by_overlap(int n_segments) {
+    const int S = n_segments, K = params_.max_tracks;
+    const std::size_t Kz = static_cast<std::size_t>(K);
     struct Pair {
         double vote;
         int s, j;
@@ -259,14 +303,21 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         return a.vote != b.vote ? a.vote > b.vote : (a.s != b.s ? a.s < b.s : a.j < b.j);
     });
     seg_slot_.assign(static_cast<std::size_t>(S + 1), -1);
-    std::vector<std::uint8_t> slot_taken(Kz, 0);
+    slot_taken_.assign(Kz, 0);
     for (const Pair& pr : pairs) {
-        if (seg_slot_[static_cast<std::size_t>(pr.s)] >= 0 || slot_taken[static_cast<std::size_t>(pr.j)]) continue;
+        if (seg_slot_[static_cast<std::size_t>(pr.s)] >= 0 || slot_taken_[static_cast<std::size_t>(pr.j)]) continue;
         seg_slot_[static_cast<std::size_t>(pr.s)] = pr.j;
-        slot_taken[static_cast<std::size_t>(pr.j)] = 1;
+        slot_taken_[static_cast<std::size_t>(pr.j)] = 1;
     }
-    // 3. Segments left over: a track not matched this frame whose last centroid is near
-    //    (an object that moved faster than its overlap), else a new track.
+}
+
+// In and out: seg_slot_, slot_taken_, tracks_. Each segment left over, in order, takes the
+// nearest untaken track within max_jump_m of its centroid and of a similar size (an object
+// that moved faster than its overlap), else a new track id in a free slot, else in the
+// slot lost longest (whose weights are forgotten); with no slot left it is dropped.
+// Cost: O(S x K), and O(N) per slot taken over; no allocation.
+void ObjectTracker::match_by_distance_or_start(int n_segments) {
+    const int S = n_segments, K = params_.max_tracks;
     for (int s = 1; s <= S; ++s) {
         if (seg_slot_[static_cast<std::size_t>(s)] >= 0) continue;
         const double* ss = seg_sums_.data() + static_cast<std::size_t>(s) * kSegSums;
@@ -275,7 +326,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         double best_d = params_.max_jump_m;
         for (int j = 0; j < K; ++j) {
             const Track& t = tracks_[static_cast<std::size_t>(j)];
-            if (t.id == 0 || slot_taken[static_cast<std::size_t>(j)]) continue;
+            if (t.id == 0 || slot_taken_[static_cast<std::size_t>(j)]) continue;
             const double ratio = ss[0] / std::max<double>(1.0, static_cast<double>(t.pixels));
             if (ratio < 0.33 || ratio > 3.0) continue;
             const double d = std::sqrt((cx - t.x) * (cx - t.x) + (cy - t.y) * (cy - t.y) + (cz - t.z) * (cz - t.z));
@@ -290,7 +341,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
                 if (tracks_[static_cast<std::size_t>(j)].id == 0) best = j;
             if (best < 0) {
                 for (int j = 0; j < K; ++j) {
-                    if (slot_taken[static_cast<std::size_t>(j)]) continue;
+                    if (slot_taken_[static_cast<std::size_t>(j)]) continue;
                     const Track& t = tracks_[static_cast<std::size_t>(j)];
                     if (best < 0 || t.lost > tracks_[static_cast<std::size_t>(best)].lost ||
                         (t.lost == tracks_[static_cast<std::size_t>(best)].lost &&
@@ -303,16 +354,22 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             tracks_[static_cast<std::size_t>(best)].id = next_id_++;
         }
         seg_slot_[static_cast<std::size_t>(s)] = best;
-        slot_taken[static_cast<std::size_t>(best)] = 1;
+        slot_taken_[static_cast<std::size_t>(best)] = 1;
     }
+}
 
-    // 4. The paper's weights on objects: each segment pixel adds psi to its track's weight
-    //    (eq. 2, 7, 8, the same update_weights as the clusters); its object is the arg-max.
-    //    A pixel with depth outside every object forgets its weights.
-    // Raw pointers, as in the surface-change pass above.
+// The paper's weights on objects. In: segments, seg_slot_, slot_taken_, changed_, the
+// cloud's validity. Out: mu_ and has_mu_ (each segment pixel adds psi to its slot's weight:
+// eq. 2, 7, 8, the same update_weights as the clusters; a changed pixel forgets first; a
+// pixel with depth outside every segment forgets), slot_of_ (arg-max slot + 1 among the
+// slots taken this frame, 0 none).
+// Cost: one pass over N pixels, no allocation.
+void ObjectTracker::weigh_pixels(const OrganizedCloud& cloud, const LabelImage& segments) {
+    const std::size_t N = cloud.size();
+    // Raw pointers, as in mark_surface_changes.
     const std::uint16_t* const seg = segments.labels.data();
     const int* const seg_slot = seg_slot_.data();
-    const std::uint8_t* const taken = slot_taken.data();
+    const std::uint8_t* const taken = slot_taken_.data();
     const std::uint8_t* const valid = cloud.valid.data();
     std::uint8_t* const changed = changed_.data();
     std::uint8_t* const has_mu = has_mu_.data();
@@ -353,8 +410,14 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             slot_of[p] = 0;
         }
     }
+}
 
-    // 5. Objects: sums per slot and 2D boxes, per band of rows (as in 1), then summed.
+// In: slot_of_, the cloud. Out: obj_sums_ (K x kObjSums: point moments and colour sums per
+// slot) and obj_boxes_ (K x 4: u_min, v_min, u_max, v_max; W, H, -1, -1 where empty).
+// Cost: one pass over N pixels, then O(B x K); no allocation after the first frame.
+void ObjectTracker::sum_objects(const OrganizedCloud& cloud) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
     band_obj_sums_.assign(kBands * Kz * kObjSums, 0.0);
     band_boxes_.assign(kBands * Kz * 4, 0);
 #pragma omp parallel for schedule(static)
@@ -380,30 +443,36 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             }
     }
     obj_sums_.assign(Kz * kObjSums, 0.0);
-    std::vector<int> umin(Kz, W), vmin(Kz, H), umax(Kz, -1), vmax(Kz, -1);
+    obj_boxes_.resize(Kz * 4);
+    for (std::size_t j = 0; j < Kz; ++j) {
+        obj_boxes_[4 * j] = W;
+        obj_boxes_[4 * j + 1] = H;
+        obj_boxes_[4 * j + 2] = obj_boxes_[4 * j + 3] = -1;
+    }
     for (int band = 0; band < kBands; ++band) {
         const double* sums = band_obj_sums_.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
         const int* boxes = band_boxes_.data() + static_cast<std::size_t>(band) * Kz * 4;
         for (std::size_t i = 0; i < Kz * kObjSums; ++i) obj_sums_[i] += sums[i];
-        for (std::size_t j = 0; j < Kz; ++j) {
-            umin[j] = std::min(umin[j], boxes[4 * j]);
-            vmin[j] = std::min(vmin[j], boxes[4 * j + 1]);
-            umax[j] = std::max(umax[j], boxes[4 * j + 2]);
-            vmax[j] = std::max(vmax[j], boxes[4 * j + 3]);
+        for (std::size_t i = 0; i < Kz * 4; i += 4) {
+            obj_boxes_[i] = std::min(obj_boxes_[i], boxes[i]);
+            obj_boxes_[i + 1] = std::min(obj_boxes_[i + 1], boxes[i + 1]);
+            obj_boxes_[i + 2] = std::max(obj_boxes_[i + 2], boxes[i + 2]);
+            obj_boxes_[i + 3] = std::max(obj_boxes_[i + 3], boxes[i + 3]);
         }
     }
-    // Objects too small after weighting are dropped (their pixels become background).
-    std::vector<std::uint8_t> keep(Kz, 0);
-    for (std::size_t j = 0; j < Kz; ++j)
-        keep[j] = obj_sums_[j * kObjSums] >= params_.min_points && tracks_[j].id != 0;
+}
 
-    objects.width = W;
-    objects.height = H;
-    objects.labels.resize(N);
+// In: obj_sums_, obj_boxes_, tracks_. Out: `out`, one object per live slot with at least
+// min_points pixels (smaller ones are dropped: their pixels become background), in slot
+// order: id, pixels, centroid, OBB axes (largest spread first), 2D box, mean colour; and
+// object_of_slot_ (K: its index in `out`, -1 none).
+// Cost: O(K) and a 3x3 eigen-decomposition per object; allocates the objects.
+void ObjectTracker::describe_objects(std::vector<DetectedObject>& out) {
+    const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
     out.clear();
-    std::vector<int> index_of(Kz, -1);
+    object_of_slot_.assign(Kz, -1);
     for (std::size_t j = 0; j < Kz; ++j) {
-        if (!keep[j]) continue;
+        if (!(obj_sums_[j * kObjSums] >= params_.min_points && tracks_[j].id != 0)) continue;
         const double* o = obj_sums_.data() + j * kObjSums;
         const double n = o[0];
         DetectedObject d;
@@ -418,21 +487,34 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             for (int b = 0; b < 3; ++b)
                 d.obb_axes[static_cast<std::size_t>(3 * a + b)] =
                     static_cast<float>(eig.eigenvectors()(b, 2 - a));  // largest spread first
-        d.u_min = umin[j]; d.u_max = umax[j]; d.v_min = vmin[j]; d.v_max = vmax[j];
+        const int* box = obj_boxes_.data() + 4 * j;
+        d.u_min = box[0]; d.u_max = box[2]; d.v_min = box[1]; d.v_max = box[3];
         d.mean_rgb = {static_cast<float>(o[10] / n), static_cast<float>(o[11] / n), static_cast<float>(o[12] / n)};
-        index_of[j] = static_cast<int>(out.size());
+        object_of_slot_[j] = static_cast<int>(out.size());
         out.push_back(std::move(d));
     }
-    // Second pass, per band of rows: the label image, the boxes' extents (axis-aligned and
-    // along the OBB axes), source clusters and segments; then merged in band order (minima,
-    // maxima, counts and flags: exact in any order).
+}
+
+// In: slot_of_, object_of_slot_, `out`, the cloud, segments, clusters. Out: `objects` (the
+// label image: track id, 0 background) and, per band of rows and object, the extents
+// (axis-aligned and along the OBB axes), the pixels per cluster and the segments seen.
+// Returns C + 1, the range of cluster labels counted.
+// Cost: one pass over N pixels, then O(B x O x (C + S)) to clear the band buffers.
+std::size_t ObjectTracker::write_labels_and_extents(const OrganizedCloud& cloud, const LabelImage& segments,
+                                                    int n_segments, const LabelImage& clusters,
+                                                    LabelImage& objects,
+                                                    const std::vector<DetectedObject>& out) {
+    const int W = cloud.width, H = cloud.height;
+    objects.width = W;
+    objects.height = H;
+    objects.labels.resize(cloud.size());
+    const std::size_t S1 = static_cast<std::size_t>(n_segments + 1);
     const std::size_t O = out.size();
     int max_cluster = 0;
     const auto Nc = static_cast<std::ptrdiff_t>(clusters.labels.size());
 #pragma omp parallel for schedule(static) reduction(max : max_cluster)
     for (std::ptrdiff_t p = 0; p < Nc; ++p) max_cluster = std::max<int>(max_cluster, clusters.labels[static_cast<std::size_t>(p)]);
     const std::size_t C1 = static_cast<std::size_t>(max_cluster) + 1;
-    constexpr int kExt = 12;  // aabb min (3), aabb max (3), OBB projection min (3), max (3)
     band_extents_.assign(kBands * O * kExt, 0.0f);
     band_cluster_count_.assign(kBands * O * C1, 0);
     band_segment_seen_.assign(kBands * O * S1, 0);
@@ -449,7 +531,7 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
         const std::size_t p0 = static_cast<std::size_t>(H * band / kBands) * W;
         const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kBands) * W;
         for (std::size_t p = p0; p < p1; ++p) {
-            const int i = slot_of_[p] ? index_of[slot_of_[p] - 1u] : -1;
+            const int i = slot_of_[p] ? object_of_slot_[slot_of_[p] - 1u] : -1;
             if (i < 0) {
                 objects.labels[p] = 0;
                 continue;
@@ -470,6 +552,18 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
             seen[static_cast<std::size_t>(i) * S1 + segments.labels[p]] = 1;
         }
     }
+    return C1;
+}
+
+// In: the band buffers of write_labels_and_extents. Out: each object's aabb_min, aabb_max,
+// obb_centre, obb_half_extent, source_clusters (>= 5 % of its pixels) and source_segments.
+// Minima, maxima, counts and flags: exact in any order of the bands.
+// Cost: O(B x O x (C + S)); allocates the source lists.
+void ObjectTracker::finish_objects(int n_segments, std::size_t n_cluster_labels,
+                                   std::vector<DetectedObject>& out) const {
+    const std::size_t S1 = static_cast<std::size_t>(n_segments + 1);
+    const std::size_t C1 = n_cluster_labels;
+    const std::size_t O = out.size();
     for (std::size_t i = 0; i < O; ++i) {
         DetectedObject& d = out[i];
         float e[kExt];
@@ -508,8 +602,14 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
                     break;
                 }
     }
+}
 
-    // 6. Tracks: remember where each object is; count frames unseen; retire the long lost.
+// In: obj_sums_. Out: tracks_: a slot with pixels this frame remembers its size and
+// centroid; one without counts a frame lost, and is retired (weights forgotten) after
+// max_lost_frames.
+// Cost: O(K), and O(N) per slot retired; no allocation.
+void ObjectTracker::follow_tracks() {
+    const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
     for (std::size_t j = 0; j < Kz; ++j) {
         Track& t = tracks_[j];
         if (t.id == 0) continue;

@@ -90,23 +90,47 @@ private:
         std::size_t pixels = 0;
         float x = 0, y = 0, z = 0;
     };
-    void free_slot(int slot);
+
+    // The phases of step(), in order; objects.cpp states each one's inputs, outputs and cost.
+    void allocate(int width, int height);
+    bool mark_surface_changes(const OrganizedCloud& cloud);  ///< true: a scene cut
+    void start_afresh();
+    void measure_segments(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments);
+    void match_by_overlap(int n_segments);
+    void match_by_distance_or_start(int n_segments);
+    void weigh_pixels(const OrganizedCloud& cloud, const LabelImage& segments);
+    void sum_objects(const OrganizedCloud& cloud);
+    void describe_objects(std::vector<DetectedObject>& out);
+    std::size_t write_labels_and_extents(const OrganizedCloud& cloud, const LabelImage& segments,
+                                         int n_segments, const LabelImage& clusters,
+                                         LabelImage& objects, const std::vector<DetectedObject>& out);
+    void finish_objects(int n_segments, std::size_t n_cluster_labels,
+                        std::vector<DetectedObject>& out) const;
+    void follow_tracks();
+    void free_slot(int slot);  ///< retires a track and forgets its weights
 
     ObjectParams params_;
+    // State across frames.
     int width_ = 0, height_ = 0;
     std::int64_t tau_ = 0;
     int next_id_ = 1;
+    int scene_cuts_ = 0;
     std::vector<Track> tracks_;           ///< max_tracks slots
     std::vector<PixelWeights> mu_;        ///< per pixel, the kept weights over track slots
     std::vector<std::uint8_t> has_mu_;    ///< 1 where a pixel's weights are not all zero
-    std::vector<std::uint8_t> slot_of_;   ///< arg-max slot + 1 per pixel this frame, 0 none
     std::vector<float> prev_z_;           ///< last frame's depth (0 = none), for scene cuts
     std::vector<std::uint8_t> prev_rgb_;  ///< last frame's colour, 3 bytes a pixel
-    std::vector<std::uint8_t> changed_;   ///< 1 where the pixel's surface changed this frame
-    int scene_cuts_ = 0;
-    // per-frame scratch
-    std::vector<double> votes_, seg_sums_, obj_sums_;
-    std::vector<int> seg_slot_;
+
+    // This frame's results, passed from phase to phase; members, reused from frame to frame.
+    // S segments, K = max_tracks slots.
+    std::vector<std::uint8_t> changed_;      ///< per pixel, 1 where its surface changed
+    std::vector<double> votes_, seg_sums_;   ///< per segment: weight mass per slot; count, x, y, z
+    std::vector<int> seg_slot_;              ///< per segment, its slot (-1: none)
+    std::vector<std::uint8_t> slot_taken_;   ///< per slot, 1 where a segment took it
+    std::vector<std::uint8_t> slot_of_;      ///< per pixel, its arg-max slot + 1, 0 none
+    std::vector<double> obj_sums_;           ///< per slot, point moments and colour sums
+    std::vector<int> obj_boxes_;             ///< per slot, u_min, v_min, u_max, v_max
+    std::vector<int> object_of_slot_;        ///< per slot, its index in step's `out` (-1: none)
     // Per band of rows (objects.cpp, kBands), reduced in band order:
     std::vector<std::uint64_t> band_votes_;
     std::vector<double> band_seg_sums_, band_obj_sums_;
