@@ -2,25 +2,28 @@
 """Runs wul3d and the classical peers on the same OSD frames, scores each with `wul3d eval`
 and writes the CSVs that scripts/plot-peers.py draws (docs/peers_quality.png, peers_speed.png).
 
-Usage: eval/peers.py [--wul3d build/wul3d] [--data ../shared/data] [--out /tmp/wul3d-peers]
-                     [--csv-dir docs] [--threads N]
+Usage: eval/peers.py [--wul3d build/wul3d] [--pcl build/eval/wul3d_pcl_peers]
+                     [--data ../shared/data] [--out /tmp/wul3d-peers] [--csv-dir docs] [--threads N]
 
 Methods, each on osd_mosd (78 frames, 640x480; learn*, test* and all) and on osd_uncropped
 (2 whole frames with floor, walls and furniture), all at 640x480 on this machine in one run:
 - wul3d's default (`wul3d run`, objects.png);
+- PCL plane + Euclidean clustering and PCL organized multi-plane + connected components
+  (eval/pcl_peers.cpp, `--pcl`; built only where CMake finds PCL, Debian's libpcl-dev; skipped
+  with a note when the program is missing; its header lists the values): the first on the
+  Open3D peer's grid with its plane and size rules, the second PCL's organized segmentation
+  demo on the full organized cloud;
 - Open3D plane + DBSCAN (Debian's python3-open3d; skipped with a note when it is missing):
   the points in wul3d's depth range (0.2-4.5 m) on every 2nd pixel of every 2nd row (wul3d's
   default --decimate 2 works on the same grid), RANSAC's largest plane (1 cm, 3 points, 1000
   iterations), the points more than 1 cm above it on the camera's side (the usual tabletop
   recipe), DBSCAN (eps 2 cm, 10 points), clusters of 100 input pixels or more are objects;
   each pixel takes its 2 x 2 block's label. Fixed textbook values, not tuned on OSD.
-PCL's plane RANSAC + Euclidean clustering and organized multi-plane + connected components
-are not run: Debian's libpcl-dev pulls 312 packages (Qt, VTK, a JDK, systemd) into the build
-machine, more than an optional comparison should.
 
 Quality: `wul3d eval` (the OSD/OCID metric), Overlap F and Boundary F. Speed: each method's
 median milliseconds per frame without disk I/O (wul3d: summary.json's ms_per_frame_median;
-the peers: timed around their compute in this process), the same frames, one after the other,
+PCL: the program's summary.json, timed around its compute per frame; Open3D: timed around its
+compute in this process), the same frames, one after the other,
 each method with --threads OpenMP threads (default 1: on a shared machine, OpenMP's barriers
 between oversubscribed threads slow every method by a factor that changes from run to run).
 OSD is research-only data: it is read from ../shared/data, never shipped; only the scores are.
@@ -124,6 +127,8 @@ def score(wul3d, pred, gt, prefix):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--wul3d", default="build/wul3d")
+    ap.add_argument("--pcl", default="build/eval/wul3d_pcl_peers",
+                    help="wul3d_pcl_peers (built when CMake finds PCL); skipped when missing")
     ap.add_argument("--data", default="../shared/data")
     ap.add_argument("--out", default="/tmp/wul3d-peers")
     ap.add_argument("--csv-dir", default="docs")
@@ -134,27 +139,36 @@ def main():
         if not (data / name).is_dir():
             sys.exit(f"peers.py: {data / name} not found (OSD is research-only and not in the repository)")
 
-    methods = {"wul3d (default)": None}
+    # Each method: how its objects.png are made (wul3d, the PCL program, or a function here).
+    methods = {"wul3d (default)": ("wul3d", None)}
+    if os.access(args.pcl, os.X_OK):
+        methods["PCL plane + Euclidean clustering"] = ("pcl", "plane-euclidean")
+        methods["PCL organized planes + components"] = ("pcl", "organized")
+    else:
+        print(f"peers.py: note: {args.pcl} is missing (PCL not found when building): "
+              "the PCL peers not run", file=sys.stderr)
     if o3d is None:
         print("peers.py: note: python3-open3d is missing: Open3D plane + DBSCAN not run", file=sys.stderr)
     else:
-        methods["Open3D plane + DBSCAN"] = open3d_plane_dbscan
+        methods["Open3D plane + DBSCAN"] = ("python", open3d_plane_dbscan)
 
     quality, speed = [], []
-    for m, (method, fn) in enumerate(methods.items()):
+    for m, (method, (kind, fn)) in enumerate(methods.items()):
         ms = []
         for set_name in ("osd_mosd", "osd_uncropped"):
             pred = out / f"{m}-{set_name}"
-            if fn is None:
-                run([args.wul3d, "run", data / set_name, "--out", pred, "-q",
+            if kind == "wul3d":
+                # --overwrite: a rerun finds its own eval-*.json there, which wul3d did not write.
+                run([args.wul3d, "run", data / set_name, "--out", pred, "-q", "--overwrite",
                      "--threads", args.threads])
-                summary = json.loads((pred / "summary.json").read_text())
-                if set_name == "osd_mosd":
-                    ms = [summary["ms_per_frame_median"]]
+                times = [json.loads((pred / "summary.json").read_text())["ms_per_frame_median"]]
+            elif kind == "pcl":
+                run([args.pcl, "--method", fn, data / set_name, pred])
+                times = [f["ms"] for f in json.loads((pred / "summary.json").read_text())["frames"]]
             else:
                 times = run_peer(method, fn, data / set_name, pred)
-                if set_name == "osd_mosd":
-                    ms = times
+            if set_name == "osd_mosd":
+                ms = times
             for s, prefix in SETS:
                 if s != set_name:
                     continue

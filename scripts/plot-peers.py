@@ -46,8 +46,10 @@ def main():
         ax.set_title(title + " (%, wul3d eval)")
         ax.set_ylim(0, 105)
         ax.grid(axis="y", alpha=0.3)
-    axes[0].legend(loc="lower left", fontsize=8)
-    fig.tight_layout()
+    # Above the panels, one row: inside them it hid the first group's bars.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=len(methods), fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
     fig.savefig(sys.argv[3], dpi=110)
 
     fig, ax = plt.subplots(figsize=(8, 2.2 + 0.4 * len(speed)))
