@@ -105,9 +105,8 @@ struct InlierTest {
         const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
         return on & facing;
     }
-    /// take(g, (*this)(pl, g)) over the whole grid.
-    /// (`n`: a store in take() of an int-sized value could change G as far as the compiler
-    /// knows.)
+    /// take(g, (*this)(pl, g)) over the whole grid. G is read once: an int that take()
+    /// stores could be G as far as the compiler knows.
     template <class Take>
     void for_each(const Plane& pl, Take&& take) const {
         const int n = G;
@@ -485,6 +484,32 @@ bool fit_grid_subset(const InlierTest& grid, int min_points, Take&& in, Plane& o
     return true;
 }
 
+/// The lowest layer of the heights `t` (G of them, in half bands) that holds many points:
+/// a histogram binned kPerBand to the half band over [-kRange, kRange), each bin's window
+/// of one half band either side summed, and the lowest window with kLayerShare of the
+/// densest one's points. Returns that window's centre, in half bands. O(G), one
+/// sequential pass, then O(bins x window); no allocation.
+float lowest_dense_layer(const float* t, int G) {
+    constexpr int kPerBand = 8, kRange = 6, kBins = 2 * kRange * kPerBand;
+    int histogram[kBins] = {};
+    for (int g = 0; g < G; ++g) {
+        const float bin = (t[g] + kRange) * kPerBand;
+        if (bin >= 0.0f && bin < static_cast<float>(kBins)) ++histogram[static_cast<int>(bin)];
+    }
+    int window[kBins], most = 0;
+    for (int c = 0; c < kBins; ++c) {
+        window[c] = 0;
+        for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b)
+            window[c] += histogram[b];
+        most = std::max(most, window[c]);
+    }
+    constexpr float kLayerShare = 0.3f;
+    int best_bin = 0;
+    while (best_bin + 1 < kBins && static_cast<float>(window[best_bin]) < kLayerShare * static_cast<float>(most))
+        ++best_bin;
+    return static_cast<float>(best_bin) / kPerBand - kRange;
+}
+
 /// 5. The chosen plane, refined. Merges chain (each pair within merge_dist_m) from a
 /// table's pieces to the tops of flat objects lying on it (books, magazines), and the
 /// plane fitted to them all lies between the layers: 6 mm above the table on a cluttered
@@ -506,9 +531,8 @@ Plane refine_support(const PlaneParams& params, const InlierTest& is_inlier, Pla
     const float *const gnx = is_inlier.nx, *const gny = is_inlier.ny, *const gnz = is_inlier.nz;
     const float cos_inlier = is_inlier.cos_inlier;
     const Band on_band = is_inlier.band;
-    // Heights over the chosen plane in half bands (far off the histogram where the normal
-    // does not face like the plane's), binned kPerBand to the unit over [-kRange, kRange).
-    constexpr int kPerBand = 8, kRange = 6, kBins = 2 * kRange * kPerBand;
+    // Heights over the chosen plane in half bands (far off lowest_dense_layer's histogram
+    // where the normal does not face like the plane's).
     ws.layer_t.resize(static_cast<std::size_t>(G));
     float* const t = ws.layer_t.data();
     const float cnx = chosen.nx, cny = chosen.ny, cnz = chosen.nz, cd = chosen.d;
@@ -518,25 +542,7 @@ Plane refine_support(const PlaneParams& params, const InlierTest& is_inlier, Pla
         const bool facing = gnx[g] * cnx + gny[g] * cny + gnz[g] * cnz >= cos_inlier;
         t[g] = facing ? h / (0.5f * on_band(gz[g])) : 1e9f;
     }
-    int histogram[kBins] = {};
-    for (int g = 0; g < G; ++g) {
-        const float bin = (t[g] + kRange) * kPerBand;
-        if (bin >= 0.0f && bin < static_cast<float>(kBins)) ++histogram[static_cast<int>(bin)];
-    }
-    // Points in the window of one half band either side of each bin.
-    int window[kBins], most = 0;
-    for (int c = 0; c < kBins; ++c) {
-        window[c] = 0;
-        for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b)
-            window[c] += histogram[b];
-        most = std::max(most, window[c]);
-    }
-    // The lowest window with kLayerShare of the densest one's points.
-    constexpr float kLayerShare = 0.3f;
-    int best_bin = 0;
-    while (best_bin + 1 < kBins && static_cast<float>(window[best_bin]) < kLayerShare * static_cast<float>(most))
-        ++best_bin;
-    const float layer = static_cast<float>(best_bin) / kPerBand - kRange;
+    const float layer = lowest_dense_layer(t, G);
     // First the histogram's window, then the new plane's half band.
     Plane pl = chosen;
     if (fit_grid_subset(is_inlier, params.min_region_points,
