@@ -68,6 +68,55 @@ Plane fit(const double* s) {
 /// The coarse grid planes are grown on: w x h points, every s-th pixel of a W-wide image.
 struct Grid {
     int w = 0, h = 0, s = 1, W = 0;
+    int size() const { return w * h; }
+};
+
+Grid make_grid(int W, int H, int stride) {
+    Grid grid;
+    grid.s = stride;
+    grid.w = (W + grid.s - 1) / grid.s;
+    grid.h = (H + grid.s - 1) / grid.s;
+    grid.W = W;
+    return grid;
+}
+
+/// The plane's band at depth z: heights within it are on the plane (sensor noise grows
+/// with z^2). Plain values, copied into the loops that use it: the grid loops vectorize,
+/// and a byte store there cannot change them as far as the compiler knows.
+struct Band {
+    float m, rel;
+    float operator()(float z) const { return m + rel * z * z; }
+};
+
+/// A grid point is an inlier of a plane when it lies on the plane's band and its normal
+/// agrees with the plane's. No branch: a point without a usable normal holds the zero
+/// normal and fails the normal test, so loops over the grid vectorize. Reads the gathered
+/// grid (gather_grid), G points.
+struct InlierTest {
+    const float *x, *y, *z, *nx, *ny, *nz;
+    int G;
+    Band band;
+    float cos_inlier;
+
+    /// `band_share` narrows the band: refine_support parts layers on half of it.
+    bool operator()(const Plane& pl, int g, float band_share = 1.0f) const {
+        const float h = pl.nx * x[g] + pl.ny * y[g] + pl.nz * z[g] + pl.d;
+        const bool on = std::fabs(h) <= band_share * band(z[g]);
+        const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
+        return on & facing;
+    }
+    /// take(g, (*this)(pl, g)) over the whole grid. G is read once: an int that take()
+    /// stores could be G as far as the compiler knows.
+    template <class Take>
+    void for_each(const Plane& pl, Take&& take) const {
+        const int n = G;
+        for (int g = 0; g < n; ++g) take(g, (*this)(pl, g));
+    }
+    std::size_t count(const Plane& pl) const {
+        unsigned inliers = 0;
+        for_each(pl, [&](int, bool in) { inliers += static_cast<unsigned>(in); });
+        return static_cast<std::size_t>(inliers);
+    }
 };
 
 /// The support's extent as a grid-resolution mask, and the test the pixels take against it:
@@ -92,197 +141,35 @@ struct HullMask {
     }
 };
 
-}  // namespace
-
-namespace {
-
-/// On-plane patches that the objects enclose (a bowl's inner bottom seen through its
-/// opening) are object material, not the support: a 4-connected patch of removed on-band
-/// pixels that touches neither the image border nor other removed points, borders object
-/// points, is small and sits on average above the plane is given back (kPlaneInside).
-/// `ws.on_band` marks the removed on-band pixels and `ws.row_first_run[v + 1]` holds row v's
-/// number of runs of them (the caller's classification pass). The
-/// patches are found as runs of on-band pixels per row joined by union-find where runs of
-/// consecutive rows overlap: a few thousand runs instead of a flood fill over the table.
-std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
-                            const std::vector<std::uint8_t>& active, const Plane& pl,
-                            PlaneWorkspace& ws, std::vector<std::uint8_t>& classes) {
-    const int W = cloud.width, H = cloud.height;
-    const std::size_t N = cloud.size();
-    const std::uint8_t* band = ws.on_band.data();
-    auto& runs = ws.runs;
-    auto find = [&](int a) {
-        while (runs[static_cast<std::size_t>(a)].parent != a) {
-            auto& r = runs[static_cast<std::size_t>(a)];
-            r.parent = runs[static_cast<std::size_t>(r.parent)].parent;
-            a = r.parent;
-        }
-        return a;
-    };
-    // The runs, row by row in parallel, each row's at its offset (the counts per row come
-    // from the caller).
-    for (int v = 0; v < H; ++v)
-        ws.row_first_run[static_cast<std::size_t>(v) + 1] += ws.row_first_run[static_cast<std::size_t>(v)];
-    const std::size_t R = static_cast<std::size_t>(ws.row_first_run[static_cast<std::size_t>(H)]);
-    runs.resize(R);
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
-        int id = ws.row_first_run[static_cast<std::size_t>(v)];
-        const std::uint8_t* row = band + static_cast<std::size_t>(v) * W;
-        for (int u = 0; u < W;) {
-            if (!row[u]) {
-                ++u;
-                continue;
-            }
-            const int begin = u;
-            while (u < W && row[u]) ++u;
-            runs[static_cast<std::size_t>(id)] = {v, begin, u, id};
-            ++id;
-        }
-    }
-    ws.island_height.assign(R, 0.0);
-    ws.island_size.assign(R, 0);
-    ws.island_flags.assign(R, 0);
-    // A neighbour outside the patch: object material, or a removed active point off the
-    // band (support or room beside it) that opens the patch.
-    auto look = [&](std::size_t q, std::uint8_t& flags) {
-        if (band[q]) return;
-        if (classes[q] != kPlaneRemoved) flags |= 2;
-        else if (active[q]) flags |= 1;
-    };
-    // Per run (in parallel): what borders it and, unless that opens it (its island is then
-    // open whatever else it holds: most of the table's runs), its heights; then summed per
-    // island.
-    const auto Rn = static_cast<std::ptrdiff_t>(R);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < Rn; ++i) {
-        const auto& r = runs[static_cast<std::size_t>(i)];
-        std::uint8_t flags = 0;
-        const std::size_t row = static_cast<std::size_t>(r.row) * W;
-        if (r.row == 0 || r.row == H - 1 || r.begin == 0 || r.end == W) {
-            flags |= 1;  // touches the image border
-        } else {
-            look(row + static_cast<std::size_t>(r.begin) - 1, flags);
-            look(row + static_cast<std::size_t>(r.end), flags);
-            for (int u = r.begin; u < r.end && !(flags & 1); ++u) {
-                look(row - W + static_cast<std::size_t>(u), flags);
-                look(row + W + static_cast<std::size_t>(u), flags);
-            }
-        }
-        double height = 0;
-        if (!(flags & 1))
-            for (int u = r.begin; u < r.end; ++u) {
-                const std::size_t p = row + static_cast<std::size_t>(u);
-                height += pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-            }
-        ws.island_height[static_cast<std::size_t>(i)] = height;
-        ws.island_flags[static_cast<std::size_t>(i)] = flags;
-    }
-    // Runs of consecutive rows that share a column (4-connectivity) join, except two open
-    // runs: their islands are open whatever else they join (most of the table's runs).
-    for (int v = 1; v < H; ++v) {
-        int a = ws.row_first_run[static_cast<std::size_t>(v) - 1];
-        const int a_end = ws.row_first_run[static_cast<std::size_t>(v)];
-        const int b_end = ws.row_first_run[static_cast<std::size_t>(v) + 1];
-        for (int b = a_end; b < b_end; ++b) {
-            const auto& rb = runs[static_cast<std::size_t>(b)];
-            while (a < a_end && runs[static_cast<std::size_t>(a)].end <= rb.begin) ++a;
-            const bool b_open = ws.island_flags[static_cast<std::size_t>(b)] & 1;
-            for (int c = a; c < a_end && runs[static_cast<std::size_t>(c)].begin < rb.end; ++c) {
-                if (b_open && (ws.island_flags[static_cast<std::size_t>(c)] & 1)) continue;
-                const int ra = find(c), rb_root = find(b);
-                if (ra != rb_root) runs[static_cast<std::size_t>(std::max(ra, rb_root))].parent = std::min(ra, rb_root);
-            }
-        }
-    }
-    for (std::size_t i = 0; i < R; ++i) {
-        const auto& r = runs[i];
-        const std::size_t root = static_cast<std::size_t>(find(static_cast<int>(i)));
-        ws.island_size[root] += r.end - r.begin;
-        if (root == i) continue;
-        ws.island_height[root] += ws.island_height[i];
-        ws.island_flags[root] |= ws.island_flags[i];
-    }
-    const double max_size = params.island_max_share * static_cast<double>(N);
-    std::size_t restored = 0;
-    for (std::size_t i = 0; i < R; ++i) {
-        const auto& r = runs[i];
-        const std::size_t root = static_cast<std::size_t>(find(static_cast<int>(i)));
-        const int size = ws.island_size[root];
-        if (ws.island_flags[root] != 2 || size > max_size ||
-            ws.island_height[root] / size <= params.island_min_height_m)
-            continue;
-        std::fill(classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.begin,
-                  classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.end, kPlaneInside);
-        restored += static_cast<std::size_t>(r.end - r.begin);
-    }
-    return restored;
+/// The test against `hull` (ws.hull, built by build_hull for `pl`). Per pixel in the hot
+/// loops: float arithmetic, grid cell by rounding (no libm call).
+HullMask make_hull_mask(const Grid& grid, const PinholeIntrinsics& K, const Plane& pl,
+                        const std::vector<std::uint8_t>& hull) {
+    const float inv_s = 1.0f / static_cast<float>(grid.s);
+    return HullMask{hull.data(), static_cast<std::size_t>(grid.w), static_cast<float>(grid.w),
+                    static_cast<float>(grid.h), static_cast<float>(K.fx) * inv_s,
+                    static_cast<float>(K.fy) * inv_s, static_cast<float>(K.cx) * inv_s + 0.5f,
+                    static_cast<float>(K.cy) * inv_s + 0.5f, pl.nx, pl.ny, pl.nz};
 }
 
-/// Slivers: candidates most of whose inliers (over half) are also the inliers of a larger
-/// candidate. Such a plane cuts through the larger surface at a small angle (fitted to a few
-/// points at an object's foot, or to noise on a carpet), and counting the points above it
-/// would count half of that surface as standing on it: it won the support from the table it
-/// cuts. `ws.sliver[rank]` for the candidates in ws.by_extent order (largest first; the 32
-/// largest are tested: each covers min_extent of the grid, so there are rarely more than a
-/// few). Inlier sets are one bit per candidate per grid point.
-template <class InlierTest>
-void mark_slivers(const std::vector<Plane>& candidates, InlierTest&& for_each_inlier_test, int G,
-                  PlaneWorkspace& ws) {
-    const std::size_t C = std::min<std::size_t>(ws.by_extent.size(), 32);
-    ws.sliver.assign(C, 0);
-    if (C < 2) return;
-    ws.candidate_bits.assign(static_cast<std::size_t>(G), 0);
-    std::uint32_t* const bits = ws.candidate_bits.data();
-    for (std::size_t rank = 0; rank < C; ++rank) {
-        const Plane& pl = candidates[static_cast<std::size_t>(ws.by_extent[rank])];
-        for_each_inlier_test(pl, [&](int g, bool in) { bits[g] |= static_cast<std::uint32_t>(in) << rank; });
-    }
-    // shared[i * C + j]: inliers of rank i that are also inliers of rank j < i.
-    ws.shared.assign(C * C, 0);
-    for (int g = 0; g < G; ++g) {
-        const std::uint32_t b = bits[g];
-        if ((b & (b - 1)) == 0) continue;  // on at most one candidate
-        for (std::size_t i = 1; i < C; ++i) {
-            if (!(b >> i & 1u)) continue;
-            for (std::size_t j = 0; j < i; ++j) ws.shared[i * C + j] += b >> j & 1u;
-        }
-    }
-    for (std::size_t i = 1; i < C; ++i) {
-        const std::size_t inliers = candidates[static_cast<std::size_t>(ws.by_extent[i])].inliers;
-        for (std::size_t j = 0; j < i; ++j)
-            if (2 * static_cast<std::size_t>(ws.shared[i * C + j]) > inliers) ws.sliver[i] = 1;
-    }
-}
+// ---------------------------------------------------------------------------------------
+// The phases of remove_support_plane, in their order. Costs: N pixels, G = N / s^2 grid
+// points (s = grid_stride_px), B regions worth fitting, C candidates. Scratch lives in the
+// PlaneWorkspace; "no allocation" means none once the workspace has seen a frame of this
+// size.
+// ---------------------------------------------------------------------------------------
 
-}  // namespace
-
-PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
-                                 const OrganizedCloud& cloud, const NormalMap& normals,
-                                 const std::vector<std::uint8_t>& active, PlaneWorkspace& ws,
-                                 std::vector<std::uint8_t>& classes) {
-    const int W = cloud.width, H = cloud.height;
-    const std::size_t N = cloud.size();
-    classes.resize(N);
-    PlaneResult result;
-
-    Grid grid;
-    grid.s = params.grid_stride_px;
-    grid.w = (W + grid.s - 1) / grid.s;
-    grid.h = (H + grid.s - 1) / grid.s;
-    grid.W = W;
-    const int G = grid.w * grid.h;
-    ws.region.assign(static_cast<std::size_t>(G), -1);
-    ws.stack.resize(static_cast<std::size_t>(G));
-    ws.sums.clear();
-
-    const float cos_grow = std::cos(params.grow_angle_deg * kDegToRad);
-    const float cos_inlier = std::cos(params.inlier_angle_deg * kDegToRad);
-    // Gather the grid's points once: every later pass over the grid reads them contiguously.
-    auto& gp = ws.grid;
-    for (auto* a : {&gp.x, &gp.y, &gp.z, &gp.nx, &gp.ny, &gp.nz}) a->resize(static_cast<std::size_t>(G));
-    gp.active.resize(static_cast<std::size_t>(G));
-    gp.usable.resize(static_cast<std::size_t>(G));
+/// Gather: every grid point once, so that every later pass over the grid reads contiguous
+/// arrays. In: the cloud, normals and active mask (N). Out: `gp`, G points; a point without
+/// a usable normal (inactive, or no normal) gets the zero normal. O(G), one parallel pass,
+/// no allocation.
+void gather_grid(const Grid& grid, const OrganizedCloud& cloud, const NormalMap& normals,
+                 const std::vector<std::uint8_t>& active, PlaneWorkspace::GridPoints& gp) {
+    const int W = grid.W;
+    const auto G = static_cast<std::size_t>(grid.size());
+    for (auto* a : {&gp.x, &gp.y, &gp.z, &gp.nx, &gp.ny, &gp.nz}) a->resize(G);
+    gp.active.resize(G);
+    gp.usable.resize(G);
 #pragma omp parallel for schedule(static)
     for (int gv = 0; gv < grid.h; ++gv) {
         for (int gu = 0; gu < grid.w; ++gu) {
@@ -292,7 +179,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             gp.y[g] = cloud.y[p];
             gp.z[g] = cloud.z[p];
             // A point without a usable normal gets the zero normal: it then fails every
-            // normal test (cos >= a positive threshold) with no branch (is_inlier).
+            // normal test (cos >= a positive threshold) with no branch (InlierTest).
             const bool use = active[p] && normals.valid[p];
             gp.nx[g] = use ? normals.nx[p] : 0.0f;
             gp.ny[g] = use ? normals.ny[p] : 0.0f;
@@ -301,16 +188,28 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             gp.usable[g] = use;
         }
     }
-    auto usable = [&](int g) { return gp.usable[static_cast<std::size_t>(g)] != 0; };
-    // The plane's band at depth z, from plain values (captured by value: the grid loops below
-    // vectorize, and a byte store there cannot change them as far as the compiler knows).
-    const float band_m = params.on_plane_m, band_rel = params.on_plane_rel;
-    auto on_band = [band_m, band_rel](float z) { return band_m + band_rel * z * z; };
+}
 
-    // 1. Region growing on the grid: a neighbour joins when its normal agrees with the
-    //    region's mean normal and it lies on the region's mean plane.
-    std::size_t with_normal = 0;
-    int regions = 0;
+struct GrownRegions {
+    int regions = 0;              ///< regions grown, ids [0, regions)
+    std::size_t with_normal = 0;  ///< usable grid points (all of them join a region)
+};
+
+/// 1. Region growing on the grid: a neighbour joins when its normal agrees with the
+/// region's mean normal and it lies on the region's mean plane. In: `ws.grid`. Out:
+/// `ws.region` (G: region id per point, -1 none), `ws.sums` (kSums per region: moments,
+/// then summed normal). O(G), sequential flood fill on `ws.stack`; `ws.sums` grows by
+/// kSums per region (no allocation once its capacity suffices).
+GrownRegions grow_regions(const PlaneParams& params, const Grid& grid, PlaneWorkspace& ws) {
+    const int G = grid.size();
+    ws.region.assign(static_cast<std::size_t>(G), -1);
+    ws.stack.resize(static_cast<std::size_t>(G));
+    ws.sums.clear();
+    const float cos_grow = std::cos(params.grow_angle_deg * kDegToRad);
+    const auto& gp = ws.grid;
+    auto usable = [&](int g) { return gp.usable[static_cast<std::size_t>(g)] != 0; };
+    GrownRegions grown;
+    int& regions = grown.regions;
     for (int seed = 0; seed < G; ++seed) {
         if (ws.region[seed] != -1 || !usable(seed)) continue;
         const int id = regions++;
@@ -353,11 +252,17 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
                 ws.stack[top++] = q;
             }
         }
-        with_normal += static_cast<std::size_t>(s[0]);
+        grown.with_normal += static_cast<std::size_t>(s[0]);
     }
+    return grown;
+}
 
-    // 2. Fit the regions worth fitting, merge coplanar ones (a table cut in pieces by the
-    //    objects on it is one plane).
+/// 2. Merge: fit the regions of at least min_region_points, and merge coplanar ones (a
+/// table cut in pieces by the objects on it is one plane). In: `ws.sums` of `regions`.
+/// Out: the merged regions' ids (their roots); each root's sums in `ws.sums` now hold its
+/// whole merged set. O(B^2) plane pairs per pass for B regions worth fitting, two passes,
+/// plus B eigen-solves (3x3) per pass; a few small vectors per frame.
+std::vector<int> merge_coplanar(const PlaneParams& params, int regions, PlaneWorkspace& ws) {
     std::vector<int> big;
     std::vector<Plane> fits(static_cast<std::size_t>(regions));
     for (int r = 0; r < regions; ++r) {
@@ -399,32 +304,16 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         roots = next;
         for (int r : roots) fits[r] = fit(ws.sums.data() + static_cast<std::size_t>(r) * kSums);
     }
+    return roots;
+}
 
-    // A grid point is an inlier of a plane when it lies on the plane's band and its normal
-    // agrees with the plane's. No branch: a point without a usable normal holds the zero
-    // normal and fails the normal test, so loops over the grid vectorize.
-    const float *const gx = gp.x.data(), *const gy = gp.y.data(), *const gz = gp.z.data();
-    const float *const gnx = gp.nx.data(), *const gny = gp.ny.data(), *const gnz = gp.nz.data();
-    // `band_share` narrows the band: step 5 parts layers on half of it.
-    auto is_inlier = [=](const Plane& pl, int g, float band_share = 1.0f) {
-        const float h = pl.nx * gx[g] + pl.ny * gy[g] + pl.nz * gz[g] + pl.d;
-        const bool on = std::fabs(h) <= band_share * on_band(gz[g]);
-        const bool facing = gnx[g] * pl.nx + gny[g] * pl.ny + gnz[g] * pl.nz >= cos_inlier;
-        return on & facing;
-    };
-    // take(g, is_inlier(pl, g)) over the whole grid.
-    auto for_each_inlier_test = [&](const Plane& pl, auto&& take) {
-        for (int g = 0; g < G; ++g) take(g, is_inlier(pl, g));
-    };
-    auto count_inliers = [&](const Plane& pl) {
-        unsigned inliers = 0;
-        for_each_inlier_test(pl, [&](int, bool in) { inliers += static_cast<unsigned>(in); });
-        return static_cast<std::size_t>(inliers);
-    };
-
-    // 3. Candidates: merged planes covering min_extent of the grid points with a normal.
-    //    Inliers are counted over the whole grid (distance and normal agree), the planes
-    //    split across cores and kept in order.
+/// 3. Candidates: the merged planes, fitted, that cover min_extent of the grid points with a
+/// normal. Inliers are counted over the whole grid (distance and normal agree), the planes
+/// split across cores and kept in order. In: `roots` and their `ws.sums`. Out: `ws.fitted`
+/// (every root's plane), `candidates` appended. O(G) per root, parallel over roots; no
+/// allocation but the candidates.
+void fit_candidates(const PlaneParams& params, const std::vector<int>& roots, std::size_t with_normal,
+                    const InlierTest& inliers, PlaneWorkspace& ws, std::vector<Plane>& candidates) {
     auto& fitted = ws.fitted;
     fitted.resize(roots.size());
     const auto n_roots = static_cast<std::ptrdiff_t>(roots.size());
@@ -432,75 +321,123 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     for (std::ptrdiff_t i = 0; i < n_roots; ++i) {
         Plane& pl = fitted[static_cast<std::size_t>(i)];
         pl = fit(ws.sums.data() + static_cast<std::size_t>(roots[static_cast<std::size_t>(i)]) * kSums);
-        pl.inliers = count_inliers(pl);
+        pl.inliers = inliers.count(pl);
     }
     for (const Plane& pl : fitted)
         if (static_cast<double>(pl.inliers) >= params.min_extent * static_cast<double>(with_normal))
-            result.candidates.push_back(pl);
+            candidates.push_back(pl);
+}
 
-    // The support's extent: the image-space convex hull of its inliers on the grid, widened
-    // by the margin; a point belongs over the support when its foot (the point moved down
-    // the normal onto the plane) projects into it.
-    auto build_hull = [&](const Plane& pl) {
-        ws.hull.assign(static_cast<std::size_t>(G), 0);
-        ws.hull_points.clear();
-        // The hull of a set is the hull of each row's leftmost and rightmost members.
-        for (int gv = 0; gv < grid.h; ++gv) {
-            int first = -1, last = -1;
-            for (int gu = 0; gu < grid.w; ++gu) {
-                if (!is_inlier(pl, gv * grid.w + gu)) continue;
-                if (first < 0) first = gu;
-                last = gu;
-            }
-            if (first < 0) continue;
-            ws.hull_points.insert(ws.hull_points.end(), {first, gv, last, gv});
+/// The support's extent: the image-space convex hull of `pl`'s inliers on the grid, widened
+/// by hull_margin_px; a point belongs over the support when its foot (the point moved down
+/// the normal onto the plane) projects into it (HullMask). Out: `ws.hull` (G, 1 = inside;
+/// all 0 when fewer than 3 rows hold inliers), `ws.hull_points`. O(G) for the inlier test,
+/// then the hull of at most 2 grid.h points and a dilation over G; OpenCV allocates the
+/// hull's corners and the kernel.
+void build_hull(const PlaneParams& params, const Grid& grid, const InlierTest& is_inlier,
+                const Plane& pl, PlaneWorkspace& ws) {
+    ws.hull.assign(static_cast<std::size_t>(grid.size()), 0);
+    ws.hull_points.clear();
+    // The hull of a set is the hull of each row's leftmost and rightmost members.
+    for (int gv = 0; gv < grid.h; ++gv) {
+        int first = -1, last = -1;
+        for (int gu = 0; gu < grid.w; ++gu) {
+            if (!is_inlier(pl, gv * grid.w + gu)) continue;
+            if (first < 0) first = gu;
+            last = gu;
         }
-        if (ws.hull_points.size() < 6) return;
-        cv::Mat pts(static_cast<int>(ws.hull_points.size() / 2), 1, CV_32SC2, ws.hull_points.data());
-        std::vector<cv::Point> hull;
-        cv::convexHull(pts, hull);
-        cv::Mat mask(grid.h, grid.w, CV_8U, ws.hull.data());
-        cv::fillConvexPoly(mask, hull, cv::Scalar(1));
-        const int m = (params.hull_margin_px + grid.s - 1) / grid.s;
-        if (m > 0) {
-            const cv::Mat kernel =
-                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1));
-            cv::dilate(mask, mask, kernel);
-        }
-    };
-    // Per pixel in the hot loops below: float arithmetic, grid cell by rounding (no libm call).
-    // Valid after build_hull(pl).
-    auto hull_of_plane = [&](const Plane& pl) {
-        const float inv_s = 1.0f / static_cast<float>(grid.s);
-        return HullMask{ws.hull.data(), static_cast<std::size_t>(grid.w), static_cast<float>(grid.w),
-                        static_cast<float>(grid.h), static_cast<float>(K.fx) * inv_s,
-                        static_cast<float>(K.fy) * inv_s, static_cast<float>(K.cx) * inv_s + 0.5f,
-                        static_cast<float>(K.cy) * inv_s + 0.5f, pl.nx, pl.ny, pl.nz};
-    };
+        if (first < 0) continue;
+        ws.hull_points.insert(ws.hull_points.end(), {first, gv, last, gv});
+    }
+    if (ws.hull_points.size() < 6) return;
+    cv::Mat pts(static_cast<int>(ws.hull_points.size() / 2), 1, CV_32SC2, ws.hull_points.data());
+    std::vector<cv::Point> hull;
+    cv::convexHull(pts, hull);
+    cv::Mat mask(grid.h, grid.w, CV_8U, ws.hull.data());
+    cv::fillConvexPoly(mask, hull, cv::Scalar(1));
+    const int m = (params.hull_margin_px + grid.s - 1) / grid.s;
+    if (m > 0) {
+        const cv::Mat kernel =
+            cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * m + 1, 2 * m + 1));
+        cv::dilate(mask, mask, kernel);
+    }
+}
 
-    // 4. The support: among planes that face up, the one that carries most: score = points
-    //    standing on it (at most its extent) + 0.1 x its extent. A candidate scores at most
-    //    1.1 x its extent, so once one scores more, smaller candidates are not counted (each
-    //    count builds a hull and passes over the grid). Largest first; ties go to the lower
-    //    index, as in index order.
+/// Slivers: candidates most of whose inliers (over half) are also the inliers of a larger
+/// candidate. Such a plane cuts through the larger surface at a small angle (fitted to a few
+/// points at an object's foot, or to noise on a carpet), and counting the points above it
+/// would count half of that surface as standing on it: it won the support from the table it
+/// cuts. `ws.sliver[rank]` for the candidates in ws.by_extent order (largest first; the 32
+/// largest are tested: each covers min_extent of the grid, so there are rarely more than a
+/// few). Inlier sets are one bit per candidate per grid point (`ws.candidate_bits`, G).
+/// O(C x G) for the bits, O(G x C^2) at worst for the shared counts (points on two or more
+/// candidates only); no allocation.
+void mark_slivers(const std::vector<Plane>& candidates, const InlierTest& inliers, PlaneWorkspace& ws) {
+    const int G = inliers.G;
+    const std::size_t C = std::min<std::size_t>(ws.by_extent.size(), 32);
+    ws.sliver.assign(C, 0);
+    if (C < 2) return;
+    ws.candidate_bits.assign(static_cast<std::size_t>(G), 0);
+    std::uint32_t* const bits = ws.candidate_bits.data();
+    for (std::size_t rank = 0; rank < C; ++rank) {
+        const Plane& pl = candidates[static_cast<std::size_t>(ws.by_extent[rank])];
+        inliers.for_each(pl, [&](int g, bool in) { bits[g] |= static_cast<std::uint32_t>(in) << rank; });
+    }
+    // shared[i * C + j]: inliers of rank i that are also inliers of rank j < i.
+    ws.shared.assign(C * C, 0);
+    for (int g = 0; g < G; ++g) {
+        const std::uint32_t b = bits[g];
+        if ((b & (b - 1)) == 0) continue;  // on at most one candidate
+        for (std::size_t i = 1; i < C; ++i) {
+            if (!(b >> i & 1u)) continue;
+            for (std::size_t j = 0; j < i; ++j) ws.shared[i * C + j] += b >> j & 1u;
+        }
+    }
+    for (std::size_t i = 1; i < C; ++i) {
+        const std::size_t inliers_i = candidates[static_cast<std::size_t>(ws.by_extent[i])].inliers;
+        for (std::size_t j = 0; j < i; ++j)
+            if (2 * static_cast<std::size_t>(ws.shared[i * C + j]) > inliers_i) ws.sliver[i] = 1;
+    }
+}
+
+struct SupportChoice {
+    int best = -1;     ///< index in the candidates, -1: no support
+    int hull_of = -1;  ///< the candidate whose extent ws.hull holds, -1 none
+};
+
+/// 4. The support: among planes that face up, the one that carries most: score = points
+/// standing on it (at most its extent) + 0.1 x its extent. A candidate scores at most
+/// 1.1 x its extent, so once one scores more, smaller candidates are not counted (each
+/// count builds a hull and passes over the grid). Largest first; ties go to the lower
+/// index, as in index order. In: `candidates`, `ws.grid`. Out: the choice; each counted
+/// candidate's `above`; `ws.by_extent`, `ws.sliver`, `ws.hull` of the last one counted.
+/// O(C log C) to rank, mark_slivers, then O(G) (a hull and a parallel pass) per candidate
+/// counted, usually one or two.
+SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics& K, const Grid& grid,
+                             const InlierTest& inliers, PlaneWorkspace& ws,
+                             std::vector<Plane>& candidates) {
+    const int G = grid.size();
+    const auto& gp = ws.grid;
+    const Band on_band = inliers.band;
+    SupportChoice choice;
     double best_score = -1;
-    int best = -1, hull_of = -1;  // hull_of: the candidate whose extent ws.hull holds
-    ws.by_extent.resize(result.candidates.size());
+    int& best = choice.best;
+    ws.by_extent.resize(candidates.size());
     std::iota(ws.by_extent.begin(), ws.by_extent.end(), 0);
     std::stable_sort(ws.by_extent.begin(), ws.by_extent.end(), [&](int a, int b) {
-        return result.candidates[static_cast<std::size_t>(a)].inliers >
-               result.candidates[static_cast<std::size_t>(b)].inliers;
+        return candidates[static_cast<std::size_t>(a)].inliers >
+               candidates[static_cast<std::size_t>(b)].inliers;
     });
-    mark_slivers(result.candidates, for_each_inlier_test, G, ws);
+    mark_slivers(candidates, inliers, ws);
     for (std::size_t rank = 0; rank < ws.by_extent.size(); ++rank) {
         const int c = ws.by_extent[rank];
-        Plane& pl = result.candidates[static_cast<std::size_t>(c)];
+        Plane& pl = candidates[static_cast<std::size_t>(c)];
         if (pl.up < params.min_up || (rank < ws.sliver.size() && ws.sliver[rank])) continue;
         const double extent = static_cast<double>(pl.inliers);
         if (extent + 0.1 * extent < best_score) break;  // the score's largest value, as computed
-        build_hull(pl);
-        hull_of = c;
-        const HullMask hull = hull_of_plane(pl);
+        build_hull(params, grid, inliers, pl, ws);
+        choice.hull_of = c;
+        const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
         std::size_t above = 0;
 #pragma omp parallel for schedule(static) reduction(+ : above)
         for (int p = 0; p < G; ++p) {
@@ -520,103 +457,132 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
             best = c;
         }
     }
+    return choice;
+}
 
-    // 5. The chosen plane, refined. Merges chain (each pair within merge_dist_m) from a
-    //    table's pieces to the tops of flat objects lying on it (books, magazines), and the
-    //    plane fitted to them all lies between the layers: 6 mm above the table on a cluttered
-    //    OSD frame, 7.6 mm in a synthetic scene of books, where half the books' points fell
-    //    into its band. On a band half as wide the layers part (a histogram of heights over
-    //    the chosen plane, in half bands, as the band widens with depth). The support is the
-    //    lowest layer that holds many points, not the densest: what lies on the table is
-    //    above it, and when the chain also tilts the plane the table's points spread over
-    //    several bands, where the densest can be a ramp from the table to the books' tops
-    //    (OSD's test59 at half resolution: 10 mm off the table). Least squares on that layer's
-    //    points, then on the points on the new plane's half band, fit it alone.
-    auto refine_support = [&](const Plane& chosen) {
-        // Heights over the chosen plane in half bands (far off the histogram where the normal
-        // does not face like the plane's), binned kPerBand to the unit over [-kRange, kRange).
-        constexpr int kPerBand = 8, kRange = 6, kBins = 2 * kRange * kPerBand;
-        ws.layer_t.resize(static_cast<std::size_t>(G));
-        float* const t = ws.layer_t.data();
-        const float cnx = chosen.nx, cny = chosen.ny, cnz = chosen.nz, cd = chosen.d;
-#pragma omp parallel for simd schedule(static)
-        for (int g = 0; g < G; ++g) {
-            const float h = cnx * gx[g] + cny * gy[g] + cnz * gz[g] + cd;
-            const bool facing = gnx[g] * cnx + gny[g] * cny + gnz[g] * cnz >= cos_inlier;
-            t[g] = facing ? h / (0.5f * on_band(gz[g])) : 1e9f;
-        }
-        int histogram[kBins] = {};
-        for (int g = 0; g < G; ++g) {
-            const float bin = (t[g] + kRange) * kPerBand;
-            if (bin >= 0.0f && bin < static_cast<float>(kBins)) ++histogram[static_cast<int>(bin)];
-        }
-        // Points in the window of one half band either side of each bin.
-        int window[kBins], most = 0;
-        for (int c = 0; c < kBins; ++c) {
-            window[c] = 0;
-            for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b)
-                window[c] += histogram[b];
-            most = std::max(most, window[c]);
-        }
-        // The lowest window with kLayerShare of the densest one's points.
-        constexpr float kLayerShare = 0.3f;
-        int best_bin = 0;
-        while (best_bin + 1 < kBins && static_cast<float>(window[best_bin]) < kLayerShare * static_cast<float>(most))
-            ++best_bin;
-        const float layer = static_cast<float>(best_bin) / kPerBand - kRange;
-        // The least-squares plane (as `fit`) of the grid points that in(g) takes, split across
-        // cores: detail::add_moments spelled out as masked sums, in its layout, because an
-        // OpenMP reduction needs them as scalars (and then they vectorize).
-        auto fit_layer = [&](auto&& in, Plane& out) {
-            double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+/// The least-squares plane (as `fit`) of the grid points that in(g) takes, into `out`;
+/// false (and `out` unchanged) under min_points. Split across cores: detail::add_moments
+/// spelled out as masked sums, in its layout, because an OpenMP reduction needs them as
+/// scalars (and then they vectorize). O(G), one parallel pass, no allocation.
+template <class Take>
+bool fit_grid_subset(const InlierTest& grid, int min_points, Take&& in, Plane& out) {
+    const float *const gx = grid.x, *const gy = grid.y, *const gz = grid.z;
+    const int G = grid.G;
+    double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
 #pragma omp parallel for simd schedule(static) reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
-            for (int g = 0; g < G; ++g) {
-                const double m = in(g) ? 1.0 : 0.0;
-                const double px = m * gx[g], py = m * gy[g], pz = m * gz[g];
-                n += m;
-                x += px; y += py; z += pz;
-                xx += px * gx[g]; xy += px * gy[g]; xz += px * gz[g];
-                yy += py * gy[g]; yz += py * gz[g]; zz += pz * gz[g];
-            }
-            if (n < params.min_region_points) return false;
-            const double s[kSums] = {n, x, y, z, xx, xy, xz, yy, yz, zz, 0, 0, 0};
-            out = fit(s);
-            return true;
-        };
-        // First the histogram's window, then the new plane's half band.
-        Plane pl = chosen;
-        if (fit_layer([=](int g) { return std::fabs(t[g] - layer) <= 1.0f; }, pl)) {
-            const Plane first = pl;
-            fit_layer([=](int g) { return is_inlier(first, g, 0.5f); }, pl);
-        }
-        pl.inliers = count_inliers(pl);
-        pl.above = chosen.above;
-        return pl;
-    };
+    for (int g = 0; g < G; ++g) {
+        const double m = in(g) ? 1.0 : 0.0;
+        const double px = m * gx[g], py = m * gy[g], pz = m * gz[g];
+        n += m;
+        x += px; y += py; z += pz;
+        xx += px * gx[g]; xy += px * gy[g]; xz += px * gz[g];
+        yy += py * gy[g]; yz += py * gz[g]; zz += pz * gz[g];
+    }
+    if (n < min_points) return false;
+    const double s[kSums] = {n, x, y, z, xx, xy, xz, yy, yz, zz, 0, 0, 0};
+    out = fit(s);
+    return true;
+}
 
-    if (best < 0) {
-        for (std::size_t p = 0; p < N; ++p) classes[p] = active[p] ? kPlaneObject : kPlaneRemoved;
-        result.kept = static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
-        return result;
+/// The lowest layer of the heights `t` (G of them, in half bands) that holds many points:
+/// a histogram binned kPerBand to the half band over [-kRange, kRange), each bin's window
+/// of one half band either side summed, and the lowest window with kLayerShare of the
+/// densest one's points. Returns that window's centre, in half bands. O(G), one
+/// sequential pass, then O(bins x window); no allocation.
+float lowest_dense_layer(const float* t, int G) {
+    constexpr int kPerBand = 8, kRange = 6, kBins = 2 * kRange * kPerBand;
+    int histogram[kBins] = {};
+    for (int g = 0; g < G; ++g) {
+        const float bin = (t[g] + kRange) * kPerBand;
+        if (bin >= 0.0f && bin < static_cast<float>(kBins)) ++histogram[static_cast<int>(bin)];
     }
-    result.found = true;
-    result.support = refine_support(result.candidates[static_cast<std::size_t>(best)]);
-    const Plane pl = result.support;
-    // The support's extent: the chosen plane's serves unless the refinement moved the plane
-    // (most frames: by under a millimetre).
-    {
-        const Plane& chosen = result.candidates[static_cast<std::size_t>(best)];
-        const float cos_moved = pl.nx * chosen.nx + pl.ny * chosen.ny + pl.nz * chosen.nz;
-        if (hull_of != best || std::fabs(pl.d - chosen.d) > 0.25f * params.on_plane_m ||
-            cos_moved < std::cos(1.0f * kDegToRad))
-            build_hull(pl);
+    int window[kBins], most = 0;
+    for (int c = 0; c < kBins; ++c) {
+        window[c] = 0;
+        for (int b = std::max(0, c - kPerBand); b < std::min(kBins, c + kPerBand); ++b)
+            window[c] += histogram[b];
+        most = std::max(most, window[c]);
     }
-    ws.on_band.resize(N);
+    constexpr float kLayerShare = 0.3f;
+    int best_bin = 0;
+    while (best_bin + 1 < kBins && static_cast<float>(window[best_bin]) < kLayerShare * static_cast<float>(most))
+        ++best_bin;
+    return static_cast<float>(best_bin) / kPerBand - kRange;
+}
+
+/// 5. The chosen plane, refined. Merges chain (each pair within merge_dist_m) from a
+/// table's pieces to the tops of flat objects lying on it (books, magazines), and the
+/// plane fitted to them all lies between the layers: 6 mm above the table on a cluttered
+/// OSD frame, 7.6 mm in a synthetic scene of books, where half the books' points fell
+/// into its band. On a band half as wide the layers part (a histogram of heights over
+/// the chosen plane, in half bands, as the band widens with depth). The support is the
+/// lowest layer that holds many points, not the densest: what lies on the table is
+/// above it, and when the chain also tilts the plane the table's points spread over
+/// several bands, where the densest can be a ramp from the table to the books' tops
+/// (OSD's test59 at half resolution: 10 mm off the table). Least squares on that layer's
+/// points, then on the points on the new plane's half band, fit it alone.
+/// In: `chosen`, the gathered grid. Out: the support, its inliers counted (`above` is the
+/// chosen one's); `ws.layer_t` (G). O(G): four passes (heights, histogram, two fits) and an
+/// inlier count; no allocation.
+Plane refine_support(const PlaneParams& params, const InlierTest& is_inlier, PlaneWorkspace& ws,
+                     const Plane& chosen) {
+    const int G = is_inlier.G;
+    const float *const gx = is_inlier.x, *const gy = is_inlier.y, *const gz = is_inlier.z;
+    const float *const gnx = is_inlier.nx, *const gny = is_inlier.ny, *const gnz = is_inlier.nz;
+    const float cos_inlier = is_inlier.cos_inlier;
+    const Band on_band = is_inlier.band;
+    // Heights over the chosen plane in half bands (far off lowest_dense_layer's histogram
+    // where the normal does not face like the plane's).
+    ws.layer_t.resize(static_cast<std::size_t>(G));
+    float* const t = ws.layer_t.data();
+    const float cnx = chosen.nx, cny = chosen.ny, cnz = chosen.nz, cd = chosen.d;
+#pragma omp parallel for simd schedule(static)
+    for (int g = 0; g < G; ++g) {
+        const float h = cnx * gx[g] + cny * gy[g] + cnz * gz[g] + cd;
+        const bool facing = gnx[g] * cnx + gny[g] * cny + gnz[g] * cnz >= cos_inlier;
+        t[g] = facing ? h / (0.5f * on_band(gz[g])) : 1e9f;
+    }
+    const float layer = lowest_dense_layer(t, G);
+    // First the histogram's window, then the new plane's half band.
+    Plane pl = chosen;
+    if (fit_grid_subset(is_inlier, params.min_region_points,
+                        [=](int g) { return std::fabs(t[g] - layer) <= 1.0f; }, pl)) {
+        const Plane first = pl;
+        fit_grid_subset(is_inlier, params.min_region_points,
+                        [=](int g) { return is_inlier(first, g, 0.5f); }, pl);
+    }
+    pl.inliers = is_inlier.count(pl);
+    pl.above = chosen.above;
+    return pl;
+}
+
+/// The refinement moved the plane enough that the chosen plane's extent no longer serves
+/// (most frames it moves by under a millimetre). O(1).
+bool support_moved(const PlaneParams& params, const Plane& chosen, const Plane& pl) {
+    const float cos_moved = pl.nx * chosen.nx + pl.ny * chosen.ny + pl.nz * chosen.nz;
+    return std::fabs(pl.d - chosen.d) > 0.25f * params.on_plane_m || cos_moved < std::cos(1.0f * kDegToRad);
+}
+
+/// No support: every active point is kept as object. Out: `classes` (N); returns the
+/// points kept. O(N), two passes, no allocation.
+std::size_t keep_all_active(const std::vector<std::uint8_t>& active, std::vector<std::uint8_t>& classes) {
+    for (std::size_t p = 0; p < classes.size(); ++p) classes[p] = active[p] ? kPlaneObject : kPlaneRemoved;
+    return static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
+}
+
+/// 6. Classify every pixel: below or on the plane (and facing like it) is removed; on the
+/// band but facing otherwise is a candidate foot; above and over the support is object.
+/// In: the support `pl` and its extent `ws.hull`. Out: `classes` (N, PlaneClass), `ws.on_band`
+/// (N, 1 = removed and on the band) and `ws.row_first_run[v + 1]` (row v's number of runs of
+/// on-band pixels, for restore_islands); returns the pixels kept. O(N), one parallel pass,
+/// no allocation.
+std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const OrganizedCloud& cloud,
+                            const NormalMap& normals, const std::vector<std::uint8_t>& active,
+                            const Plane& pl, const Band on_band, const float cos_inlier,
+                            PlaneWorkspace& ws, std::vector<std::uint8_t>& classes) {
+    const int W = cloud.width, H = cloud.height;
+    ws.on_band.resize(cloud.size());
     ws.row_first_run.assign(static_cast<std::size_t>(H) + 1, 0);
-
-    // 6. Classify every pixel: below or on the plane (and facing like it) is removed; on the
-    //    band but facing otherwise is a candidate foot; above and over the support is object.
-    //    The runs of removed on-band pixels are counted per row for restore_islands.
     std::size_t kept = 0;
     // Raw pointers: the byte stores below may alias anything, so through the containers the
     // compiler would reload their data pointers on every pixel.
@@ -626,8 +592,8 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     std::uint8_t* const cls = classes.data();
     std::uint8_t* const band_out = ws.on_band.data();
     // ... and the plane as plain values (a byte store could change it too, as far as the
-    // compiler knows).
-    const HullMask hull = hull_of_plane(pl);
+    // compiler knows); the mask and `on_band` are local copies for the same reason.
+    const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
     const float pnx = pl.nx, pny = pl.ny, pnz = pl.nz, pd = pl.d;
 #pragma omp parallel for schedule(static) reduction(+ : kept)
     for (int v = 0; v < H; ++v) {
@@ -657,6 +623,207 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         }
         ws.row_first_run[static_cast<std::size_t>(v) + 1] = runs;
     }
+    return kept;
+}
+
+// 7. Islands (restore_islands and its steps). On-plane patches that the objects enclose (a
+// bowl's inner bottom seen through its opening) are object material, not the support: a
+// 4-connected patch of removed on-band pixels that touches neither the image border nor
+// other removed points, borders object points, is small and sits on average above the
+// plane is given back (kPlaneInside). The patches are found as runs of on-band pixels per
+// row joined by union-find where runs of consecutive rows overlap: a few thousand runs
+// instead of a flood fill over the table.
+
+using Run = PlaneWorkspace::Run;
+
+/// The root of run `a`'s set, halving the path on the way.
+int find_run(std::vector<Run>& runs, int a) {
+    while (runs[static_cast<std::size_t>(a)].parent != a) {
+        auto& r = runs[static_cast<std::size_t>(a)];
+        r.parent = runs[static_cast<std::size_t>(r.parent)].parent;
+        a = r.parent;
+    }
+    return a;
+}
+
+/// The runs of `ws.on_band`, row by row in parallel, each row's at its offset. In:
+/// `ws.row_first_run[v + 1]` = row v's count (classify_pixels). Out: `ws.row_first_run`
+/// as offsets (H + 1), `ws.runs` (each its own set). O(N), one parallel pass; no
+/// allocation once `ws.runs` has the capacity.
+void find_band_runs(int W, int H, PlaneWorkspace& ws) {
+    const std::uint8_t* band = ws.on_band.data();
+    auto& runs = ws.runs;
+    for (int v = 0; v < H; ++v)
+        ws.row_first_run[static_cast<std::size_t>(v) + 1] += ws.row_first_run[static_cast<std::size_t>(v)];
+    const std::size_t R = static_cast<std::size_t>(ws.row_first_run[static_cast<std::size_t>(H)]);
+    runs.resize(R);
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) {
+        int id = ws.row_first_run[static_cast<std::size_t>(v)];
+        const std::uint8_t* row = band + static_cast<std::size_t>(v) * W;
+        for (int u = 0; u < W;) {
+            if (!row[u]) {
+                ++u;
+                continue;
+            }
+            const int begin = u;
+            while (u < W && row[u]) ++u;
+            runs[static_cast<std::size_t>(id)] = {v, begin, u, id};
+            ++id;
+        }
+    }
+}
+
+/// Per run (in parallel): what borders it and, unless that opens it (its island is then
+/// open whatever else it holds: most of the table's runs), its heights over `pl`. Out:
+/// `ws.island_flags`, `ws.island_height` per run; `ws.island_size` zeroed. O(runs' pixels
+/// and their neighbours above and below), one parallel pass; no allocation once sized.
+void inspect_runs(const OrganizedCloud& cloud, const std::vector<std::uint8_t>& active, const Plane& pl,
+                  const std::vector<std::uint8_t>& classes, PlaneWorkspace& ws) {
+    const int W = cloud.width, H = cloud.height;
+    const std::uint8_t* band = ws.on_band.data();
+    const auto& runs = ws.runs;
+    const std::size_t R = runs.size();
+    ws.island_height.assign(R, 0.0);
+    ws.island_size.assign(R, 0);
+    ws.island_flags.assign(R, 0);
+    // A neighbour outside the patch: object material, or a removed active point off the
+    // band (support or room beside it) that opens the patch.
+    auto look = [&](std::size_t q, std::uint8_t& flags) {
+        if (band[q]) return;
+        if (classes[q] != kPlaneRemoved) flags |= 2;
+        else if (active[q]) flags |= 1;
+    };
+    const auto Rn = static_cast<std::ptrdiff_t>(R);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t i = 0; i < Rn; ++i) {
+        const auto& r = runs[static_cast<std::size_t>(i)];
+        std::uint8_t flags = 0;
+        const std::size_t row = static_cast<std::size_t>(r.row) * W;
+        if (r.row == 0 || r.row == H - 1 || r.begin == 0 || r.end == W) {
+            flags |= 1;  // touches the image border
+        } else {
+            look(row + static_cast<std::size_t>(r.begin) - 1, flags);
+            look(row + static_cast<std::size_t>(r.end), flags);
+            for (int u = r.begin; u < r.end && !(flags & 1); ++u) {
+                look(row - W + static_cast<std::size_t>(u), flags);
+                look(row + W + static_cast<std::size_t>(u), flags);
+            }
+        }
+        double height = 0;
+        if (!(flags & 1))
+            for (int u = r.begin; u < r.end; ++u) {
+                const std::size_t p = row + static_cast<std::size_t>(u);
+                height += pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
+            }
+        ws.island_height[static_cast<std::size_t>(i)] = height;
+        ws.island_flags[static_cast<std::size_t>(i)] = flags;
+    }
+}
+
+/// Runs of consecutive rows that share a column (4-connectivity) join, except two open
+/// runs: their islands are open whatever else they join (most of the table's runs). Then
+/// each run's size, heights and flags are summed into its root. Out: `ws.runs`' parents,
+/// `ws.island_*` complete at the roots. O(runs) near-constant union-find steps,
+/// sequential; no allocation.
+void join_runs_into_islands(int H, PlaneWorkspace& ws) {
+    auto& runs = ws.runs;
+    for (int v = 1; v < H; ++v) {
+        int a = ws.row_first_run[static_cast<std::size_t>(v) - 1];
+        const int a_end = ws.row_first_run[static_cast<std::size_t>(v)];
+        const int b_end = ws.row_first_run[static_cast<std::size_t>(v) + 1];
+        for (int b = a_end; b < b_end; ++b) {
+            const auto& rb = runs[static_cast<std::size_t>(b)];
+            while (a < a_end && runs[static_cast<std::size_t>(a)].end <= rb.begin) ++a;
+            const bool b_open = ws.island_flags[static_cast<std::size_t>(b)] & 1;
+            for (int c = a; c < a_end && runs[static_cast<std::size_t>(c)].begin < rb.end; ++c) {
+                if (b_open && (ws.island_flags[static_cast<std::size_t>(c)] & 1)) continue;
+                const int ra = find_run(runs, c), rb_root = find_run(runs, b);
+                if (ra != rb_root) runs[static_cast<std::size_t>(std::max(ra, rb_root))].parent = std::min(ra, rb_root);
+            }
+        }
+    }
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const auto& r = runs[i];
+        const std::size_t root = static_cast<std::size_t>(find_run(runs, static_cast<int>(i)));
+        ws.island_size[root] += r.end - r.begin;
+        if (root == i) continue;
+        ws.island_height[root] += ws.island_height[i];
+        ws.island_flags[root] |= ws.island_flags[i];
+    }
+}
+
+/// The closed islands that border object points only, are small and sit above the plane
+/// become kPlaneInside in `classes`; returns their pixels. O(runs + the pixels given
+/// back), sequential; no allocation.
+std::size_t give_back_islands(const PlaneParams& params, int W, std::size_t N, PlaneWorkspace& ws,
+                              std::vector<std::uint8_t>& classes) {
+    auto& runs = ws.runs;
+    const double max_size = params.island_max_share * static_cast<double>(N);
+    std::size_t restored = 0;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const auto& r = runs[i];
+        const std::size_t root = static_cast<std::size_t>(find_run(runs, static_cast<int>(i)));
+        const int size = ws.island_size[root];
+        if (ws.island_flags[root] != 2 || size > max_size ||
+            ws.island_height[root] / size <= params.island_min_height_m)
+            continue;
+        std::fill(classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.begin,
+                  classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.end, kPlaneInside);
+        restored += static_cast<std::size_t>(r.end - r.begin);
+    }
+    return restored;
+}
+
+/// 7. The islands given back. In: classify_pixels' `classes`, `ws.on_band` and run counts.
+/// Out: `classes` with kPlaneInside; returns the pixels given back. O(N) for the runs, then
+/// O(runs).
+std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
+                            const std::vector<std::uint8_t>& active, const Plane& pl,
+                            PlaneWorkspace& ws, std::vector<std::uint8_t>& classes) {
+    find_band_runs(cloud.width, cloud.height, ws);
+    inspect_runs(cloud, active, pl, classes, ws);
+    join_runs_into_islands(cloud.height, ws);
+    return give_back_islands(params, cloud.width, cloud.size(), ws, classes);
+}
+
+}  // namespace
+
+PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
+                                 const OrganizedCloud& cloud, const NormalMap& normals,
+                                 const std::vector<std::uint8_t>& active, PlaneWorkspace& ws,
+                                 std::vector<std::uint8_t>& classes) {
+    classes.resize(cloud.size());
+    PlaneResult result;
+    const Grid grid = make_grid(cloud.width, cloud.height, params.grid_stride_px);
+    gather_grid(grid, cloud, normals, active, ws.grid);
+    const Band band{params.on_plane_m, params.on_plane_rel};
+    const float cos_inlier = std::cos(params.inlier_angle_deg * kDegToRad);
+    const auto& gp = ws.grid;
+    const InlierTest inliers{gp.x.data(),  gp.y.data(),  gp.z.data(), gp.nx.data(), gp.ny.data(),
+                             gp.nz.data(), grid.size(), band,        cos_inlier};
+
+    // 1-3: planar regions, merged, fitted; those large enough are the candidates.
+    const GrownRegions grown = grow_regions(params, grid, ws);
+    const std::vector<int> roots = merge_coplanar(params, grown.regions, ws);
+    fit_candidates(params, roots, grown.with_normal, inliers, ws, result.candidates);
+
+    // 4-5: the support among them, refined.
+    const SupportChoice choice = choose_support(params, K, grid, inliers, ws, result.candidates);
+    if (choice.best < 0) {
+        result.kept = keep_all_active(active, classes);
+        return result;
+    }
+    result.found = true;
+    const Plane& chosen = result.candidates[static_cast<std::size_t>(choice.best)];
+    result.support = refine_support(params, inliers, ws, chosen);
+    const Plane pl = result.support;
+    // The support's extent: the chosen plane's serves unless the refinement moved the plane.
+    if (choice.hull_of != choice.best || support_moved(params, chosen, pl))
+        build_hull(params, grid, inliers, pl, ws);
+
+    // 6-7: every pixel classified; enclosed on-plane patches given back to the objects.
+    std::size_t kept = classify_pixels(grid, K, cloud, normals, active, pl, band, cos_inlier, ws, classes);
     kept += restore_islands(params, cloud, active, pl, ws, classes);
     result.kept = kept;
     return result;
