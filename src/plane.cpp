@@ -461,25 +461,39 @@ SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics&
 }
 
 /// The least-squares plane (as `fit`) of the grid points that in(g) takes, into `out`;
-/// false (and `out` unchanged) under min_points. Split across cores: detail::add_moments
-/// spelled out as masked sums, in its layout, because an OpenMP reduction needs them as
-/// scalars (and then they vectorize). O(G), one parallel pass, no allocation.
+/// false (and `out` unchanged) under min_points. Split across cores in a fixed number of
+/// blocks added up in order, so the sums, and the plane, are the same bits on any number
+/// of threads (an OpenMP reduction adds in the threads' order, and the pipeline runs this
+/// stage on one thread or two from frame to frame). In a block, detail::add_moments spelled
+/// out as masked sums, in its layout, so that they vectorize. O(G), one parallel pass, no
+/// allocation.
 template <class Take>
 bool fit_grid_subset(const InlierTest& grid, int min_points, Take&& in, Plane& out) {
     const float *const gx = grid.x, *const gy = grid.y, *const gz = grid.z;
     const int G = grid.G;
-    double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-#pragma omp parallel for simd schedule(static) reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
-    for (int g = 0; g < G; ++g) {
-        const double m = in(g) ? 1.0 : 0.0;
-        const double px = m * gx[g], py = m * gy[g], pz = m * gz[g];
-        n += m;
-        x += px; y += py; z += pz;
-        xx += px * gx[g]; xy += px * gy[g]; xz += px * gz[g];
-        yy += py * gy[g]; yz += py * gz[g]; zz += pz * gz[g];
+    constexpr int kBlocks = 16, kMoments = detail::kMoments;  // n, x, y, z, xx, ... zz
+    double block_sums[kBlocks][kMoments];
+#pragma omp parallel for schedule(static)
+    for (int b = 0; b < kBlocks; ++b) {
+        const int g0 = static_cast<int>(static_cast<long long>(G) * b / kBlocks);
+        const int g1 = static_cast<int>(static_cast<long long>(G) * (b + 1) / kBlocks);
+        double n = 0, x = 0, y = 0, z = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+#pragma omp simd reduction(+ : n, x, y, z, xx, xy, xz, yy, yz, zz)
+        for (int g = g0; g < g1; ++g) {
+            const double m = in(g) ? 1.0 : 0.0;
+            const double px = m * gx[g], py = m * gy[g], pz = m * gz[g];
+            n += m;
+            x += px; y += py; z += pz;
+            xx += px * gx[g]; xy += px * gy[g]; xz += px * gz[g];
+            yy += py * gy[g]; yz += py * gz[g]; zz += pz * gz[g];
+        }
+        const double sums[kMoments] = {n, x, y, z, xx, xy, xz, yy, yz, zz};
+        std::copy(sums, sums + kMoments, block_sums[b]);
     }
-    if (n < min_points) return false;
-    const double s[kSums] = {n, x, y, z, xx, xy, xz, yy, yz, zz, 0, 0, 0};
+    double s[kSums] = {};
+    for (int b = 0; b < kBlocks; ++b)
+        for (int k = 0; k < kMoments; ++k) s[k] += block_sums[b][k];
+    if (s[0] < min_points) return false;
     out = fit(s);
     return true;
 }

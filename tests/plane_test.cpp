@@ -1,6 +1,7 @@
 #include "wul3d/plane.hpp"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <string>
@@ -391,4 +392,44 @@ TEST(RemoveSupportPlane, EnclosedPatchAboveThePlane_IsAContainersInside) {
             EXPECT_GT(static_cast<double>(removed) / static_cast<double>(patch_size), 0.9);
         }
     }
+}
+
+// The pipeline runs the plane stage on one thread or on all, from frame to frame, by
+// timing (Pipeline's side-by-side choice): the support must not depend on the thread count,
+// to the bit, or a run's outputs would depend on the machine's load.
+TEST(RemoveSupportPlane, SamePlaneToTheBitOnAnyNumberOfThreads) {
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    const int threads_before = omp_get_max_threads();
+    int compared = 0;
+    for (const char* set : {"uois_tabletop", "pcl_kinect"}) {
+        auto source = open_source((sample_dir() / set).string(), SourceOptions{});
+        SourceItem item;
+        for (std::size_t i = 0; i < source->size(); ++i) {
+            source->read(i, item);
+            for (int n : {1, 2, 3}) {
+                SCOPED_TRACE(item.frame.name + " decimated " + std::to_string(n));
+                RgbdFrame small;
+                decimate_frame(item.frame, n, small);
+                Prepared f = prepared(small);
+                std::vector<Plane> planes;
+                for (int threads : {1, 2, 3, 4}) {
+                    omp_set_num_threads(threads);
+                    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
+                    if (r.found) planes.push_back(r.support);
+                }
+                if (planes.empty()) continue;
+                ASSERT_EQ(planes.size(), 4u);
+                ++compared;
+                for (const Plane& pl : planes) {
+                    EXPECT_EQ(pl.nx, planes[0].nx);
+                    EXPECT_EQ(pl.ny, planes[0].ny);
+                    EXPECT_EQ(pl.nz, planes[0].nz);
+                    EXPECT_EQ(pl.d, planes[0].d);
+                }
+            }
+        }
+    }
+    omp_set_num_threads(threads_before);
+    EXPECT_GE(compared, 10);
 }
