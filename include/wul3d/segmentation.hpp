@@ -62,8 +62,11 @@ struct SegmentParams {
     // short boundary, and that boundary crosses a smooth surface (no crease: shading on two
     // faces of one box is not a second object).
     float color_alpha = 0.02f;      ///< alpha of eq. (4) for the split; [0.002, 0.1]
-    float color_min_distance = 45;  ///< RGB distance (0-255) between the parts' means; > 0
-    float color_min_share = 0.15f;  ///< each part holds at least this share; (0, 0.5]
+    float color_min_distance = 25;  ///< chromaticity distance (0-255 scale) between the
+                                    ///< parts' means; > 0
+    float color_min_share = 0.05f;  ///< each part holds at least this share (and min_points):
+                                    ///< a flat box lying on a larger one may show only its
+                                    ///< rim; (0, 0.5]
     float color_max_boundary = 0.5f;  ///< boundary pairs / the smaller part's outline pairs
                                       ///< at most: a contact is one side of it; (0, 1]
     float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
