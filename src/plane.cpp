@@ -131,13 +131,18 @@ struct HullMask {
     float gfx, gfy, gcx, gcy;  // intrinsics in grid cells, centres + 0.5 (cell by truncation)
     float nx, ny, nz;        // the plane's normal
 
-    bool has_foot(float x, float y, float z, float h) const {
+    /// The grid cell the foot projects into, -1 off the image.
+    std::ptrdiff_t foot_cell(float x, float y, float z, float h) const {
         const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
-        if (fz <= 1e-3f) return false;
+        if (fz <= 1e-3f) return -1;
         const float inv_z = 1.0f / fz;
         const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
-        if (!(gu >= 0.0f && gv >= 0.0f && gu < fw && gv < fh)) return false;
-        return mask[static_cast<std::size_t>(gv) * w + static_cast<std::size_t>(gu)] != 0;
+        if (!(gu >= 0.0f && gv >= 0.0f && gu < fw && gv < fh)) return -1;
+        return static_cast<std::ptrdiff_t>(static_cast<std::size_t>(gv) * w + static_cast<std::size_t>(gu));
+    }
+    bool has_foot(float x, float y, float z, float h) const {
+        const std::ptrdiff_t cell = foot_cell(x, y, z, h);
+        return cell >= 0 && mask[cell] != 0;
     }
 };
 
@@ -406,13 +411,14 @@ struct SupportChoice {
 };
 
 /// 4. The support: among planes that face up, the one that carries most: score = points
-/// standing on it (at most its extent) + 0.1 x its extent. A candidate scores at most
+/// standing on it (at most its extent; none where something taller than an object rises from
+/// the same foot) + 0.1 x its extent. A candidate scores at most
 /// 1.1 x its extent, so once one scores more, smaller candidates are not counted (each
 /// count builds a hull and passes over the grid). Largest first; ties go to the lower
 /// index, as in index order. In: `candidates`, `ws.grid`. Out: the choice; each counted
 /// candidate's `above`; `ws.by_extent`, `ws.sliver`, `ws.hull` of the last one counted.
-/// O(C log C) to rank, mark_slivers, then O(G) (a hull and a parallel pass) per candidate
-/// counted, usually one or two.
+/// O(C log C) to rank, mark_slivers, then O(G) (a hull, a pass and a parallel pass) per
+/// candidate counted, usually one or two.
 SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics& K, const Grid& grid,
                              const InlierTest& inliers, PlaneWorkspace& ws,
                              std::vector<Plane>& candidates) {
@@ -438,13 +444,29 @@ SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics&
         build_hull(params, grid, inliers, pl, ws);
         choice.hull_of = c;
         const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
+        // What rises from its foot higher than anything standing on the plane is not an
+        // object on it: a wall, or a table over the floor (its top over the cells its legs
+        // and what lies under it stand on). Points whose foot shares a grid cell with such
+        // a point's foot do not count: they made the floor of a room carry more than the
+        // table with the objects (the feet of the walls and the table's legs). One thread:
+        // an O(G) pass of byte stores.
+        ws.tall_foot.assign(static_cast<std::size_t>(G), 0);
+        for (int p = 0; p < G; ++p) {
+            if (!gp.active[p]) continue;
+            const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
+            if (h <= params.max_object_height_m) continue;
+            const std::ptrdiff_t cell = hull.foot_cell(gp.x[p], gp.y[p], gp.z[p], h);
+            if (cell >= 0) ws.tall_foot[static_cast<std::size_t>(cell)] = 1;
+        }
+        const std::uint8_t* const tall = ws.tall_foot.data();
         std::size_t above = 0;
 #pragma omp parallel for schedule(static) reduction(+ : above)
         for (int p = 0; p < G; ++p) {
             if (!gp.active[p]) continue;
             const float h = pl.height(gp.x[p], gp.y[p], gp.z[p]);
             if (h <= on_band(gp.z[p]) || h > params.max_object_height_m) continue;
-            if (hull.has_foot(gp.x[p], gp.y[p], gp.z[p], h)) ++above;
+            const std::ptrdiff_t cell = hull.foot_cell(gp.x[p], gp.y[p], gp.z[p], h);
+            above += cell >= 0 && hull.mask[cell] != 0 && tall[cell] == 0;
         }
         pl.above = above;
         // Points standing on a plane count up to its own extent (a small tilted plane, a box

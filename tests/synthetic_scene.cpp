@@ -101,6 +101,21 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
                     rgb[0] = 150; rgb[1] = 140; rgb[2] = 120;
                 }
             }
+            if (s.floor_y > 0 && dy > 1e-6f && s.floor_y / dy < best) {
+                best = s.floor_y / dy;
+                id = kTruthFloor;
+                rgb[0] = 60; rgb[1] = 150; rgb[2] = 70;
+            }
+            for (std::size_t i = 0; i < s.floor_boxes.size(); ++i) {
+                const SceneBox& b = s.floor_boxes[i];
+                const float t = hit_box(dx, dy, dz, b.x - b.w / 2, b.x + b.w / 2, s.floor_y - b.h,
+                                        s.floor_y, b.z - b.d / 2, b.z + b.d / 2);
+                if (t < best) {
+                    best = t;
+                    id = kTruthFloorBox0 + static_cast<int>(i);
+                    rgb[0] = b.r; rgb[1] = b.g; rgb[2] = b.b;
+                }
+            }
             if (s.wall && dz > 1e-6f && 2.4f / dz < best) {
                 best = 2.4f / dz;
                 id = kTruthWall;

@@ -29,6 +29,9 @@ struct Scene {
     std::vector<SceneBox> boxes;
     std::vector<SceneCup> cups;
     bool wall = false;          ///< a back wall at z = 2.4 m
+    float floor_y = 0.0f;       ///< a floor this far below the camera (0: none), out to the
+                                ///< wall when there is one
+    std::vector<SceneBox> floor_boxes;  ///< boxes standing on the floor (a table's legs)
     float table_half_width = 0.6f;            ///< table spans x in [-w, w]
     float table_near = 0.7f, table_far = 1.7f;  ///< and z in [near, far], metres
     float table_y = 0.35f;      ///< table top height below the camera, metres
@@ -38,8 +41,10 @@ struct Scene {
                                 ///< scene's axes stay put; 0 = looking straight ahead)
 };
 
-/// Ground-truth ids: 0 nothing, 1 table, 2 wall, 10 + i box i, 50 + i cup i.
-constexpr int kTruthTable = 1, kTruthWall = 2, kTruthBox0 = 10, kTruthCup0 = 50;
+/// Ground-truth ids: 0 nothing, 1 table, 2 wall, 3 floor, 10 + i box i, 50 + i cup i,
+/// 80 + i floor box i.
+constexpr int kTruthTable = 1, kTruthWall = 2, kTruthFloor = 3, kTruthBox0 = 10, kTruthCup0 = 50,
+              kTruthFloorBox0 = 80;
 
 /// Intrinsics used for every synthetic scene of that size.
 PinholeIntrinsics scene_intrinsics(int width, int height);

@@ -90,6 +90,8 @@ struct PlaneWorkspace {
     std::vector<std::uint32_t> candidate_bits;  ///< per grid point: bit r = inlier of rank r
     std::vector<int> shared;          ///< inliers two candidates share (ranks i > j)
     std::vector<std::uint8_t> sliver; ///< per rank: cuts through a larger candidate, not scored
+    std::vector<std::uint8_t> tall_foot;  ///< per grid cell: something rises from it past
+                                          ///< max_object_height_m over the candidate counted
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
     struct Run {
