@@ -699,6 +699,10 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     const int W = x.W;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     ws.scope_lo.assign(L, std::numeric_limits<float>::max());
+    ws.scope_any_px.assign(L, -1);
+    ws.scope_sx.assign(L, 0.0);
+    ws.scope_sy.assign(L, 0.0);
+    ws.scope_sz.assign(L, 0.0);
     ws.scope_hi.assign(L, -std::numeric_limits<float>::max());
     ws.scope_high.assign(L, 0);
     ws.scope_outline.assign(L, 0);
@@ -738,6 +742,10 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 const float h = height(p);
                 const auto li = static_cast<std::size_t>(l);
                 ws.scope_lo[li] = std::min(ws.scope_lo[li], h);
+                ws.scope_any_px[li] = static_cast<int>(p);
+                ws.scope_sx[li] += x.c.x[p];
+                ws.scope_sy[li] += x.c.y[p];
+                ws.scope_sz[li] += x.c.z[p];
                 ws.scope_hi[li] = std::max(ws.scope_hi[li], h);
                 ws.scope_high[li] += h > prm.scope_max_height_m;
                 ++ws.sizes[li];
@@ -755,15 +763,57 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
 }
 
+/// Whether the camera could see the support under segment l's middle: F, the foot of the
+/// segment's mean point on the support, is placed in the image by the local scale of the
+/// organized grid (the pitch of the points beside one of the segment's pixels), and the
+/// pixel there shows something nearer than F (the segment itself, or an object in front),
+/// shows nothing (no depth: the sensor's shadow beside an object) or lies out of the frame.
+/// A box seen from steeply above shows its top alone, its sides in shadow or edge-on, and
+/// its body hides its foot. A box hanging over the table, seen obliquely, shows the table
+/// under its middle. Cost: a few reads per segment.
+bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, std::size_t l) {
+    const int p = ws.scope_any_px[l];
+    if (p < 0 || ws.sizes[l] == 0) return false;
+    const int W = x.W, u = p % W, v = p / W;
+    const auto P = static_cast<std::size_t>(p);
+    // The grid's scale at p: pixels per unit of x/z (y/z), from a neighbour with depth.
+    auto scale = [&](int du, int dv) -> float {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || uu >= W || vv < 0 || vv >= x.H) return 0.0f;
+        const auto q = static_cast<std::size_t>(vv) * W + uu;
+        if (!x.c.valid[q]) return 0.0f;
+        const float d = du ? x.c.x[q] / x.c.z[q] - x.c.x[P] / x.c.z[P] : x.c.y[q] / x.c.z[q] - x.c.y[P] / x.c.z[P];
+        return std::fabs(d) > 1e-9f ? static_cast<float>(du + dv) / d : 0.0f;
+    };
+    float fx = scale(1, 0), fy = scale(0, 1);
+    if (!(fx > 0.0f)) fx = scale(-1, 0);
+    if (!(fy > 0.0f)) fy = scale(0, -1);
+    if (!(fx > 0.0f) || !(fy > 0.0f)) return false;
+    const double m = ws.sizes[l];
+    const auto cx = static_cast<float>(ws.scope_sx[l] / m), cy = static_cast<float>(ws.scope_sy[l] / m),
+               cz = static_cast<float>(ws.scope_sz[l] / m);
+    const float h = pl.height(cx, cy, cz);
+    const float fxw = cx - h * pl.nx, fyw = cy - h * pl.ny, fzw = cz - h * pl.nz;
+    if (!(fzw > 0.0f)) return true;
+    const long fu = u + std::lround(fx * (fxw / fzw - x.c.x[P] / x.c.z[P]));
+    const long fv = v + std::lround(fy * (fyw / fzw - x.c.y[P] / x.c.z[P]));
+    if (fu < 0 || fu >= W || fv < 0 || fv >= x.H) return true;
+    const auto f = static_cast<std::size_t>(fv) * W + static_cast<std::size_t>(fu);
+    if (!x.c.valid[f]) return true;
+    return x.c.z[f] < fzw - (x.prm.depth_jump_m + x.prm.depth_jump_rel * fzw * fzw);
+}
+
 /// ws.scope_keep per segment, from measure_scope's counts: bit 0 inside the volume, bit 1
 /// kept. Inside: under the height limit (2 % of the points may be noise) and not running on
-/// past the hull or out of view. Kept: stands (the lowest point touches the support), or
+/// past the hull or out of view. Kept: stands (the lowest point touches the support, or the
+/// camera cannot see the support under the segment's middle: foot_hidden), or
 /// rests on a kept segment: touches it in the image (a box on a box, a lid on a tin, an
 /// object behind another with its foot hidden). No height test: a supported object's visible
 /// bottom can lie well above its supporter's visible top (a tin's lid overhangs what it
 /// stands on), and what hangs or is fixed to a wall has already left the volume. Cost: O(n),
 /// then passes over ws.edges until "rests on" stops spreading.
-void decide_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     auto& keep = ws.scope_keep;
     keep.assign(L, 0);
@@ -772,7 +822,9 @@ void decide_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
         const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
                             static_cast<float>(ws.scope_outside[l]) <=
                                 prm.scope_max_outside * static_cast<float>(ws.scope_outline[l]);
-        keep[l] = static_cast<std::uint8_t>(inside ? (ws.scope_lo[l] <= prm.scope_contact_m ? 3 : 1) : 0);
+        const bool stands = ws.scope_lo[l] <= prm.scope_contact_m ||
+                            foot_hidden(x, pl, ws, l);
+        keep[l] = static_cast<std::uint8_t>(inside ? (stands ? 3 : 1) : 0);
     }
     for (bool grew = true; grew;) {
         grew = false;
@@ -812,7 +864,7 @@ int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int
     const FrameEdge edge = find_frame_edge(x);
     const float far_z = support_middle_depth(x, pl);
     measure_scope(x, pl, edge, far_z, ws, n);
-    decide_scope(x.prm, ws, n);
+    decide_scope(x, pl, ws, n);
     return clear_out_of_scope(x.prm, ws, n);
 }
 

@@ -284,8 +284,9 @@ TEST(SegmentParams, Scope_ParsedAndNamed) {
     EXPECT_EQ(SegmentParams{}.scope, Scope::Support);
 }
 
-// Two boxes apart on the table, the second lifted 10 cm off it: it stands on nothing and
-// touches nothing, so the support does not hold it. --scope scene keeps it.
+// Two boxes apart on the table, the second hanging 10 cm over it (rendered so: the table
+// shows under it): it stands on nothing, touches nothing, and the table is seen under its
+// middle, so the support does not hold it. --scope scene keeps it.
 TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
     Scene s = pitched_tabletop_scene();
     SceneBox a, b;
@@ -294,9 +295,9 @@ TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
     b.x = 0.2f;
     b.z = 1.0f;
     b.b = 200;
+    b.lift = 0.1f;
     s.boxes = {a, b};
     PlaneStage st = up_to_the_plane(s);
-    lift(st, kTruthBox0 + 1, 0.1f);
     for (const Scope scope : {Scope::Support, Scope::Scene}) {
         SCOPED_TRACE(scope_name(scope));
         SegmentParams params;
@@ -318,6 +319,49 @@ TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
             EXPECT_EQ(stats.segments, 2);
         }
     }
+}
+
+// A box whose sides the sensor does not see (seen from steeply above, or in the shadow of a
+// structured-light sensor): its segment is its top alone, 15 cm over the table, standing on
+// nothing within scope_contact_m and touching nothing. Its foot is hidden, not seen: the
+// pixel of the support point under its middle shows no depth, so the support holds it.
+// (The hanging box above shows the table under its middle and stays out.)
+TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox a, b;
+    a.x = -0.2f;
+    a.z = 1.0f;
+    b.x = 0.2f;
+    b.z = 1.0f;
+    b.h = 0.15f;
+    b.b = 200;
+    s.boxes = {a, b};
+    PlaneStage st = up_to_the_plane(s);
+    const Plane& pl = st.plane.support;
+    float top = 0;
+    for (std::size_t p = 0; p < st.truth.size(); ++p)
+        if (st.truth[p] == kTruthBox0 + 1) top = std::max(top, pl.height(st.cloud.x[p], st.cloud.y[p], st.cloud.z[p]));
+    ASSERT_GT(top, 0.12f);
+    std::size_t unseen = 0;
+    for (std::size_t p = 0; p < st.truth.size(); ++p) {
+        if (st.truth[p] != kTruthBox0 + 1 || pl.height(st.cloud.x[p], st.cloud.y[p], st.cloud.z[p]) > top - 0.01f)
+            continue;
+        st.cloud.valid[p] = 0;
+        st.normals.valid[p] = 0;
+        st.classes[p] = kPlaneRemoved;
+        st.truth[p] = 0;  // unseen: the box is its top
+        ++unseen;
+    }
+    ASSERT_GT(unseen, 500u);  // the sides were in view, and are gone
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    int ia = 0, ib = 0;
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &ia), 0.9);
+    EXPECT_NE(ia, 0);
+    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib);
+    EXPECT_NE(ib, 0) << "the box seen without its sides was left out";
+    EXPECT_EQ(stats.out_of_scope, 0);
+    EXPECT_EQ(stats.segments, 2);
 }
 
 // The same lift on a box that touches another in the image (a small box in front of a tall

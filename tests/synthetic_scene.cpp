@@ -123,8 +123,8 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
             }
             for (std::size_t i = 0; i < s.boxes.size(); ++i) {
                 const SceneBox& b = s.boxes[i];
-                const float t = hit_box(dx, dy, dz, b.x - b.w / 2, b.x + b.w / 2, s.table_y - b.h,
-                                        s.table_y, b.z - b.d / 2, b.z + b.d / 2);
+                const float t = hit_box(dx, dy, dz, b.x - b.w / 2, b.x + b.w / 2, s.table_y - b.lift - b.h,
+                                        s.table_y - b.lift, b.z - b.d / 2, b.z + b.d / 2);
                 if (t < best) {
                     best = t;
                     id = kTruthBox0 + static_cast<int>(i);

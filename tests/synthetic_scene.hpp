@@ -13,6 +13,7 @@ namespace wul3d::test {
 struct SceneBox {
     float x = 0, z = 1.2f;              ///< centre of the footprint on the table, metres
     float w = 0.15f, h = 0.15f, d = 0.15f;  ///< size along x, y, z, metres
+    float lift = 0.0f;                  ///< its bottom this far over the surface (hanging), metres
     std::uint8_t r = 200, g = 30, b = 30;
 };
 

@@ -101,7 +101,8 @@ struct SegmentParams {
     // bigger than the table holds: a wall, a chair, the next table.
     Scope scope = Scope::Support;
     float scope_contact_m = 0.03f;     ///< a segment whose lowest point is this close to the
-                                       ///< support stands on it; > 0
+                                       ///< support stands on it (so does one whose foot the
+                                       ///< camera cannot see: its sides unseen); > 0
     float scope_max_height_m = 0.5f;   ///< a segment with over 2 % of its points higher than
                                        ///< this over the support is not held by it; > 0
     float scope_max_outside = 0.1f;    ///< largest share of a segment's outline that continues
@@ -151,6 +152,8 @@ struct SegmentWorkspace {
     // Scope: per segment its lowest and highest point over the support, points above the
     // height limit, outline pairs, and those that continue into removed points above it.
     std::vector<float> scope_lo, scope_hi;
+    std::vector<int> scope_any_px;                     ///< one pixel of each segment
+    std::vector<double> scope_sx, scope_sy, scope_sz;  ///< sums of each segment's points
     std::vector<int> scope_high, scope_outline, scope_outside;
     std::vector<std::uint8_t> scope_keep;
 };
