@@ -284,20 +284,29 @@ TEST(SegmentParams, Scope_ParsedAndNamed) {
     EXPECT_EQ(SegmentParams{}.scope, Scope::Support);
 }
 
-// Two boxes apart on the table, the second hanging 10 cm over it (rendered so: the table
-// shows under it): it stands on nothing, touches nothing, and the table is seen under its
-// middle, so the support does not hold it. --scope scene keeps it.
-TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
+namespace {
+/// The pitched tabletop with two boxes 0.4 m apart, the second (blue) `h` tall and hanging
+/// `lift` over the table.
+Scene two_boxes_apart(float h, float lift) {
     Scene s = pitched_tabletop_scene();
     SceneBox a, b;
     a.x = -0.2f;
     a.z = 1.0f;
     b.x = 0.2f;
     b.z = 1.0f;
+    b.h = h;
+    b.lift = lift;
     b.b = 200;
-    b.lift = 0.1f;
     s.boxes = {a, b};
-    PlaneStage st = up_to_the_plane(s);
+    return s;
+}
+}  // namespace
+
+// Two boxes apart on the table, the second hanging 10 cm over it (rendered so: the table
+// shows under it): it stands on nothing, touches nothing, and the table is seen under its
+// middle, so the support does not hold it. --scope scene keeps it.
+TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
+    PlaneStage st = up_to_the_plane(two_boxes_apart(SceneBox{}.h, 0.1f));
     for (const Scope scope : {Scope::Support, Scope::Scene}) {
         SCOPED_TRACE(scope_name(scope));
         SegmentParams params;
@@ -327,16 +336,7 @@ TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
 // pixel of the support point under its middle shows no depth, so the support holds it.
 // (The hanging box above shows the table under its middle and stays out.)
 TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
-    Scene s = pitched_tabletop_scene();
-    SceneBox a, b;
-    a.x = -0.2f;
-    a.z = 1.0f;
-    b.x = 0.2f;
-    b.z = 1.0f;
-    b.h = 0.15f;
-    b.b = 200;
-    s.boxes = {a, b};
-    PlaneStage st = up_to_the_plane(s);
+    PlaneStage st = up_to_the_plane(two_boxes_apart(0.15f, 0.0f));
     const Plane& pl = st.plane.support;
     float top = 0;
     for (std::size_t p = 0; p < st.truth.size(); ++p)
