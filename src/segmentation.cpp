@@ -65,6 +65,7 @@ void SegmentParams::validate() const {
     require(color_min_distance > 0, "color_min_distance", color_min_distance, "> 0");
     require(color_min_share > 0 && color_min_share <= 0.5f, "color_min_share", color_min_share, "in (0, 0.5]");
     require(color_max_boundary > 0 && color_max_boundary <= 1, "color_max_boundary", color_max_boundary, "in (0, 1]");
+    require(color_max_compact >= 0, "color_max_compact", color_max_compact, ">= 0");
     require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
     require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
     require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");

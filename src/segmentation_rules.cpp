@@ -390,12 +390,14 @@ ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWor
     return {{f[0], f[1], f[2], f[3], f[4], f[5]}, first};
 }
 
-/// The segments large enough to split (2 x min_points), largest first, into ws.by_size: tried
+/// The segments of this round (ws.to_try) large enough to split (2 x min_points), largest
+/// first, into ws.by_size: tried
 /// in parallel, no thread is left with a big one at the end. Cost: O(n log n).
 void order_by_size(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
     ws.by_size.clear();
     for (int l = 1; l <= n; ++l)
-        if (segment_size(ws, l) >= 2 * prm.min_points) ws.by_size.push_back(l);
+        if (ws.to_try[static_cast<std::size_t>(l)] && segment_size(ws, l) >= 2 * prm.min_points)
+            ws.by_size.push_back(l);
     std::stable_sort(ws.by_size.begin(), ws.by_size.end(),
                      [&](int a, int b) { return segment_size(ws, a) > segment_size(ws, b); });
 }
@@ -562,9 +564,14 @@ bool try_colour_split(const Ctx& x, const ColourFeatures& ft, const ClusterParam
     // crease step away on either side tell a smooth surface from a fold.
     const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
     const SplitBoundary sb = split_boundary(x, ws, l, px, m, small_part, cos_crease);
-    // A contact between two objects is one side of the smaller one's outline; a split
-    // along a texture (stripes, print) runs round most of each piece.
-    if (static_cast<float>(sb.boundary) > prm.color_max_boundary * static_cast<float>(sb.small_outline)) return false;
+    // A contact between two objects is one side of the smaller one's outline, or, where the
+    // larger one encloses it in view (a box lying on a box, seen from above), the whole
+    // outline of a compact piece: 4 sqrt(pixels) for a square, 6 for a 6:1 rectangle. A
+    // split along a texture (stripes, checks, print) runs round most of each of its many
+    // pieces, far longer than either.
+    const bool one_side = static_cast<float>(sb.boundary) <= prm.color_max_boundary * static_cast<float>(sb.small_outline);
+    const bool compact = static_cast<double>(sb.boundary) <= prm.color_max_compact * std::sqrt(static_cast<double>(small));
+    if (!one_side && !compact) return false;
     // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
     // straddle its edge), or the parts must differ in chromaticity: light falling on two
     // faces of one box at other angles scales their colour, it does not turn it, so
@@ -599,15 +606,12 @@ int number_splits(SegmentWorkspace& ws, int n) {
     return splits;
 }
 
-}  // namespace
-
-/// The colour cue: tries to split each segment in two by 2-means under the paper's distance
-/// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
-/// are large, meet along a short boundary across a smooth surface. In: ws.label (1..n with
-/// gaps). Out: ws.label with part 1 of each split segment numbered n + 1, n + 2, ... in
-/// segment order. Cost: a counting sort and a gather of the object pixels (parallel passes),
-/// then O(segment pixels) per 2-means iteration per segment tried, segments in parallel.
-int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
+/// One round of the colour cue over the segments marked in ws.to_try (1..n): tries to split
+/// each in two, then numbers part 1 of each split segment n + 1, n + 2, ... in segment order.
+/// Returns the splits. Cost: a counting sort and a gather of the object pixels (parallel
+/// passes), then O(segment pixels) per 2-means iteration per segment tried, segments in
+/// parallel.
+int split_round(const Ctx& x, SegmentWorkspace& ws, int n) {
     const SegmentParams& prm = x.prm;
     sort_pixels_by_segment(x, ws, n);
     // part is written for a segment's pixels before anything reads them: no clearing.
@@ -629,6 +633,27 @@ int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
         if (try_colour_split(x, features, cp, cos_crease, ws, l)) ws.split[static_cast<std::size_t>(l)] = 1;
     }
     return number_splits(ws, n);
+}
+
+}  // namespace
+
+/// The colour cue: tries to split each segment in two by 2-means under the paper's distance
+/// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
+/// are large, and meet along one side of the smaller part or round a compact piece, across
+/// a smooth surface or with a turn of colour. A second round tries the two parts of each
+/// split segment again: three flush boxes of three colours need two cuts. In: ws.label
+/// (1..n with gaps). Out: ws.label with the new parts numbered n + 1, n + 2, ... (round 1's
+/// in segment order, then round 2's). Cost: split_round once, twice when it split anything.
+int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
+    ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
+    const int first = split_round(x, ws, n);
+    if (first == 0) return 0;
+    // Round 2: the segments split in round 1 (part 0 kept their label) and their new parts.
+    // A third round split nothing more on the tune seeds (docs/ABLATION.md).
+    ws.to_try.assign(static_cast<std::size_t>(n + first) + 1, 0);
+    for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)];
+    for (int l = n + 1; l <= n + first; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
+    return first + split_round(x, ws, n + first);
 }
 
 // ---- scope ---------------------------------------------------------------------------------

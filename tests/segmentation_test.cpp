@@ -425,3 +425,73 @@ TEST(SegmentObjects, FlushBoxesOfTwoHeights_SeparatedAcrossTheFold) {
     EXPECT_NE(b, 0);
     EXPECT_NE(a, b) << "the two boxes are one object";
 }
+
+// A flat box lying on a larger box of another colour, seen from above: the larger box's top
+// encloses the flat one in view, so their colour boundary is the flat box's whole outline,
+// not one side of it. It is short for the piece's area (a compact piece, not a texture),
+// and the colour cue splits them (color_max_compact).
+TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox base;
+    base.z = 1.0f;
+    base.w = 0.26f;
+    base.h = 0.08f;
+    base.d = 0.24f;
+    base.r = 180; base.g = 150; base.b = 100;  // near the table's colour, as its feet are
+    SceneBox flat = base;
+    flat.w = 0.12f;
+    flat.d = 0.1f;
+    flat.h = 0.015f;
+    flat.lift = base.h;  // lying on the base box's top
+    flat.r = 40; flat.g = 90; flat.b = 200;
+    s.boxes = {base, flat};
+    std::vector<int> truth;
+    const PlaneStage in = up_to_the_plane(s);
+    int a = 0, b = 0;
+    SegmentParams without;
+    without.color_max_compact = 0;
+    const LabelImage one = segment(in, without);
+    dominant_share(one.labels, in.truth, kTruthBox0, &a);
+    dominant_share(one.labels, in.truth, kTruthBox0 + 1, &b);
+    ASSERT_EQ(a, b) << "without the compact-piece test the two boxes should be one (test premise)";
+
+    SegmentStats stats;
+    const LabelImage two = segment(in, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(two.labels, in.truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(two.labels, in.truth, kTruthBox0 + 1, &b), 0.8);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(b, 0);
+    EXPECT_NE(a, b) << "the flat box was not split from the box it lies on";
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
+// Three flush boxes of three colours in a row: one 2-means split cuts one box off, and the
+// second round splits the two that are left.
+TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 9;
+    SceneBox left;
+    left.x = -0.12f;
+    left.z = 1.0f;
+    left.w = 0.12f;
+    left.r = 210; left.g = 40; left.b = 40;
+    SceneBox middle = left;
+    middle.x = 0.0f;
+    middle.r = 40; middle.g = 180; middle.b = 60;
+    SceneBox right = left;
+    right.x = 0.12f;
+    right.r = 40; right.g = 60; right.b = 220;
+    s.boxes = {left, middle, right};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
+    int id[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + i, &id[i]), 0.9) << "box " << i;
+        EXPECT_NE(id[i], 0) << "box " << i;
+    }
+    EXPECT_NE(id[0], id[1]);
+    EXPECT_NE(id[1], id[2]);
+    EXPECT_NE(id[0], id[2]);
+    EXPECT_EQ(stats.color_splits, 2);
+}

@@ -69,6 +69,10 @@ struct SegmentParams {
                                     ///< rim; (0, 0.5]
     float color_max_boundary = 0.5f;  ///< boundary pairs / the smaller part's outline pairs
                                       ///< at most: a contact is one side of it; (0, 1]
+    float color_max_compact = 6;      ///< ... or boundary pairs / sqrt(the smaller part's
+                                      ///< pixels) at most: a compact piece that the larger
+                                      ///< part encloses in view (a box lying on a box); a
+                                      ///< texture's parts run far longer; >= 0, 0 = off
     float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
                                       ///< step away on either side) within this angle; > 0
     float color_min_hue_deg = 10;     ///< ... or else (the boundary follows a fold) the parts'
@@ -136,6 +140,7 @@ struct SegmentWorkspace {
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
     std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
     std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
+    std::vector<std::uint8_t> to_try;  ///< colour cue: 1 = try segment l this round
     std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
