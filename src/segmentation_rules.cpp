@@ -416,29 +416,59 @@ int farthest_colour(const float* const* f, int m, double r, double g, double b) 
     return best;
 }
 
-/// 2-means seeds for one segment (planes `f`, m pixels) in `cen`: the pixel farthest in colour
-/// from the mean, then the one farthest from it. False, and no seeds, when the colour
-/// spread cannot hold parts `min_spread` apart (feature units). Cost: three passes over the
-/// segment's colour planes.
-bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6]) {
-    const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
-    double mr = 0, mg = 0, mb = 0;
-    for (int i = 0; i < m; ++i) {
-        mr += cr[i]; mg += cg[i]; mb += cb[i];
+/// The principal axis of a 3 x 3 covariance (unit length) and its variance, by power
+/// iteration from the axis of the largest diagonal entry. Cost: O(1).
+double principal_axis(const double (&cov)[3][3], double (&e)[3]) {
+    e[0] = e[1] = e[2] = 0;
+    e[cov[0][0] >= cov[1][1] && cov[0][0] >= cov[2][2] ? 0 : cov[1][1] >= cov[2][2] ? 1 : 2] = 1;
+    double variance = 0;
+    for (int it = 0; it < 20; ++it) {
+        double next[3];
+        for (int a = 0; a < 3; ++a) next[a] = cov[a][0] * e[0] + cov[a][1] * e[1] + cov[a][2] * e[2];
+        const double len = std::sqrt(next[0] * next[0] + next[1] * next[1] + next[2] * next[2]);
+        if (!(len > 0)) break;
+        for (int a = 0; a < 3; ++a) e[a] = next[a] / len;
+        variance = len;
     }
-    mr /= m; mg /= m; mb /= m;
-    const int a0 = farthest_colour(f, m, mr, mg, mb);
+    return variance;
+}
+
+/// 2-means seeds for one segment (planes `f`, m pixels) in `cen`: the mean colour plus and
+/// minus one standard deviation along the colours' principal axis, both at the mean
+/// position. Seeds at the farthest colours (the pixel farthest from the mean, then the one
+/// farthest from it) let a few outlying pixels, the feet a segment took from the table or
+/// a line of mixed colour at an edge, pull 2-means into a part of their own, which the
+/// share test then rejects; they move the principal axis little (generated tune seeds
+/// 88.5 -> 89.8 Overlap F, docs/ABLATION.md). False, and no seeds, when the colour spread
+/// cannot hold parts `min_spread` apart (feature units). Cost: three passes over the
+/// segment's planes.
+bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6]) {
+    double mean[6] = {};
+    for (int q = 0; q < 6; ++q) {
+        for (int i = 0; i < m; ++i) mean[q] += f[q][i];
+        mean[q] /= m;
+    }
+    const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
     // The parts' mean colours lie among the segment's colours, so they are at most the
     // segment's colour diameter apart, at most twice the farthest colour from the mean:
     // below the minimum distance no split can be kept.
     {
-        const double dr = cr[a0] - mr, dg = cg[a0] - mg, db = cb[a0] - mb;
+        const int a0 = farthest_colour(f, m, mean[3], mean[4], mean[5]);
+        const double dr = cr[a0] - mean[3], dg = cg[a0] - mean[4], db = cb[a0] - mean[5];
         if (2 * std::sqrt(dr * dr + dg * dg + db * db) < min_spread) return false;
     }
-    const int b0 = farthest_colour(f, m, cr[a0], cg[a0], cb[a0]);
+    double cov[3][3] = {};
+    for (int i = 0; i < m; ++i) {
+        const double d[3] = {cr[i] - mean[3], cg[i] - mean[4], cb[i] - mean[5]};
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) cov[a][b] += d[a] * d[b];
+    }
+    double e[3];
+    const double sd = std::sqrt(principal_axis(cov, e) / m);
     for (int q = 0; q < 6; ++q) {
-        cen[0][q] = f[q][a0];
-        cen[1][q] = f[q][b0];
+        const double step = q < 3 ? 0.0 : sd * e[q - 3];
+        cen[0][q] = static_cast<float>(mean[q] + step);
+        cen[1][q] = static_cast<float>(mean[q] - step);
     }
     return true;
 }
