@@ -495,3 +495,45 @@ TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
     EXPECT_NE(id[0], id[2]);
     EXPECT_EQ(stats.color_splits, 2);
 }
+
+// Two flush boxes of different colours, one with a small sticker of a third colour (under
+// 2 % of the pair) farther from each box's colour than they are from each other. 2-means
+// seeded at the farthest colours starts one part at the sticker and keeps it there (both
+// boxes are nearer the other seed), a part the share test rejects; seeded along the
+// colours' principal axis it finds the two boxes.
+TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 11;
+    SceneBox red;  // muted colours: the sticker is farther from each than they are apart
+    red.x = -0.075f;
+    red.z = 1.0f;
+    red.r = 190; red.g = 70; red.b = 60;
+    SceneBox blue = red;
+    blue.x = 0.075f;
+    blue.r = 60; blue.g = 80; blue.b = 190;
+    s.boxes = {red, blue};
+    PlaneStage in = up_to_the_plane(s);
+    // The sticker: a 6 x 6 px square of green in the middle of the red box's pixels.
+    long su = 0, sv = 0, n = 0;
+    for (int v = 0; v < in.cloud.height; ++v)
+        for (int u = 0; u < in.cloud.width; ++u)
+            if (in.truth[static_cast<std::size_t>(v) * in.cloud.width + u] == kTruthBox0) su += u, sv += v, ++n;
+    ASSERT_GT(n, 1000);
+    int painted = 0;
+    for (int v = static_cast<int>(sv / n) - 3; v < static_cast<int>(sv / n) + 3; ++v)
+        for (int u = static_cast<int>(su / n) - 3; u < static_cast<int>(su / n) + 3; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * in.cloud.width + u;
+            if (in.truth[p] != kTruthBox0) continue;
+            in.cloud.r[p] = 0; in.cloud.g[p] = 255; in.cloud.b[p] = 0;
+            ++painted;
+        }
+    ASSERT_GT(painted, 20);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    int a = 0, b = 0;
+    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(a, b) << "the sticker hid the contact between the boxes";
+    EXPECT_EQ(stats.color_splits, 1);
+}
