@@ -61,6 +61,18 @@ LabelImage segment(const Scene& s, Segmenter segmenter, std::vector<int>& truth,
     return segment(s, params, truth, stats);
 }
 
+/// Truth objects `ta` and `tb` each come out mostly as one object (shares over `share`), and
+/// as two different objects.
+void expect_separate(const LabelImage& out, const std::vector<int>& truth, int ta, int tb, double share,
+                     const char* what) {
+    int a = 0, b = 0;
+    EXPECT_GT(dominant_share(out.labels, truth, ta, &a), share);
+    EXPECT_GT(dominant_share(out.labels, truth, tb, &b), share);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(b, 0);
+    EXPECT_NE(a, b) << what;
+}
+
 }  // namespace
 
 TEST(SegmentParams, Validate_NamesTheFlag) {
@@ -418,12 +430,7 @@ TEST(SegmentObjects, FlushBoxesOfTwoHeights_SeparatedAcrossTheFold) {
     std::vector<int> truth;
     SegmentStats stats;
     const LabelImage hyb = segment(s, Segmenter::Hybrid, truth, &stats);
-    int a = 0, b = 0;
-    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0, &a), 0.9);
-    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0 + 1, &b), 0.9);
-    EXPECT_NE(a, 0);
-    EXPECT_NE(b, 0);
-    EXPECT_NE(a, b) << "the two boxes are one object";
+    expect_separate(hyb, truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the two boxes are one object");
 }
 
 // A flat box lying on a larger box of another colour, seen from above: the larger box's top
@@ -432,18 +439,9 @@ TEST(SegmentObjects, FlushBoxesOfTwoHeights_SeparatedAcrossTheFold) {
 // and the colour cue splits them (color_max_compact).
 TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
     Scene s = pitched_tabletop_scene();
-    SceneBox base;
-    base.z = 1.0f;
-    base.w = 0.26f;
-    base.h = 0.08f;
-    base.d = 0.24f;
-    base.r = 180; base.g = 150; base.b = 100;  // near the table's colour, as its feet are
-    SceneBox flat = base;
-    flat.w = 0.12f;
-    flat.d = 0.1f;
-    flat.h = 0.015f;
-    flat.lift = base.h;  // lying on the base box's top
-    flat.r = 40; flat.g = 90; flat.b = 200;
+    // The base near the table's colour, as its feet are; the flat box lying on its top.
+    const SceneBox base{.z = 1.0f, .w = 0.26f, .h = 0.08f, .d = 0.24f, .r = 180, .g = 150, .b = 100};
+    const SceneBox flat{.z = 1.0f, .w = 0.12f, .h = 0.015f, .d = 0.1f, .lift = base.h, .r = 40, .g = 90, .b = 200};
     s.boxes = {base, flat};
     std::vector<int> truth;
     const PlaneStage in = up_to_the_plane(s);
@@ -457,11 +455,7 @@ TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
 
     SegmentStats stats;
     const LabelImage two = segment(in, SegmentParams{}, &stats);
-    EXPECT_GT(dominant_share(two.labels, in.truth, kTruthBox0, &a), 0.9);
-    EXPECT_GT(dominant_share(two.labels, in.truth, kTruthBox0 + 1, &b), 0.8);
-    EXPECT_NE(a, 0);
-    EXPECT_NE(b, 0);
-    EXPECT_NE(a, b) << "the flat box was not split from the box it lies on";
+    expect_separate(two, in.truth, kTruthBox0, kTruthBox0 + 1, 0.8, "the flat box was not split from the box it lies on");
     EXPECT_EQ(stats.color_splits, 1);
 }
 
@@ -470,18 +464,9 @@ TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
 TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 9;
-    SceneBox left;
-    left.x = -0.12f;
-    left.z = 1.0f;
-    left.w = 0.12f;
-    left.r = 210; left.g = 40; left.b = 40;
-    SceneBox middle = left;
-    middle.x = 0.0f;
-    middle.r = 40; middle.g = 180; middle.b = 60;
-    SceneBox right = left;
-    right.x = 0.12f;
-    right.r = 40; right.g = 60; right.b = 220;
-    s.boxes = {left, middle, right};
+    s.boxes = {SceneBox{.x = -0.12f, .z = 1.0f, .w = 0.12f, .r = 210, .g = 40, .b = 40},
+               SceneBox{.x = 0.0f, .z = 1.0f, .w = 0.12f, .r = 40, .g = 180, .b = 60},
+               SceneBox{.x = 0.12f, .z = 1.0f, .w = 0.12f, .r = 40, .g = 60, .b = 220}};
     std::vector<int> truth;
     SegmentStats stats;
     const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
@@ -504,14 +489,9 @@ TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
 TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 11;
-    SceneBox red;  // muted colours: the sticker is farther from each than they are apart
-    red.x = -0.075f;
-    red.z = 1.0f;
-    red.r = 190; red.g = 70; red.b = 60;
-    SceneBox blue = red;
-    blue.x = 0.075f;
-    blue.r = 60; blue.g = 80; blue.b = 190;
-    s.boxes = {red, blue};
+    // Muted colours: the sticker is farther from each than they are from each other.
+    s.boxes = {SceneBox{.x = -0.075f, .z = 1.0f, .r = 190, .g = 70, .b = 60},
+               SceneBox{.x = 0.075f, .z = 1.0f, .r = 60, .g = 80, .b = 190}};
     PlaneStage in = up_to_the_plane(s);
     // The sticker: a 6 x 6 px square of green in the middle of the red box's pixels.
     long su = 0, sv = 0, n = 0;
@@ -530,10 +510,6 @@ TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
     ASSERT_GT(painted, 20);
     SegmentStats stats;
     const LabelImage out = segment(in, SegmentParams{}, &stats);
-    int a = 0, b = 0;
-    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0, &a), 0.9);
-    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0 + 1, &b), 0.9);
-    EXPECT_NE(a, 0);
-    EXPECT_NE(a, b) << "the sticker hid the contact between the boxes";
+    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the sticker hid the contact between the boxes");
     EXPECT_EQ(stats.color_splits, 1);
 }
