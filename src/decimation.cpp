@@ -61,6 +61,10 @@ void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthR
     const std::uint8_t* const rgb = in.rgb;
 
     const float scale = in.depth_scale_m_per_unit;  // z = depth * scale, as back-projected
+    // Raw output pointers, taken once: through the vectors, each byte stored would make the
+    // compiler load them again.
+    std::uint16_t* const out_depth = out.depth.data.data();
+    std::uint8_t* const out_rgb = out.color.rgb.data();
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
@@ -80,9 +84,9 @@ void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthR
                     with_depth = true;
                 }
             const std::size_t o = static_cast<std::size_t>(v) * w + u;
-            out.depth.data[o] = depth[pick];
+            out_depth[o] = depth[pick];
             if (rgb)
-                for (int c = 0; c < 3; ++c) out.color.rgb[3 * o + c] = rgb[3 * pick + c];
+                for (int c = 0; c < 3; ++c) out_rgb[3 * o + c] = rgb[3 * pick + c];
         }
     }
 }
