@@ -32,6 +32,25 @@ const std::array<float, kWeights>& vote_weights() {
     return table;
 }
 
+/// A row of n input columns from its blocks: the `channels` values of block b over its
+/// columns b * factor ... b * factor + factor - 1 (the last block may be cut by n). The
+/// default factor 2 has its own loop, which the compiler vectorizes; others go one column
+/// of each block at a time (no division per column).
+template <int channels, class T>
+void widen_row(const T* blocks, int factor, int n, T* out) {
+    if (factor == 2) {
+        for (int b = 0; b < n / 2; ++b)
+            for (int c = 0; c < channels; ++c)
+                out[channels * 2 * b + c] = out[channels * (2 * b + 1) + c] = blocks[channels * b + c];
+        if (n % 2)
+            for (int c = 0; c < channels; ++c) out[channels * (n - 1) + c] = blocks[channels * (n / 2) + c];
+        return;
+    }
+    for (int k = 0; k < factor; ++k)
+        for (int b = 0, u = k; u < n; ++b, u += factor)
+            for (int c = 0; c < channels; ++c) out[channels * u + c] = blocks[channels * b + c];
+}
+
 }  // namespace
 
 void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthRange* range) {
@@ -255,14 +274,13 @@ void DecimatedSource::own_blocks_of_row(int v, const std::uint8_t* usable, const
     if (usable) usable += first_block;
     // Each block's depth, 0 where its pixels cannot take it as it is: no depth (no
     // surface), an edge block (searched) or not usable; into scratch's tail, then over the
-    // block's columns, one column of each block at a time (no division per column).
+    // block's columns.
     float* const per_block = scratch + W;
     for (int bu = 0; bu < w_; ++bu) {
         const bool as_is = !(edges && edges[bu]) && !(usable && !usable[bu]);
         per_block[bu] = as_is ? static_cast<float>(small[bu]) : 0.0f;
     }
-    for (int k = 0; k < factor; ++k)
-        for (int bu = 0, u = k; u < W; ++bu, u += factor) scratch[u] = per_block[bu];
+    widen_row<1>(per_block, factor, W, scratch);
     // same_surface and DepthRange::contains, with the same float operations: the same
     // answers. `&`, not `&&`: a branch per pixel would keep the loop from vectorizing.
     const std::uint16_t* const full = full_ + static_cast<std::size_t>(v) * W;
@@ -487,23 +505,13 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
         // Block row bv's results, each block's over its columns.
         auto widen = [=](int bv) {
             const std::size_t first = static_cast<std::size_t>(bv) * w;
-            for (int u = 0, bu = 0, in_block = 0; u < W; ++u) {
-                const std::size_t q = first + static_cast<std::size_t>(bu);
-                row_labels[u] = in_labels[q];
-                row_rgb[3 * u] = in_rgb[3 * q];
-                row_rgb[3 * u + 1] = in_rgb[3 * q + 1];
-                row_rgb[3 * u + 2] = in_rgb[3 * q + 2];
-                row_active[u] = in_active[q];
-                if (objects) {
-                    row_classes[u] = in_classes[q];
-                    row_segments[u] = in_segments[q];
-                    row_objects[u] = in_objects[q];
-                }
-                if (++in_block == factor) {
-                    in_block = 0;
-                    ++bu;
-                }
-            }
+            widen_row<1>(in_labels + first, factor, W, row_labels);
+            widen_row<3>(in_rgb + 3 * first, factor, W, row_rgb);
+            widen_row<1>(in_active + first, factor, W, row_active);
+            if (!objects) return;
+            widen_row<1>(in_classes + first, factor, W, row_classes);
+            widen_row<1>(in_segments + first, factor, W, row_segments);
+            widen_row<1>(in_objects + first, factor, W, row_objects);
         };
         float* const scratch = block_row.scratch.data();
         std::uint8_t* const takes_own = block_row.takes_own.data();
