@@ -554,15 +554,18 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
             for (std::size_t u = 0; u < n_row; ++u) in_row += active_out[row + u];
             active += in_row;
             if (!objects) continue;
-            // Each run of one object id adds to its box at once; rows without one are
-            // told apart first, by a loop that vectorizes.
+            // Each run of one object id adds to its box at once. The runs' starts are found
+            // by memchr in a flag per column (0: a run starts), set by a loop that
+            // vectorizes; takes_own is free again to hold them.
             const std::uint16_t* const ids = objects_out + row;
-            std::uint16_t any_id = 0;
-            for (int u = 0; u < W; ++u) any_id |= ids[u];
-            for (int u = 0; u < W && any_id != 0;) {
+            std::uint8_t* const continues = takes_own;
+            continues[0] = 0;
+            for (int u = 1; u < W; ++u) continues[u] = ids[u] == ids[u - 1];
+            for (int u = 0; u < W;) {
+                const auto* const next = static_cast<const std::uint8_t*>(
+                    std::memchr(continues + u + 1, 0, static_cast<std::size_t>(W - u - 1)));
+                const int run_end = next ? static_cast<int>(next - continues) : W;
                 const std::uint16_t id = ids[u];
-                int run_end = u + 1;
-                while (run_end < W && ids[run_end] == id) ++run_end;
                 if (id != 0 && id <= max_id && object_index[id] >= 0)
                     boxes[object_index[id]].add_run(u, run_end - 1, v);
                 u = run_end;
