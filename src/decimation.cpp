@@ -84,21 +84,25 @@ void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthR
     // compiler load them again.
     std::uint16_t* const out_depth = out.depth.data.data();
     std::uint8_t* const out_rgb = out.color.rgb.data();
+    // The range's limits as locals, for the same reason; none: every depth is in range.
+    const DepthRange all{-std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
+    const DepthRange limits = range ? *range : all;
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
         for (int u = 0; u < w; ++u) {
             // The block's first pixel in range, row-major; else its first with depth; else
-            // its top-left one.
+            // its top-left one. Mostly the top-left one is in range: the search is skipped.
             const std::size_t top_left = static_cast<std::size_t>(v) * factor * W + static_cast<std::size_t>(u) * factor;
             std::size_t pick = top_left;
+            bool in_range = depth[top_left] != 0 && limits.contains(static_cast<float>(depth[top_left]) * scale);
             const int rows = std::min(factor, H - v * factor), cols = std::min(factor, W - u * factor);
-            bool with_depth = false, in_range = false;
+            bool with_depth = false;
             for (int dv = 0; dv < rows && !in_range; ++dv)
                 for (int du = 0; du < cols && !in_range; ++du) {
                     const std::size_t q = top_left + static_cast<std::size_t>(dv) * W + du;
                     if (depth[q] == 0) continue;
-                    in_range = !range || range->contains(static_cast<float>(depth[q]) * scale);
+                    in_range = limits.contains(static_cast<float>(depth[q]) * scale);
                     if (in_range || !with_depth) pick = q;
                     with_depth = true;
                 }
