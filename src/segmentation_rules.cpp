@@ -735,7 +735,19 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
         }
     };
-    for (int v = fe.top; v < fe.bottom; ++v)
+    // A row without a label whose next row has none either adds nothing (every pair in it
+    // and down from it joins two unlabelled pixels): told by a loop that vectorizes, and
+    // skipped. Mostly the rows above and below the objects.
+    auto row_has_label = [&](int v) {
+        int any = 0;
+        for (int u = fe.left; u < fe.right; ++u) any |= label[static_cast<std::size_t>(v) * W + u];
+        return any != 0;
+    };
+    bool next_has_label = fe.top < fe.bottom && row_has_label(fe.top);
+    for (int v = fe.top; v < fe.bottom; ++v) {
+        const bool has_label = next_has_label;
+        next_has_label = v + 1 < fe.bottom && row_has_label(v + 1);
+        if (!has_label && !next_has_label) continue;
         for (int u = fe.left; u < fe.right; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if (const int l = label[p]) {
@@ -759,6 +771,7 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             if (u + 1 < fe.right) pair(p, p + 1);
             if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
         }
+    }
     std::sort(ws.edges.begin(), ws.edges.end());
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
 }
