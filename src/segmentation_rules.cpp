@@ -467,6 +467,9 @@ void two_means(const float* const* planes, int m, std::uint8_t* side, float (&ce
             const int i1 = std::min(m, i0 + kBlock);
             float block[6] = {};
             int block_ones = 0, block_changed = 0;
+            // The sides first, in a loop that vectorizes (one pixel per lane, each dot in
+            // the same order); then the sums, pixel after pixel as before (a float sum
+            // reordered would round otherwise).
             for (int i = i0; i < i1; ++i) {
                 float dot = 0;
                 for (int q = 0; q < 6; ++q) dot += w[q] * f[q][i];
@@ -474,7 +477,9 @@ void two_means(const float* const* planes, int m, std::uint8_t* side, float (&ce
                 block_changed += j != side[i];
                 side[i] = j;
                 block_ones += j;
-                const float mask = j;
+            }
+            for (int i = i0; i < i1; ++i) {
+                const float mask = side[i];
                 for (int q = 0; q < 6; ++q) block[q] += mask * f[q][i];
             }
             for (int q = 0; q < 6; ++q) sum1[q] += block[q];
