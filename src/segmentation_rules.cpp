@@ -28,7 +28,13 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
     const auto& label = ws.label;
     ws.steps.clear();
     ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
-    for (int v = 0; v < H; ++v)
+    for (int v = 0; v < H; ++v) {
+        // Only labelled pixels add anything: a row without one is told by an OR over it (a
+        // loop that vectorizes) and skipped.
+        const int* const row = label.data() + static_cast<std::size_t>(v) * W;
+        int any = 0;
+        for (int u = 0; u < W; ++u) any |= row[u];
+        if (any == 0) continue;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int a = label[p];
@@ -49,6 +55,7 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
                 ws.steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
             }
         }
+    }
     std::sort(ws.steps.begin(), ws.steps.end(),
               [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
 }
