@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "param_check.hpp"
@@ -29,6 +30,25 @@ const std::array<float, kWeights>& vote_weights() {
         return t;
     }();
     return table;
+}
+
+/// A row of n input columns from its blocks: the `channels` values of block b over its
+/// columns b * factor ... b * factor + factor - 1 (the last block may be cut by n). The
+/// default factor 2 has its own loop, which the compiler vectorizes; others go one column
+/// of each block at a time (no division per column).
+template <int channels, class T>
+void widen_row(const T* blocks, int factor, int n, T* out) {
+    if (factor == 2) {
+        for (int b = 0; b < n / 2; ++b)
+            for (int c = 0; c < channels; ++c)
+                out[channels * 2 * b + c] = out[channels * (2 * b + 1) + c] = blocks[channels * b + c];
+        if (n % 2)
+            for (int c = 0; c < channels; ++c) out[channels * (n - 1) + c] = blocks[channels * (n / 2) + c];
+        return;
+    }
+    for (int k = 0; k < factor; ++k)
+        for (int b = 0, u = k; u < n; ++b, u += factor)
+            for (int c = 0; c < channels; ++c) out[channels * u + c] = blocks[channels * b + c];
 }
 
 }  // namespace
@@ -60,28 +80,36 @@ void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthR
     const std::uint8_t* const rgb = in.rgb;
 
     const float scale = in.depth_scale_m_per_unit;  // z = depth * scale, as back-projected
+    // Raw output pointers, taken once: through the vectors, each byte stored would make the
+    // compiler load them again.
+    std::uint16_t* const out_depth = out.depth.data.data();
+    std::uint8_t* const out_rgb = out.color.rgb.data();
+    // The range's limits as locals, for the same reason; none: every depth is in range.
+    const DepthRange all{-std::numeric_limits<float>::infinity(), std::numeric_limits<float>::infinity()};
+    const DepthRange limits = range ? *range : all;
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < h; ++v) {
         for (int u = 0; u < w; ++u) {
             // The block's first pixel in range, row-major; else its first with depth; else
-            // its top-left one.
+            // its top-left one. Mostly the top-left one is in range: the search is skipped.
             const std::size_t top_left = static_cast<std::size_t>(v) * factor * W + static_cast<std::size_t>(u) * factor;
             std::size_t pick = top_left;
+            bool in_range = depth[top_left] != 0 && limits.contains(static_cast<float>(depth[top_left]) * scale);
             const int rows = std::min(factor, H - v * factor), cols = std::min(factor, W - u * factor);
-            bool with_depth = false, in_range = false;
+            bool with_depth = false;
             for (int dv = 0; dv < rows && !in_range; ++dv)
                 for (int du = 0; du < cols && !in_range; ++du) {
                     const std::size_t q = top_left + static_cast<std::size_t>(dv) * W + du;
                     if (depth[q] == 0) continue;
-                    in_range = !range || range->contains(static_cast<float>(depth[q]) * scale);
+                    in_range = limits.contains(static_cast<float>(depth[q]) * scale);
                     if (in_range || !with_depth) pick = q;
                     with_depth = true;
                 }
             const std::size_t o = static_cast<std::size_t>(v) * w + u;
-            out.depth.data[o] = depth[pick];
+            out_depth[o] = depth[pick];
             if (rgb)
-                for (int c = 0; c < 3; ++c) out.color.rgb[3 * o + c] = rgb[3 * pick + c];
+                for (int c = 0; c < 3; ++c) out_rgb[3 * o + c] = rgb[3 * pick + c];
         }
     }
 }
@@ -106,7 +134,8 @@ DecimatedSource::DecimatedSource(const std::uint16_t* input, int width, int heig
       factor_(factor),
       // Depths compared in the images' units: metres = units * scale.
       same_(same_m / scale_m_per_unit),
-      same_rel_(same_rel * scale_m_per_unit) {
+      same_rel_(same_rel * scale_m_per_unit),
+      scale_(scale_m_per_unit) {
     if (factor < 1 || w_ != (W_ + factor - 1) / factor ||
         h_ != (H_ + factor - 1) / factor ||
         decimated.data.size() != static_cast<std::size_t>(w_) * h_)
@@ -236,6 +265,36 @@ std::int32_t DecimatedSource::nearest_in_depth(int bu, int bv, float z, const st
     return best;
 }
 
+void DecimatedSource::own_blocks_of_row(int v, const std::uint8_t* usable, const DepthRange* range,
+                                        float* scratch, std::uint8_t* takes_own) const {
+    // Locals: members read after each byte stored could have changed (char aliasing).
+    const int factor = factor_, W = W_;
+    const float same = same_, same_rel = same_rel_, scale = scale_;
+    const float zmin = range ? range->zmin_m : -std::numeric_limits<float>::infinity();
+    const float zmax = range ? range->zmax_m : std::numeric_limits<float>::infinity();
+    const std::size_t first_block = static_cast<std::size_t>(v / factor) * w_;
+    const std::uint16_t* const small = small_ + first_block;
+    const std::uint8_t* const edges = edges_ ? edges_ + first_block : nullptr;
+    if (usable) usable += first_block;
+    // Each block's depth, 0 where its pixels cannot take it as it is: no depth (no
+    // surface), an edge block (searched) or not usable; into scratch's tail, then over the
+    // block's columns.
+    float* const per_block = scratch + W;
+    for (int bu = 0; bu < w_; ++bu) {
+        const bool as_is = !(edges && edges[bu]) && !(usable && !usable[bu]);
+        per_block[bu] = as_is ? static_cast<float>(small[bu]) : 0.0f;
+    }
+    widen_row<1>(per_block, factor, W, scratch);
+    // same_surface and DepthRange::contains, with the same float operations: the same
+    // answers. `&`, not `&&`: a branch per pixel would keep the loop from vectorizing.
+    const std::uint16_t* const full = full_ + static_cast<std::size_t>(v) * W;
+    for (int u = 0; u < W; ++u) {
+        const float z = full[u], block = scratch[u], metres = z * scale;
+        takes_own[u] = (z != 0) & (block != 0) & (std::fabs(block - z) <= same + same_rel * z * z) &
+                       (metres >= zmin) & (metres <= zmax);
+    }
+}
+
 // ---- the way back: expand_result --------------------------------------------------------
 
 /// expand_result's scratch: track id -> object_list index, and per row band the active pixels
@@ -245,11 +304,12 @@ struct ExpandWorkspace::Buffers {
     struct Box {
         int u_min, v_min, u_max, v_max;
         std::size_t pixels;
-        void add(int u, int v) {
-            ++pixels;
-            u_min = std::min(u_min, u);
+        /// Pixels u_first..u_last of row v.
+        void add_run(int u_first, int u_last, int v) {
+            pixels += static_cast<std::size_t>(u_last - u_first + 1);
+            u_min = std::min(u_min, u_first);
             v_min = std::min(v_min, v);
-            u_max = std::max(u_max, u);
+            u_max = std::max(u_max, u_last);
             v_max = std::max(v_max, v);
         }
         void merge(const Box& o) {
@@ -268,6 +328,16 @@ struct ExpandWorkspace::Buffers {
     std::vector<std::uint8_t> edge_blocks;        ///< decimated pixels at an object's outline
     std::vector<std::uint16_t> edge_lo, edge_hi;  ///< their 3-wide row minima and maxima
     std::vector<std::int32_t> block_source;       ///< each edge block's source after the colour vote
+    /// One block row's results repeated over the input's columns (each block's over its
+    /// factor columns): each input row of the block row starts as a copy of it. One per band.
+    struct BlockRow {
+        int bv = -1;  ///< the block row it holds
+        std::vector<std::uint16_t> labels, segments, objects;
+        std::vector<std::uint8_t> rgb, active, classes;
+        std::vector<float> scratch;           ///< own_blocks_of_row's (W + w)
+        std::vector<std::uint8_t> takes_own;  ///< own_blocks_of_row's
+    };
+    std::vector<BlockRow> band_rows;
 };
 
 ExpandWorkspace::ExpandWorkspace() : b_(std::make_unique<Buffers>()) {}
@@ -362,9 +432,25 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
     const std::size_t n_obj = r.object_list.size();
     buf.band_boxes.assign(ExpandWorkspace::Buffers::kBands * n_obj, ExpandWorkspace::Buffers::Box{W, H, -1, -1, 0});
     buf.band_active.assign(ExpandWorkspace::Buffers::kBands, 0);
+    buf.band_rows.resize(ExpandWorkspace::Buffers::kBands);
+    for (ExpandWorkspace::Buffers::BlockRow& b : buf.band_rows) {
+        const auto n_row = static_cast<std::size_t>(W);
+        b.bv = -1;  // a new frame: no block row held
+        b.labels.resize(n_row);
+        b.segments.resize(objects ? n_row : 0);
+        b.objects.resize(objects ? n_row : 0);
+        b.rgb.resize(3 * n_row);
+        b.active.resize(n_row);
+        b.classes.resize(objects ? n_row : 0);
+        b.scratch.resize(n_row + static_cast<std::size_t>(w));
+        b.takes_own.resize(n_row);
+    }
 
-    // One pass: every result of the pixel's source, or "no point" without one; the counts
-    // and boxes per fixed row band, reduced in band order below.
+    // Per row: first every pixel from its own block (nearly every pixel's source: a plain
+    // copy of the block row, each block's results loaded once), then the pixels whose source
+    // is another block or none (no depth, off their block's surface, at an outline, out of
+    // the range or on a block out of it) written again; last the row's counts and boxes.
+    // Counts and boxes per fixed row band, reduced in band order below.
     // Raw pointers: through the vectors, every byte store would make the compiler reload
     // every data pointer.
     const std::uint8_t* const frame_rgb = frame.has_color() && frame.color_matches() ? frame.rgb : nullptr;
@@ -384,15 +470,80 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
     const float scale = frame.depth_scale_m_per_unit;
     const DepthRange& range = params.range;
     const std::uint16_t* const depth = frame.depth;
+    const int factor = source.factor();
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < ExpandWorkspace::Buffers::kBands; ++band) {
         ExpandWorkspace::Buffers::Box* const boxes = buf.band_boxes.data() + static_cast<std::size_t>(band) * n_obj;
+        ExpandWorkspace::Buffers::BlockRow& block_row = buf.band_rows[static_cast<std::size_t>(band)];
         std::size_t active = 0;
+        // Pixel p's results from block q, or "no point" for q < 0. The pointers copied into
+        // the thread's own closure: read through the shared ones, each would be loaded again
+        // after every byte stored.
+        auto take = [=](std::size_t p, std::int32_t q) {
+            std::uint8_t* const rgb = colors + 3 * p;
+            if (q < 0) {
+                labels[p] = 0;
+                rgb[0] = rgb[1] = rgb[2] = frame_rgb ? dimmed_grey(frame_rgb + 3 * p) : 0;
+                active_out[p] = 0;
+                if (!objects) return;
+                classes[p] = kPlaneRemoved;
+                segments[p] = 0;
+                objects_out[p] = 0;
+                return;
+            }
+            const auto sq = static_cast<std::size_t>(q);
+            labels[p] = in_labels[sq];
+            rgb[0] = in_rgb[3 * sq];
+            rgb[1] = in_rgb[3 * sq + 1];
+            rgb[2] = in_rgb[3 * sq + 2];
+            active_out[p] = in_active[sq];
+            if (!objects) return;
+            classes[p] = in_classes[sq];
+            segments[p] = in_segments[sq];
+            objects_out[p] = in_objects[sq];
+        };
+        std::uint16_t *const row_labels = block_row.labels.data(), *const row_segments = block_row.segments.data(),
+                      *const row_objects = block_row.objects.data();
+        std::uint8_t *const row_rgb = block_row.rgb.data(), *const row_active = block_row.active.data(),
+                     *const row_classes = block_row.classes.data();
+        // Block row bv's results, each block's over its columns.
+        auto widen = [=](int bv) {
+            const std::size_t first = static_cast<std::size_t>(bv) * w;
+            widen_row<1>(in_labels + first, factor, W, row_labels);
+            widen_row<3>(in_rgb + 3 * first, factor, W, row_rgb);
+            widen_row<1>(in_active + first, factor, W, row_active);
+            if (!objects) return;
+            widen_row<1>(in_classes + first, factor, W, row_classes);
+            widen_row<1>(in_segments + first, factor, W, row_segments);
+            widen_row<1>(in_objects + first, factor, W, row_objects);
+        };
+        float* const scratch = block_row.scratch.data();
+        std::uint8_t* const takes_own = block_row.takes_own.data();
         for (int v = band * H / ExpandWorkspace::Buffers::kBands; v < (band + 1) * H / ExpandWorkspace::Buffers::kBands; ++v) {
-            const int bv = v / source.factor();
-            for (int u = 0, bu = 0, in_block = 0; u < W; ++u) {
-                const std::size_t p = static_cast<std::size_t>(v) * W + u;
-                std::uint8_t* const rgb = colors + 3 * p;
+            const int bv = v / factor;
+            const std::size_t row = static_cast<std::size_t>(v) * W;
+            // First every pixel from its own block, copied from the block row.
+            if (block_row.bv != bv) {
+                widen(bv);
+                block_row.bv = bv;
+            }
+            const auto n_row = static_cast<std::size_t>(W);
+            std::copy_n(row_labels, n_row, labels + row);
+            std::copy_n(row_rgb, 3 * n_row, colors + 3 * row);
+            std::copy_n(row_active, n_row, active_out + row);
+            if (objects) {
+                std::copy_n(row_classes, n_row, classes + row);
+                std::copy_n(row_segments, n_row, segments + row);
+                std::copy_n(row_objects, n_row, objects_out + row);
+            }
+            // Then the pixels that do not take their own block as it is (off its surface, out
+            // of range, on a block out of it, or at an outline), one by one.
+            source.own_blocks_of_row(v, in_active, &range, scratch, takes_own);
+            const std::uint8_t* const end = takes_own + W;
+            for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(takes_own, 0, n_row)); at != nullptr;
+                 at = static_cast<const std::uint8_t*>(std::memchr(at + 1, 0, static_cast<std::size_t>(end - at - 1)))) {
+                const int u = static_cast<int>(at - takes_own), bu = u / factor;
+                const std::size_t p = row + static_cast<std::size_t>(u);
                 std::int32_t q = source.in_block(u, v, bu, bv);
                 if (q >= 0) {
                     if (!range.contains(static_cast<float>(depth[p]) * scale))
@@ -400,32 +551,28 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
                     else if (!in_active[q])
                         q = source.nearest_in_depth(bu, bv, depth[p], in_active);
                 }
-                if (++in_block == source.factor()) {
-                    in_block = 0;
-                    ++bu;
-                }
-                if (q < 0) {
-                    labels[p] = 0;
-                    rgb[0] = rgb[1] = rgb[2] = frame_rgb ? dimmed_grey(frame_rgb + 3 * p) : 0;
-                    active_out[p] = 0;
-                    if (!objects) continue;
-                    classes[p] = kPlaneRemoved;
-                    segments[p] = 0;
-                    objects_out[p] = 0;
-                    continue;
-                }
-                const auto sq = static_cast<std::size_t>(q);
-                labels[p] = in_labels[sq];
-                rgb[0] = in_rgb[3 * sq];
-                rgb[1] = in_rgb[3 * sq + 1];
-                rgb[2] = in_rgb[3 * sq + 2];
-                active += active_out[p] = in_active[sq];
-                if (!objects) continue;
-                classes[p] = in_classes[sq];
-                segments[p] = in_segments[sq];
-                const std::uint16_t id = objects_out[p] = in_objects[sq];
-                if (id == 0 || id > max_id || object_index[id] < 0) continue;
-                boxes[object_index[id]].add(u, v);
+                take(p, q);
+            }
+            // Last the row's counts. A row's count fits in 32 bits, which sum faster.
+            unsigned in_row = 0;
+            for (std::size_t u = 0; u < n_row; ++u) in_row += active_out[row + u];
+            active += in_row;
+            if (!objects) continue;
+            // Each run of one object id adds to its box at once. The runs' starts are found
+            // by memchr in a flag per column (0: a run starts), set by a loop that
+            // vectorizes; takes_own is free again to hold them.
+            const std::uint16_t* const ids = objects_out + row;
+            std::uint8_t* const continues = takes_own;
+            continues[0] = 0;
+            for (int u = 1; u < W; ++u) continues[u] = ids[u] == ids[u - 1];
+            for (int u = 0; u < W;) {
+                const auto* const next = static_cast<const std::uint8_t*>(
+                    std::memchr(continues + u + 1, 0, static_cast<std::size_t>(W - u - 1)));
+                const int run_end = next ? static_cast<int>(next - continues) : W;
+                const std::uint16_t id = ids[u];
+                if (id != 0 && id <= max_id && object_index[id] >= 0)
+                    boxes[object_index[id]].add_run(u, run_end - 1, v);
+                u = run_end;
             }
         }
         buf.band_active[static_cast<std::size_t>(band)] = active;

@@ -518,6 +518,14 @@ std::size_t ObjectTracker::write_labels_and_extents(const OrganizedCloud& cloud,
     band_extents_.assign(kBands * O * kExt, 0.0f);
     band_cluster_count_.assign(kBands * O * C1, 0);
     band_segment_seen_.assign(kBands * O * S1, 0);
+    // Raw pointers, as in mark_surface_changes: the byte stores (labels' high bytes aside,
+    // `seen`) would make the compiler reload every vector's data pointer on each pixel.
+    const std::uint8_t* const slot_of = slot_of_.data();
+    const int* const object_of_slot = object_of_slot_.data();
+    std::uint16_t* const labels_out = objects.labels.data();
+    const float *const cx = cloud.x.data(), *const cy = cloud.y.data(), *const cz = cloud.z.data();
+    const std::uint16_t* const cluster_of = clusters.labels.empty() ? nullptr : clusters.labels.data();
+    const std::uint16_t* const segment_of = segments.labels.data();
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kBands; ++band) {
         float* const ext = band_extents_.data() + static_cast<std::size_t>(band) * O * kExt;
@@ -531,15 +539,15 @@ std::size_t ObjectTracker::write_labels_and_extents(const OrganizedCloud& cloud,
         const std::size_t p0 = static_cast<std::size_t>(H * band / kBands) * W;
         const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kBands) * W;
         for (std::size_t p = p0; p < p1; ++p) {
-            const int i = slot_of_[p] ? object_of_slot_[slot_of_[p] - 1u] : -1;
+            const int i = slot_of[p] ? object_of_slot[slot_of[p] - 1u] : -1;
             if (i < 0) {
-                objects.labels[p] = 0;
+                labels_out[p] = 0;
                 continue;
             }
             const DetectedObject& d = out[static_cast<std::size_t>(i)];
-            objects.labels[p] = static_cast<std::uint16_t>(std::min(d.id, 65535));
+            labels_out[p] = static_cast<std::uint16_t>(std::min(d.id, 65535));
             float* e = ext + static_cast<std::size_t>(i) * kExt;
-            const float pt[3] = {cloud.x[p], cloud.y[p], cloud.z[p]};
+            const float pt[3] = {cx[p], cy[p], cz[p]};
             for (int a = 0; a < 3; ++a) {
                 const float* ax = d.obb_axes.data() + 3 * a;
                 const float t = ax[0] * (pt[0] - d.centroid[0]) + ax[1] * (pt[1] - d.centroid[1]) + ax[2] * (pt[2] - d.centroid[2]);
@@ -548,8 +556,8 @@ std::size_t ObjectTracker::write_labels_and_extents(const OrganizedCloud& cloud,
                 e[a + 3] = std::min(e[a + 3], t);
                 e[a + 9] = std::max(e[a + 9], t);
             }
-            if (!clusters.labels.empty()) ++ccount[static_cast<std::size_t>(i) * C1 + clusters.labels[p]];
-            seen[static_cast<std::size_t>(i) * S1 + segments.labels[p]] = 1;
+            if (cluster_of) ++ccount[static_cast<std::size_t>(i) * C1 + cluster_of[p]];
+            seen[static_cast<std::size_t>(i) * S1 + segment_of[p]] = 1;
         }
     }
     return C1;

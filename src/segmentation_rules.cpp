@@ -28,7 +28,13 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
     const auto& label = ws.label;
     ws.steps.clear();
     ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
-    for (int v = 0; v < H; ++v)
+    for (int v = 0; v < H; ++v) {
+        // Only labelled pixels add anything: a row without one is told by an OR over it (a
+        // loop that vectorizes) and skipped.
+        const int* const row = label.data() + static_cast<std::size_t>(v) * W;
+        int any = 0;
+        for (int u = 0; u < W; ++u) any |= row[u];
+        if (any == 0) continue;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int a = label[p];
@@ -49,6 +55,7 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
                 ws.steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
             }
         }
+    }
     std::sort(ws.steps.begin(), ws.steps.end(),
               [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
 }
@@ -499,6 +506,9 @@ void two_means(const float* const* planes, int m, std::uint8_t* side, float (&ce
             const int i1 = std::min(m, i0 + kBlock);
             float block[6] = {};
             int block_ones = 0, block_changed = 0;
+            // The sides first, in a loop that vectorizes (one pixel per lane, each dot in
+            // the same order); then the sums, pixel after pixel as before (a float sum
+            // reordered would round otherwise).
             for (int i = i0; i < i1; ++i) {
                 float dot = 0;
                 for (int q = 0; q < 6; ++q) dot += w[q] * f[q][i];
@@ -506,7 +516,9 @@ void two_means(const float* const* planes, int m, std::uint8_t* side, float (&ce
                 block_changed += j != side[i];
                 side[i] = j;
                 block_ones += j;
-                const float mask = j;
+            }
+            for (int i = i0; i < i1; ++i) {
+                const float mask = side[i];
                 for (int q = 0; q < 6; ++q) block[q] += mask * f[q][i];
             }
             for (int q = 0; q < 6; ++q) sum1[q] += block[q];
@@ -790,7 +802,19 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
         }
     };
-    for (int v = fe.top; v < fe.bottom; ++v)
+    // A row without a label whose next row has none either adds nothing (every pair in it
+    // and down from it joins two unlabelled pixels): told by a loop that vectorizes, and
+    // skipped. Mostly the rows above and below the objects.
+    auto row_has_label = [&](int v) {
+        int any = 0;
+        for (int u = fe.left; u < fe.right; ++u) any |= label[static_cast<std::size_t>(v) * W + u];
+        return any != 0;
+    };
+    bool next_has_label = fe.top < fe.bottom && row_has_label(fe.top);
+    for (int v = fe.top; v < fe.bottom; ++v) {
+        const bool has_label = next_has_label;
+        next_has_label = v + 1 < fe.bottom && row_has_label(v + 1);
+        if (!has_label && !next_has_label) continue;
         for (int u = fe.left; u < fe.right; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if (const int l = label[p]) {
@@ -814,6 +838,7 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             if (u + 1 < fe.right) pair(p, p + 1);
             if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
         }
+    }
     std::sort(ws.edges.begin(), ws.edges.end());
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
 }

@@ -64,22 +64,29 @@ void render_weight_colors(const ClusterState& state, const LabelImage& labels,
     const bool grey_ok = frame.has_color() && frame.color_width == W && frame.color_height == H;
     const std::uint8_t* rgb = grey_ok ? frame.rgb : nullptr;
 
+    // Raw pointers, read once: through the vectors and the state, each byte stored would
+    // make the compiler load them again.
+    const std::uint16_t* const label = labels.labels.data();
+    std::uint8_t* const out_rgb = out.rgb.data();
+    const float* const colour = C.data();
+    const PixelWeights* const weights =
+        state.grid_width() > 0 && state.grid_height() > 0 ? &state.weights(0) : nullptr;
+    const int stride = state.params().stride;
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
         const int grid_row = state.grid_index(0, v);
-        const int stride = state.params().stride;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            std::uint8_t* o = out.rgb.data() + 3 * p;
-            if (labels.labels[p] != 0) {
+            std::uint8_t* o = out_rgb + 3 * p;
+            if (label[p] != 0) {
                 // Paper eq. (9): C_p = sum_j C_j mu_j, over the kept weights (the others
                 // are 0 or negligible, see PixelWeights).
-                const PixelWeights& w = state.weights(grid_row + (stride == 1 ? u : u / stride));
+                const PixelWeights& w = weights[grid_row + (stride == 1 ? u : u / stride)];
                 float acc[3] = {0, 0, 0};
                 for (int s = 0; s < PixelWeights::kSlots; ++s) {
                     if (w.mu[s] == 0) continue;  // most slots of a still scene are empty
                     const float m = static_cast<float>(w.mu[s]);
-                    const float* c = &C[3 * w.cluster[s]];
+                    const float* c = colour + 3 * w.cluster[s];
                     acc[0] += c[0] * m;
                     acc[1] += c[1] * m;
                     acc[2] += c[2] * m;

@@ -99,6 +99,14 @@ public:
     /// per block, when given), the one nearest to depth z (the image's units), or -1: a
     /// first-found on ties, rows top to bottom.
     std::int32_t nearest_in_depth(int bu, int bv, float z, const std::uint8_t* among) const;
+    /// Input row v at once: takes_own[u] = 1 where in_block(u, v, u / factor, v / factor) is
+    /// the pixel's own block, `usable` (one flag per block; nullptr: every block) holds for
+    /// that block and, with `range`, the pixel's depth in metres is in it; else 0. `scratch`
+    /// holds a float per input column and per block column (W + w). The test of in_block
+    /// without its branches (loops that vectorize), for callers that handle the other pixels
+    /// one by one.
+    void own_blocks_of_row(int v, const std::uint8_t* usable, const DepthRange* range,
+                           float* scratch, std::uint8_t* takes_own) const;
 
 private:
     bool same_surface(std::int32_t q, float z) const {
@@ -113,6 +121,7 @@ private:
     const std::uint16_t* small_;
     int W_, H_, w_, h_, factor_;
     float same_, same_rel_;  ///< in the depth images' units
+    float scale_;            ///< metres per depth unit
     const std::uint8_t* rgb_ = nullptr;        ///< input colour, with use_colour_at_edges
     const std::uint8_t* small_rgb_ = nullptr;  ///< decimated colour
     const std::uint8_t* edges_ = nullptr;      ///< edge blocks
