@@ -398,8 +398,8 @@ ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWor
 }
 
 /// The segments of this round (ws.to_try) large enough to split (2 x min_points), largest
-/// first, into ws.by_size: tried
-/// in parallel, no thread is left with a big one at the end. Cost: O(n log n).
+/// first, into ws.by_size: tried in parallel, no thread is left with a big one at the end.
+/// Cost: O(n log n).
 void order_by_size(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
     ws.by_size.clear();
     for (int l = 1; l <= n; ++l)
