@@ -166,7 +166,7 @@ struct SegmentWorkspace {
 /// What segmentation did, as data.
 struct SegmentStats {
     int segments = 0;      ///< objects written to `out`
-    int color_splits = 0;  ///< segments the colour cue split
+    int color_splits = 0;  ///< splits the colour cue made, both rounds (each adds a segment)
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim
     std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
