@@ -25,9 +25,12 @@ struct Ctx {
     const std::vector<std::uint8_t>& cls;
     int W, H;
 
+    /// The largest depth step between neighbours on one surface at depth z, metres: the
+    /// sensor's noise, which grows with z^2.
+    float depth_step(float z) const { return prm.depth_jump_m + prm.depth_jump_rel * z * z; }
     bool connected(std::size_t p, std::size_t q, float steps = 1.0f) const {
         const float z = c.z[p];
-        return std::fabs(z - c.z[q]) <= steps * (prm.depth_jump_m + prm.depth_jump_rel * z * z);
+        return std::fabs(z - c.z[q]) <= steps * depth_step(z);
     }
     /// Paper-free LCCP test between two surface points: concave when the normals face
     /// each other across the step, (n_p - n_q) . (X_q - X_p) > 0.

@@ -742,12 +742,11 @@ FrameEdge find_frame_edge(const Ctx& x) {
 /// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
 /// table's near edge, is still on the table. Cost: one pass over the pixels.
 float support_middle_depth(const Ctx& x, const Plane& pl) {
-    const SegmentParams& prm = x.prm;
     double table_z = 0, table_n = 0;
     for (std::size_t p = 0; p < x.c.size(); ++p) {
         if (!x.c.valid[p] || x.cls[p] != kPlaneRemoved) continue;
         const float z = x.c.z[p];
-        if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p])) > prm.depth_jump_m + prm.depth_jump_rel * z * z)
+        if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p])) > x.depth_step(z))
             continue;
         table_z += z;
         table_n += 1;
@@ -785,7 +784,7 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     auto beyond = [&](std::size_t q, std::size_t p) {
         if (!x.c.valid[q] || x.cls[q] != kPlaneRemoved || !x.connected(p, q)) return false;
         const float z = x.c.z[q];
-        return height(q) > prm.depth_jump_m + prm.depth_jump_rel * z * z;
+        return height(q) > x.depth_step(z);
     };
     // Outline pairs: touching segment pairs, and the pairs that lead out of the volume.
     auto pair = [&](std::size_t p, std::size_t q) {
@@ -880,7 +879,7 @@ bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, std:
     if (fu < 0 || fu >= W || fv < 0 || fv >= x.H) return true;
     const auto f = static_cast<std::size_t>(fv) * W + static_cast<std::size_t>(fu);
     if (!x.c.valid[f]) return true;
-    return x.c.z[f] < fzw - (x.prm.depth_jump_m + x.prm.depth_jump_rel * fzw * fzw);
+    return x.c.z[f] < fzw - x.depth_step(fzw);
 }
 
 /// ws.scope_keep per segment, from measure_scope's counts: bit 0 inside the volume, bit 1
