@@ -19,7 +19,9 @@ Generated scenes are written once to WORK/gen_A-B and reused. RUN_FLAGS after `-
 `wul3d run` (an ablation: `eval/benchmark.py -- --scope scene`).
 """
 import argparse
+import json
 import pathlib
+import re
 import subprocess
 import sys
 import time
@@ -54,7 +56,10 @@ def generate(work, seeds):
     folder = work / f"gen_{seeds}"
     a, _, b = seeds.partition("-")
     n = int(b or a) - int(a) + 1
-    if folder.is_dir() and len([p for p in folder.iterdir() if p.is_dir()]) == n:
+    # Reused only when scenegen.py wrote all of it at its present version.
+    stamp = folder / "scenegen.json"
+    version = re.search(r"^VERSION = (\d+)", (HERE / "scenegen.py").read_text(), re.M).group(1)
+    if stamp.is_file() and str(json.loads(stamp.read_text()).get("version")) == version:
         return folder
     t = time.time()
     res = subprocess.run([sys.executable, str(HERE / "scenegen.py"), "--out", str(folder), "--seeds", seeds],

@@ -11,7 +11,8 @@ What a scene holds (docs/EVAL.md, "Generated scenes"): a table (top and legs) on
 two walls, chairs, a second table with things on it, pictures on the walls; on the table 2-20
 objects drawn from boxes standing alone, boxes stacked, flat boxes lying on one another, two
 or three boxes flush side by side (mostly of different colours), cylinders, bowls, cups and
-boxes leaning on a neighbour, in plain or textured colours. The camera stands at the table
+boxes leaning on a neighbour, in plain or textured colours; most cylinders wear a label of
+another colour, as cans and bottles do. The camera stands at the table
 and looks down at it from 0.4-0.9 m above the top.
 
 The depth is a structured-light sensor's (Kinect v1-like, baseline 7.5 cm): depth from
@@ -32,11 +33,13 @@ try:
 except ImportError:
     sys.exit("scenegen.py: numpy and Pillow are missing (apt-get install python3-numpy python3-pil)")
 
+VERSION = 2          # of the scenes a seed gives; written to DIR/scenegen.json (2: labels on cylinders)
 FOCAL = 525.0        # pixels at 640x480 (Kinect v1)
 BASELINE = 0.075     # metres, projector to depth camera, along the camera's x
 SUBPIXEL = 8.0       # disparity quantization: 1/8 pixel
 DISPARITY_SIGMA = 0.06  # pixels of noise in disparity (at 640x480)
 ZMAX = 4.5
+LABELLED = 0.6      # the share of cylinders (cans, bottles) that wear a label of another colour
 MIN_VISIBLE = 300    # an object with fewer pixels with depth is labelled 0 (background)
 INF = np.float64(1e9)
 
@@ -175,7 +178,22 @@ def material(rng, textured=None):
             "scale": rng.uniform(0.01, 0.04)}
 
 
+def with_label(rng, body, h):
+    """A can's or a bottle's label: a band of another colour round the body, from z0 to z1
+    (world heights; the cylinder stands on the table top, z = 0)."""
+    a = body["a"]
+    while True:
+        b = rng.uniform(20, 235, 3)
+        if np.linalg.norm(b - a) >= 60:
+            break
+    return {"kind": "label", "body": body, "b": b,
+            "z0": h * rng.uniform(0.03, 0.35), "z1": h * rng.uniform(0.6, 0.97)}
+
+
 def shade(mat, p):
+    if mat["kind"] == "label":
+        on = (p[:, 2] >= mat["z0"]) & (p[:, 2] <= mat["z1"])
+        return np.where(on[:, None], mat["b"], shade(mat["body"], p))
     a = np.broadcast_to(mat["a"], p.shape)
     if mat["kind"] == "plain":
         return a
@@ -201,7 +219,9 @@ def yaw_matrix(yaw, tilt_axis=None, tilt=0.0):
 # ---------------------------------------------------------------------------------------
 # The scene: a list of (primitive, label, material).
 # ---------------------------------------------------------------------------------------
-def build_scene(rng):
+def build_scene(rng, prints):
+    """`prints`: the random stream of the cylinders' labels, apart from `rng` so that adding
+    them left every layout as it was."""
     parts = []
     table_h = rng.uniform(0.70, 0.78)
     L, D = rng.uniform(1.2, 1.8), rng.uniform(0.7, 1.0)
@@ -355,7 +375,10 @@ def build_scene(rng):
             if at is None:
                 continue
             label += 1
-            parts.append((Cone(at[0], at[1], 0.0, h, r0, r1, open_top), label, material(rng)))
+            mat = material(rng)
+            if kind == "cylinder" and prints.random() < LABELLED:
+                mat = with_label(prints, mat, h)
+            parts.append((Cone(at[0], at[1], 0.0, h, r0, r1, open_top), label, mat))
             footprints.append((at[0], at[1], r1))
     return parts, (L, D, table_h)
 
@@ -433,7 +456,7 @@ def render(seed, width=640, height=480, truth=None):
     exact depth (`z`, metres), each pixel's world point (`world`) and its part's label before
     the visibility rule (`raw_labels`), for the tests."""
     rng = np.random.default_rng(seed)
-    parts, (L, D, _) = build_scene(rng)
+    parts, (L, D, _) = build_scene(rng, np.random.default_rng([seed, 1]))
     pos, Rc = camera(rng, L, D)
     s = width / 640.0
     f, cx, cy = FOCAL * s, (width - 1) / 2.0, (height - 1) / 2.0
@@ -548,6 +571,9 @@ def main(argv=None):
         sys.exit("scenegen.py: --width and --height must be at least 32 and 24")
     for seed in seeds:
         write(a.out / f"scene_{seed:05d}", *render(seed, a.width, a.height))
+    # Last, so that a folder with it is whole: eval/benchmark.py reuses only such a folder.
+    (a.out / "scenegen.json").write_text(json.dumps(
+        {"version": VERSION, "seeds": a.seeds, "width": a.width, "height": a.height}) + "\n")
     print(f"scenegen.py: {len(seeds)} scenes -> {a.out}")
 
 

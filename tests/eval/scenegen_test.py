@@ -2,6 +2,7 @@
 """eval/scenegen.py: small scenes whose labels and depth are checked against the ray cast.
 
 Run by ctest (tests/CMakeLists.txt); needs Debian's python3-numpy and python3-pil."""
+import json
 import pathlib
 import sys
 import tempfile
@@ -83,6 +84,21 @@ class Scenegen(unittest.TestCase):
             np.testing.assert_array_equal(np.array(Image.open(f / "depth.png")), depth)
             np.testing.assert_array_equal(np.array(Image.open(f / "label.png")), label)
             np.testing.assert_array_equal(np.array(Image.open(f / "color.png")), color)
+            stamp = json.loads((pathlib.Path(tmp) / "scenegen.json").read_text())
+            self.assertEqual(stamp["version"], scenegen.VERSION)
+
+    def test_cylinders_wear_labels_of_another_colour(self):
+        labelled = []
+        for seed in range(30):
+            parts, _ = scenegen.build_scene(np.random.default_rng(seed), np.random.default_rng([seed, 1]))
+            labelled += [(prim, mat) for prim, lab, mat in parts if lab > 0 and mat["kind"] == "label"]
+        self.assertGreater(len(labelled), 5)
+        for prim, mat in labelled:
+            self.assertTrue(isinstance(prim, scenegen.Cone) and prim.r0 == prim.r1)
+            self.assertTrue(prim.z0 < mat["z0"] < mat["z1"] < prim.z1)
+            mid, below = np.array([[0.0, 0.0, (mat["z0"] + mat["z1"]) / 2]]), np.array([[0.0, 0.0, mat["z0"] / 2]])
+            np.testing.assert_array_equal(scenegen.shade(mat, mid)[0], mat["b"])
+            self.assertGreaterEqual(np.linalg.norm(scenegen.shade(mat, below)[0] - mat["b"]), 1)
 
     def test_bad_seed_range_is_one_line(self):
         with self.assertRaises(SystemExit) as e:
