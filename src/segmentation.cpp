@@ -68,6 +68,8 @@ void SegmentParams::validate() const {
     require(color_max_compact >= 0, "color_max_compact", color_max_compact, ">= 0");
     require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
     require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
+    require(color_round_deg >= 0 && color_round_deg < 90, "color_round_deg", color_round_deg, "in [0, 90)");
+    require(color_round_max_radius_m > 0, "color_round_max_radius_m", color_round_max_radius_m, "> 0");
     require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");
     require(rim_max_residual_m > 0, "rim_max_residual_m", rim_max_residual_m, "> 0");
     require(rim_min_arc > 0 && rim_min_arc <= 1, "rim_min_arc", rim_min_arc, "in (0, 1]");
@@ -466,7 +468,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
         stats.ms.containers = ms_since();
     }
     if (params.segmenter == Segmenter::Hybrid) {
-        stats.color_splits = color_splits(x, ws, n);
+        stats.color_splits = color_splits(x, support, ws, n);
         n += stats.color_splits;
         stats.ms.color = ms_since();
     }

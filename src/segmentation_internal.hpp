@@ -86,7 +86,7 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
 
 /// The colour cue (hybrid): splits segments in two by colour; the new parts are numbered
 /// n + 1, n + 2, ... in segment order. Returns the splits.
-int color_splits(const Ctx& x, SegmentWorkspace& ws, int n);
+int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n);
 
 /// Scope::Support (docs/DESIGN.md, "Scope"): clears the labels of the segments the support
 /// does not hold. Returns the segments of min_points or more left out.

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 
 #include "segmentation_internal.hpp"
@@ -578,12 +579,69 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
     return sb;
 }
 
+/// Whether the pixels px[0, m) of one segment stand round on the support pl: a quarter of
+/// them or more are walls (normals within color_round_deg of the plane), the walls lie on
+/// one upright circle (a Kasa fit on the plane, as the containers' rims: RMS within
+/// rim_max_residual_m, spanning rim_min_arc of the diameter, radius up to
+/// color_round_max_radius_m) and three quarters of them face within color_round_deg of its
+/// radii. A can, a bottle or a cup is one solid of revolution; two objects flush in view
+/// show flat faces. Cost: three passes over the m pixels.
+bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, const int* px, int m) {
+    const SegmentParams& prm = x.prm;
+    const float sin_wall = std::sin(prm.color_round_deg * kDegToRad);
+    auto for_walls = [&](auto&& visit) {
+        for (int i = 0; i < m; ++i) {
+            const auto p = static_cast<std::size_t>(px[i]);
+            if (x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_wall)
+                visit(p);
+        }
+    };
+    double walls = 0;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for_walls([&](std::size_t p) {
+        ++walls;
+        mean += plane_xy(x.c, p);
+    });
+    if (walls < 3 || 4 * walls < m) return false;
+    mean /= walls;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for_walls([&](std::size_t p) {
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
+        const Eigen::Vector3d row(d.x(), d.y(), 1.0);
+        A += row * row.transpose();
+        rhs -= row * d.squaredNorm();
+    });
+    const Eigen::Vector3d sol = A.ldlt().solve(rhs);
+    const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
+    const double R2 = centre.squaredNorm() - sol.z();
+    if (!(R2 > 0) || !std::isfinite(R2) || R2 > static_cast<double>(prm.color_round_max_radius_m) * prm.color_round_max_radius_m)
+        return false;
+    const double R = std::sqrt(R2), cos_radial = std::cos(prm.color_round_deg * kDegToRad);
+    // Residual, the walls' extent (the diagonal of their box on the plane) and how many
+    // face along a radius (either way: a cup's inside faces in).
+    double res = 0, radial = 0;
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::max()), hi = -lo;
+    for_walls([&](std::size_t p) {
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean - centre;
+        const double r = d.norm();
+        res += (r - R) * (r - R);
+        const Eigen::Vector2d n2(x.n.nx[p] * plane_xy.e1.x() + x.n.ny[p] * plane_xy.e1.y() + x.n.nz[p] * plane_xy.e1.z(),
+                                 x.n.nx[p] * plane_xy.e2.x() + x.n.ny[p] * plane_xy.e2.y() + x.n.nz[p] * plane_xy.e2.z());
+        radial += std::fabs(n2.dot(d)) >= cos_radial * n2.norm() * r;
+        lo = lo.cwiseMin(d);
+        hi = hi.cwiseMax(d);
+    });
+    return std::sqrt(res / walls) <= prm.rim_max_residual_m && (hi - lo).norm() >= prm.rim_min_arc * 2 * R &&
+           4 * radial >= 3 * walls;
+}
+
 /// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
 /// "Colour cue"). Writes ws.part at the segment's pixels once 2-means ran. True when the
 /// split is kept. Cost: O(segment pixels) per 2-means iteration and for the boundary; no
 /// allocation (called in parallel, one segment per call).
-bool try_colour_split(const Ctx& x, const ColourFeatures& ft, const ClusterParams& cp, float cos_crease,
-                      SegmentWorkspace& ws, int l) {
+bool try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
+                      const ClusterParams& cp, float cos_crease, SegmentWorkspace& ws, int l) {
     const SegmentParams& prm = x.prm;
     const int o = ws.offsets[static_cast<std::size_t>(l)];
     const int* px = ws.order.data() + o;
@@ -627,7 +685,8 @@ bool try_colour_split(const Ctx& x, const ColourFeatures& ft, const ClusterParam
         const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
         if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) return false;
     }
-    return true;
+    // Last, as it is the rarest to fail: a round thing's colours are print.
+    return !(support && prm.color_round_deg > 0 && stands_round(x, *plane_xy, *support, px, m));
 }
 
 /// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
@@ -653,7 +712,7 @@ int number_splits(SegmentWorkspace& ws, int n) {
 /// Returns the splits. Cost: a counting sort and a gather of the object pixels (parallel
 /// passes), then O(segment pixels) per 2-means iteration per segment tried, segments in
 /// parallel.
-int split_round(const Ctx& x, SegmentWorkspace& ws, int n) {
+int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n) {
     const SegmentParams& prm = x.prm;
     sort_pixels_by_segment(x, ws, n);
     // part is written for a segment's pixels before anything reads them: no clearing.
@@ -665,6 +724,8 @@ int split_round(const Ctx& x, SegmentWorkspace& ws, int n) {
     cp.delta = 1.0f - prm.color_alpha;
     const ColourFeatures features = gather_features(x, cp, ws, n);
     const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
+    std::optional<PlaneAxes> plane_xy;
+    if (support) plane_xy.emplace(*support);
     // Each segment is tried on its own; split ids are given out in segment order afterwards
     // so that the labels do not depend on the threads.
     order_by_size(prm, ws, n);
@@ -672,7 +733,7 @@ int split_round(const Ctx& x, SegmentWorkspace& ws, int n) {
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::ptrdiff_t t = 0; t < n_tried; ++t) {
         const int l = ws.by_size[static_cast<std::size_t>(t)];
-        if (try_colour_split(x, features, cp, cos_crease, ws, l)) ws.split[static_cast<std::size_t>(l)] = 1;
+        if (try_colour_split(x, support, plane_xy ? &*plane_xy : nullptr, features, cp, cos_crease, ws, l)) ws.split[static_cast<std::size_t>(l)] = 1;
     }
     return number_splits(ws, n);
 }
@@ -686,16 +747,16 @@ int split_round(const Ctx& x, SegmentWorkspace& ws, int n) {
 /// split segment again: three flush boxes of three colours need two cuts. In: ws.label
 /// (1..n with gaps). Out: ws.label with the new parts numbered n + 1, n + 2, ... (round 1's
 /// in segment order, then round 2's). Cost: split_round once, twice when it split anything.
-int color_splits(const Ctx& x, SegmentWorkspace& ws, int n) {
+int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n) {
     ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
-    const int first = split_round(x, ws, n);
+    const int first = split_round(x, support, ws, n);
     if (first == 0) return 0;
     // Round 2: the segments split in round 1 (part 0 kept their label) and their new parts.
     // A third round split nothing more on the tune seeds (docs/ABLATION.md).
     ws.to_try.assign(static_cast<std::size_t>(n + first) + 1, 0);
     for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)];
     for (int l = n + 1; l <= n + first; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
-    return first + split_round(x, ws, n + first);
+    return first + split_round(x, support, ws, n + first);
 }
 
 // ---- scope ---------------------------------------------------------------------------------

@@ -459,6 +459,28 @@ TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
     EXPECT_EQ(stats.color_splits, 1);
 }
 
+// A cup with a printed band round its outer wall: two colours on one solid of revolution,
+// as a can's or a bottle's label. The band is a compact piece the colour cue would cut off;
+// the cup's walls lie on one upright circle and face along its radii, so it stays one
+// object (color_round_deg).
+TEST(SegmentObjects, CupWithAPrintedBand_StaysOneObject) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 5;
+    s.cups = {SceneCup{.z = 0.9f, .radius = 0.045f, .h = 0.13f, .band_lo = 0.03f, .band_hi = 0.1f}};
+    const PlaneStage in = up_to_the_plane(s);
+    SegmentParams without;
+    without.color_round_deg = 0;
+    SegmentStats split_stats;
+    const LabelImage split = segment(in, without, &split_stats);
+    ASSERT_GE(split_stats.color_splits, 1) << "without the round test the band should be cut off (test premise)";
+    ASSERT_LT(dominant_share(split.labels, in.truth, kTruthCup0), 0.9) << "(test premise)";
+
+    SegmentStats stats;
+    const LabelImage one = segment(in, SegmentParams{}, &stats);
+    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_GE(dominant_share(one.labels, in.truth, kTruthCup0), 0.95) << "the printed cup was split";
+}
+
 // Three flush boxes of three colours in a row: one 2-means split cuts one box off, and the
 // second round splits the two that are left.
 TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {

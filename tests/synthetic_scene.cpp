@@ -138,6 +138,11 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
                     best = t;
                     id = kTruthCup0 + static_cast<int>(i);
                     rgb[0] = c.r; rgb[1] = c.g; rgb[2] = c.b;
+                    const float ex = t * dx - c.x, ez = t * dz - c.z, height = s.table_y - t * dy;
+                    const float mid = c.radius - c.wall / 2;
+                    if (ex * ex + ez * ez >= mid * mid && height >= c.band_lo && height <= c.band_hi) {
+                        rgb[0] = c.band_r; rgb[1] = c.band_g; rgb[2] = c.band_b;
+                    }
                 }
             }
             const std::size_t p = static_cast<std::size_t>(v) * s.width + u;

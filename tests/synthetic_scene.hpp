@@ -24,6 +24,9 @@ struct SceneCup {
     float h = 0.08f;                ///< height, metres
     float wall = 0.005f;            ///< wall and floor thickness, metres
     std::uint8_t r = 230, g = 200, b = 60;
+    float band_lo = 0, band_hi = 0;  ///< a printed band round the outer wall, heights over the
+                                     ///< table, metres (none when equal)
+    std::uint8_t band_r = 40, band_g = 60, band_b = 200;
 };
 
 struct Scene {

@@ -79,6 +79,13 @@ struct SegmentParams {
                                       ///< mean RGB vectors differ by this angle: shading
                                       ///< scales a colour, only another material turns it;
                                       ///< (0, 90)
+    float color_round_deg = 25;       ///< no split of a segment that stands round on the
+                                      ///< support (a can, a bottle, a cup: its colours are
+                                      ///< print): its walls, normals within this of the
+                                      ///< support plane, lie on one upright circle (the
+                                      ///< rim_ fit's residual and arc) and face within this
+                                      ///< of its radii; [0, 90), 0 = off
+    float color_round_max_radius_m = 0.15f;  ///< ... a circle of at most this radius; > 0
     // Containers (needs the support plane): a bowl or a cup seen from above shows its outer
     // wall and, over the front rim, its inside; the rim hides the inside's lower part, so
     // the two meet only across a depth step, where no crease test or merge can join them.
