@@ -79,6 +79,7 @@ void SegmentParams::validate() const {
     require(scope_contact_m > 0, "scope_contact_m", scope_contact_m, "> 0");
     require(scope_max_height_m > 0, "scope_max_height_m", scope_max_height_m, "> 0");
     require(scope_max_outside >= 0 && scope_max_outside <= 1, "scope_max_outside", scope_max_outside, "in [0, 1]");
+    require(scope_upright_share >= 0 && scope_upright_share <= 1, "scope_upright_share", scope_upright_share, "in [0, 1]");
 }
 
 namespace detail {

@@ -768,6 +768,10 @@ namespace {
 /// columns of a Kinect v1's 640x480). A segment cut there goes on out of view. A wider band
 /// without depth is a view past the depth range or a crop, which says nothing of what the
 /// segment does there.
+/// A pixel faces sideways (is part of an upright surface: a wall, a cupboard's side) when
+/// its normal lies within this of the support plane.
+constexpr float kUprightDeg = 25.0f;
+
 struct FrameEdge {
     int top, bottom, left, right;  ///< the rows [top, bottom) and columns [left, right) with depth
     int edge_top, edge_bottom, edge_left, edge_right;  ///< the edge's rows and columns; -1: none
@@ -817,9 +821,11 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
 
 /// Per segment, over the frame inside its edge: the lowest and highest point over the
 /// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
-/// (ws.sizes), outline pairs (scope_outline) and those that lead out of the volume
-/// (scope_outside: into removed points above the support, or into the frame's edge, beyond
-/// the support's middle `far_z`); the touching segment pairs, once each, into ws.edges. In:
+/// (ws.sizes) and those facing sideways (scope_upright: normals within kUprightDeg of the
+/// support plane), outline pairs (scope_outline) and those that lead out of the volume
+/// (scope_outside: into removed points above the support, or into the frame's top edge,
+/// beyond the support's middle `far_z`) or into its other edges there (scope_frame); the
+/// touching segment pairs, once each, into ws.edges. In:
 /// ws.label (1..n with gaps). Cost: one pass over the pixels, then a sort of the pairs.
 void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
                    int n) {
@@ -834,11 +840,14 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     ws.scope_high.assign(L, 0);
     ws.scope_outline.assign(L, 0);
     ws.scope_outside.assign(L, 0);
+    ws.scope_frame.assign(L, 0);
+    ws.scope_upright.assign(L, 0);
     ws.sizes.assign(L, 0);
     ws.edges.clear();
     const int* const label = ws.label.data();
     const SegmentParams& prm = x.prm;
     auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
+    const float sin_upright = std::sin(kUprightDeg * kDegToRad);
     // A removed point clearly above the support (by more than the depth noise at its depth)
     // was removed for lying off the support's hull: the segment that runs on into it, with
     // continuous depth, continues beyond the support's volume.
@@ -892,8 +901,12 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 const int on_edge = x.c.z[p] > far_z ? (v == fe.edge_top) + (u == fe.edge_left) +
                                                            (u == fe.edge_right) + (v == fe.edge_bottom)
                                                      : 0;
+                const int on_top = x.c.z[p] > far_z && v == fe.edge_top;
                 ws.scope_outline[li] += on_edge;
-                ws.scope_outside[li] += on_edge;
+                ws.scope_outside[li] += on_top;
+                ws.scope_frame[li] += on_edge - on_top;
+                ws.scope_upright[li] += x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny +
+                                                                  x.n.nz[p] * pl.nz) <= sin_upright;
             }
             if (u + 1 < fe.right) pair(p, p + 1);
             if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
@@ -959,8 +972,12 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     keep.assign(L, 0);
     for (std::size_t l = 1; l < L; ++l) {
         if (ws.sizes[l] == 0) continue;
+        // The frame's sides and bottom cut walls and the sides of furniture, and objects on
+        // the table too; only an upright segment (a wall) leaves the volume there.
+        const bool upright = static_cast<float>(ws.scope_upright[l]) >= prm.scope_upright_share * static_cast<float>(ws.sizes[l]);
+        const int outside = ws.scope_outside[l] + (upright ? ws.scope_frame[l] : 0);
         const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
-                            static_cast<float>(ws.scope_outside[l]) <=
+                            static_cast<float>(outside) <=
                                 prm.scope_max_outside * static_cast<float>(ws.scope_outline[l]);
         const bool stands = ws.scope_lo[l] <= prm.scope_contact_m ||
                             foot_hidden(x, pl, ws, l);

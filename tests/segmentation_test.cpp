@@ -376,6 +376,45 @@ TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
     EXPECT_EQ(stats.segments, 2);
 }
 
+// On the far half of the table, the frame's right edge cuts a box and its left edge a board
+// standing upright (a wall's stand-in). The box shows its top: an object the frame cuts,
+// which stays. The board faces sideways: like a wall, it leaves the support's volume through
+// the frame's edge (scope_upright_share). With every segment counted at the frame's sides
+// (share 0, as before) the box leaves too.
+TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
+    Scene s = pitched_tabletop_scene();
+    s.table_half_width = 1.5f;
+    s.boxes = {SceneBox{.x = 0.62f, .z = 1.3f, .w = 0.3f, .h = 0.1f, .d = 0.2f},
+               SceneBox{.x = -0.65f, .z = 1.3f, .w = 0.3f, .h = 0.35f, .d = 0.02f, .r = 40, .g = 60, .b = 200}};
+    const PlaneStage st = up_to_the_plane(s);
+    const int W = 320;
+    bool box_at_edge = false, board_at_edge = false;
+    for (std::size_t p = 0; p < st.truth.size(); ++p) {
+        box_at_edge |= st.truth[p] == kTruthBox0 && static_cast<int>(p % W) == W - 1;
+        board_at_edge |= st.truth[p] == kTruthBox0 + 1 && p % W == 0;
+    }
+    ASSERT_TRUE(box_at_edge && board_at_edge) << "the frame should cut both (test premise)";
+    SegmentParams every;
+    every.scope_upright_share = 0;
+    int box = 0, board = 0;
+    const LabelImage before = segment(st, every);
+    dominant_share(before.labels, st.truth, kTruthBox0, &box);
+    ASSERT_EQ(box, 0) << "counting the frame's sides for every segment should leave the box out (test premise)";
+    SegmentParams no_edges;  // nothing leaves through its outline: the board is held
+    no_edges.scope_max_outside = 1;
+    const LabelImage held = segment(st, no_edges);
+    dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
+    ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &box), 0.9);
+    EXPECT_NE(box, 0) << "the box the frame cuts was left out";
+    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
+    EXPECT_EQ(board, 0) << "the upright board the frame cuts is an object";
+    EXPECT_EQ(stats.out_of_scope, 1);
+}
+
 // The same lift on a box that touches another in the image (a small box in front of a tall
 // one): it rests on a segment the support holds, as a box on a box or an object whose foot
 // another hides, and stays.

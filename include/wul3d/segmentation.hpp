@@ -117,7 +117,13 @@ struct SegmentParams {
     float scope_max_height_m = 0.5f;   ///< a segment with over 2 % of its points higher than
                                        ///< this over the support is not held by it; > 0
     float scope_max_outside = 0.1f;    ///< largest share of a segment's outline that continues
-                                       ///< into removed points above the support; [0, 1]
+                                       ///< into removed points above the support, or into
+                                       ///< the frame's edge beyond the support's middle; [0, 1]
+    float scope_upright_share = 0.7f;  ///< the frame's sides and bottom count for a segment
+                                       ///< only when this share of its pixels face sideways
+                                       ///< (within 25 degrees of the support plane): a wall;
+                                       ///< an object on the table the frame cuts shows its
+                                       ///< top (its top edge counts for all); [0, 1]
 
     void validate() const;  ///< throws ParamError naming the field
 };
@@ -167,6 +173,8 @@ struct SegmentWorkspace {
     std::vector<int> scope_any_px;                     ///< one pixel of each segment
     std::vector<double> scope_sx, scope_sy, scope_sz;  ///< sums of each segment's points
     std::vector<int> scope_high, scope_outline, scope_outside;
+    std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
+                                                  ///< bottom; pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
 };
 
