@@ -821,8 +821,7 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
 
 /// Per segment, over the frame inside its edge: the lowest and highest point over the
 /// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
-/// (ws.sizes) and those facing sideways (scope_upright: normals within kUprightDeg of the
-/// support plane), outline pairs (scope_outline) and those that lead out of the volume
+/// (ws.sizes), outline pairs (scope_outline) and those that lead out of the volume
 /// (scope_outside: into removed points above the support, or into the frame's top edge,
 /// beyond the support's middle `far_z`) or into its other edges there (scope_frame); the
 /// touching segment pairs, once each, into ws.edges. In:
@@ -841,13 +840,11 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     ws.scope_outline.assign(L, 0);
     ws.scope_outside.assign(L, 0);
     ws.scope_frame.assign(L, 0);
-    ws.scope_upright.assign(L, 0);
     ws.sizes.assign(L, 0);
     ws.edges.clear();
     const int* const label = ws.label.data();
     const SegmentParams& prm = x.prm;
     auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
-    const float sin_upright = std::sin(kUprightDeg * kDegToRad);
     // A removed point clearly above the support (by more than the depth noise at its depth)
     // was removed for lying off the support's hull: the segment that runs on into it, with
     // continuous depth, continues beyond the support's volume.
@@ -905,8 +902,6 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 ws.scope_outline[li] += on_edge;
                 ws.scope_outside[li] += on_top;
                 ws.scope_frame[li] += on_edge - on_top;
-                ws.scope_upright[li] += x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny +
-                                                                  x.n.nz[p] * pl.nz) <= sin_upright;
             }
             if (u + 1 < fe.right) pair(p, p + 1);
             if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
@@ -914,6 +909,22 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     }
     std::sort(ws.edges.begin(), ws.edges.end());
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
+}
+
+/// ws.scope_upright: per segment that runs into the frame's sides or bottom (scope_frame),
+/// its pixels facing sideways (normals within kUprightDeg of the support plane); 0 for the
+/// others. Cost: none when no segment does (most tabletop frames), else one pass over the
+/// pixels.
+void count_upright(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.scope_upright.assign(L, 0);
+    if (std::all_of(ws.scope_frame.begin(), ws.scope_frame.end(), [](int f) { return f == 0; })) return;
+    const float sin_upright = std::sin(kUprightDeg * kDegToRad);
+    for (std::size_t p = 0; p < x.c.size(); ++p) {
+        const auto l = static_cast<std::size_t>(ws.label[p]);
+        if (l == 0 || ws.scope_frame[l] == 0 || !x.n.valid[p]) continue;
+        ws.scope_upright[l] += std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_upright;
+    }
 }
 
 /// Whether the camera could see the support under segment l's middle: F, the foot of the
@@ -1021,6 +1032,7 @@ int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int
     const FrameEdge edge = find_frame_edge(x);
     const float far_z = support_middle_depth(x, pl);
     measure_scope(x, pl, edge, far_z, ws, n);
+    count_upright(x, pl, ws, n);
     decide_scope(x, pl, ws, n);
     return clear_out_of_scope(x.prm, ws, n);
 }
