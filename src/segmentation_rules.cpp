@@ -79,6 +79,26 @@ struct PlaneAxes {
     }
 };
 
+/// A circle on the support plane through the points `for_points` visits (it calls its
+/// argument with each pixel), by algebraic least squares (Kasa), centred on their mean
+/// `mean` for conditioning: the centre relative to `mean` and the squared radius (not > 0,
+/// or not finite, when the points fit no circle). Cost: one pass over the points.
+template <class ForPoints>
+std::pair<Eigen::Vector2d, double> fit_circle(const Ctx& x, const PlaneAxes& plane_xy, const Eigen::Vector2d& mean,
+                                              ForPoints&& for_points) {
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for_points([&](std::size_t p) {
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
+        const Eigen::Vector3d row(d.x(), d.y(), 1.0);
+        A += row * row.transpose();
+        rhs -= row * d.squaredNorm();
+    });
+    const Eigen::Vector3d sol = A.ldlt().solve(rhs);
+    const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
+    return {centre, centre.squaredNorm() - sol.z()};
+}
+
 /// A circle fitted to the front segment's edge along the steps ws.steps[i0, i1) (the nearer
 /// pixels of the depth steps that lie in `front`), on the plane: algebraic least squares
 /// (Kasa), centred on the edge's mean for conditioning. Appends {front, back, centre (2),
@@ -102,17 +122,7 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
     if (m < 3) return;
     mean /= m;
     height /= m;
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    for_edge([&](std::size_t p) {
-        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
-        const Eigen::Vector3d row(d.x(), d.y(), 1.0);
-        A += row * row.transpose();
-        rhs -= row * d.squaredNorm();
-    });
-    const Eigen::Vector3d sol = A.ldlt().solve(rhs);
-    const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
-    const double R2 = centre.squaredNorm() - sol.z();
+    const auto [centre, R2] = fit_circle(x, plane_xy, mean, for_edge);
     if (!(R2 > 0) || !std::isfinite(R2)) return;
     const double R = std::sqrt(R2);
     // Geometric residual, and the widest chord: the farthest edge pixel from the mean,
@@ -604,17 +614,7 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     });
     if (walls < 3 || 4 * walls < m) return false;
     mean /= walls;
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    for_walls([&](std::size_t p) {
-        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
-        const Eigen::Vector3d row(d.x(), d.y(), 1.0);
-        A += row * row.transpose();
-        rhs -= row * d.squaredNorm();
-    });
-    const Eigen::Vector3d sol = A.ldlt().solve(rhs);
-    const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
-    const double R2 = centre.squaredNorm() - sol.z();
+    const auto [centre, R2] = fit_circle(x, plane_xy, mean, for_walls);
     if (!(R2 > 0) || !std::isfinite(R2) || R2 > static_cast<double>(prm.color_round_max_radius_m) * prm.color_round_max_radius_m)
         return false;
     const double R = std::sqrt(R2), cos_radial = std::cos(prm.color_round_deg * kDegToRad);
