@@ -615,8 +615,8 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     if (walls < 3 || 4 * walls < m) return false;
     mean /= walls;
     const auto [centre, R2] = fit_circle(x, plane_xy, mean, for_walls);
-    if (!(R2 > 0) || !std::isfinite(R2) || R2 > static_cast<double>(prm.color_round_max_radius_m) * prm.color_round_max_radius_m)
-        return false;
+    const double max_r = prm.color_round_max_radius_m;
+    if (!(R2 > 0) || !std::isfinite(R2) || R2 > max_r * max_r) return false;
     const double R = std::sqrt(R2), cos_radial = std::cos(prm.color_round_deg * kDegToRad);
     // Residual, the walls' extent (the diagonal of their box on the plane) and how many
     // face along a radius (either way: a cup's inside faces in).
@@ -626,8 +626,8 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
         const Eigen::Vector2d d = plane_xy(x.c, p) - mean - centre;
         const double r = d.norm();
         res += (r - R) * (r - R);
-        const Eigen::Vector2d n2(x.n.nx[p] * plane_xy.e1.x() + x.n.ny[p] * plane_xy.e1.y() + x.n.nz[p] * plane_xy.e1.z(),
-                                 x.n.nx[p] * plane_xy.e2.x() + x.n.ny[p] * plane_xy.e2.y() + x.n.nz[p] * plane_xy.e2.z());
+        const Eigen::Vector3d nrm(x.n.nx[p], x.n.ny[p], x.n.nz[p]);
+        const Eigen::Vector2d n2(nrm.dot(plane_xy.e1), nrm.dot(plane_xy.e2));  // the normal on the plane
         radial += std::fabs(n2.dot(d)) >= cos_radial * n2.norm() * r;
         lo = lo.cwiseMin(d);
         hi = hi.cwiseMax(d);
@@ -733,7 +733,8 @@ int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n)
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::ptrdiff_t t = 0; t < n_tried; ++t) {
         const int l = ws.by_size[static_cast<std::size_t>(t)];
-        if (try_colour_split(x, support, plane_xy ? &*plane_xy : nullptr, features, cp, cos_crease, ws, l)) ws.split[static_cast<std::size_t>(l)] = 1;
+        const PlaneAxes* axes = plane_xy ? &*plane_xy : nullptr;
+        ws.split[static_cast<std::size_t>(l)] = try_colour_split(x, support, axes, features, cp, cos_crease, ws, l);
     }
     return number_splits(ws, n);
 }
@@ -743,7 +744,8 @@ int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n)
 /// The colour cue: tries to split each segment in two by 2-means under the paper's distance
 /// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
 /// are large, and meet along one side of the smaller part or round a compact piece, across
-/// a smooth surface or with a turn of colour. A second round tries the two parts of each
+/// a smooth surface or with a turn of colour, and the segment does not stand round on the
+/// support (stands_round: a can's label is print). A second round tries the two parts of each
 /// split segment again: three flush boxes of three colours need two cuts. In: ws.label
 /// (1..n with gaps). Out: ws.label with the new parts numbered n + 1, n + 2, ... (round 1's
 /// in segment order, then round 2's). Cost: split_round once, twice when it split anything.
@@ -763,15 +765,15 @@ int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n
 
 namespace {
 
+/// A pixel faces sideways (is part of an upright surface: a wall, a cupboard's side) when
+/// its normal lies within this of the support plane.
+constexpr float kUprightDeg = 25.0f;
+
 /// The frame's edge: the image border and the rows and columns with no depth at all that
 /// reach it, when they are a narrow band (a sensor's registration border: 48 rows and 63
 /// columns of a Kinect v1's 640x480). A segment cut there goes on out of view. A wider band
 /// without depth is a view past the depth range or a crop, which says nothing of what the
 /// segment does there.
-/// A pixel faces sideways (is part of an upright surface: a wall, a cupboard's side) when
-/// its normal lies within this of the support plane.
-constexpr float kUprightDeg = 25.0f;
-
 struct FrameEdge {
     int top, bottom, left, right;  ///< the rows [top, bottom) and columns [left, right) with depth
     int edge_top, edge_bottom, edge_left, edge_right;  ///< the edge's rows and columns; -1: none
@@ -985,7 +987,8 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
         if (ws.sizes[l] == 0) continue;
         // The frame's sides and bottom cut walls and the sides of furniture, and objects on
         // the table too; only an upright segment (a wall) leaves the volume there.
-        const bool upright = static_cast<float>(ws.scope_upright[l]) >= prm.scope_upright_share * static_cast<float>(ws.sizes[l]);
+        const bool upright =
+            static_cast<float>(ws.scope_upright[l]) >= prm.scope_upright_share * static_cast<float>(ws.sizes[l]);
         const int outside = ws.scope_outside[l] + (upright ? ws.scope_frame[l] : 0);
         const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
                             static_cast<float>(outside) <=
