@@ -12,8 +12,8 @@ two walls, chairs, a second table with things on it, pictures on the walls; on t
 objects drawn from boxes standing alone, boxes stacked, flat boxes lying on one another, two
 or three boxes flush side by side (mostly of different colours), cylinders, bowls, cups and
 boxes leaning on a neighbour, in plain or textured colours; most cylinders wear a label of
-another colour, as cans and bottles do. The camera stands at the table
-and looks down at it from 0.4-0.9 m above the top.
+another colour, as cans and bottles do. The camera stands at the table and looks down at it
+from 0.4-0.9 m above the top.
 
 The depth is a structured-light sensor's (Kinect v1-like, baseline 7.5 cm): depth from
 disparity quantized to 1/8 pixel with noise in disparity (so the depth error grows with
