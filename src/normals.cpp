@@ -1,6 +1,8 @@
 #include "wul3d/normals.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <sstream>
 
@@ -61,6 +63,78 @@ inline bool tangent(const OrganizedCloud& c, std::size_t p, std::size_t lo, std:
     return true;
 }
 
+/// ok ? a : b with a mask in place of a branch: GCC would sink the loads of `a` and `b`
+/// into the branch, and then cannot vectorize the loop (a conditional load may trap).
+inline float pick(bool ok, float a, float b) {
+    const std::uint32_t m = 0u - static_cast<std::uint32_t>(ok);
+    return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & m) | (std::bit_cast<std::uint32_t>(b) & ~m));
+}
+
+/// The normal of each pixel of [p0, p1), pixels of one row whose neighbours `du` and `dv`
+/// away (r columns, r rows) all lie in the frame: the arithmetic of tangent() and of
+/// estimate_normals' pixel loop, with selects in place of branches so that the loop
+/// vectorizes. Same operations on each pixel, hence the same bits. Cost: one pass.
+void interior_normals(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                      const std::uint8_t* __restrict valid, std::size_t p0, std::size_t p1, std::size_t du,
+                      std::size_t dv, float jump_per_m, float* __restrict nx, float* __restrict ny,
+                      float* __restrict nz, std::uint8_t* __restrict valid_out) {
+    for (std::size_t p = p0; p < p1; ++p) {
+        const float xp = x[p], yp = y[p], zp = z[p], max_jump = jump_per_m * zp;
+        // `&`, not `&&`, and every load made whatever the selects pick (all lie in the
+        // frame): a branch would stop vectorization.
+        auto near = [&](std::size_t q) { return (valid[q] != 0) & (std::fabs(z[q] - zp) <= max_jump); };
+        const bool left = near(p - du), right = near(p + du), up = near(p - dv), down = near(p + dv);
+        // tangent(): from the near neighbour below (else the pixel) to the one above (else
+        // the pixel), i.e. hi - lo, hi - p or p - lo.
+        auto tangent_part = [](bool lo_ok, float lo, bool hi_ok, float hi, float at_p) {
+            return pick(hi_ok, hi, at_p) - pick(lo_ok, lo, at_p);
+        };
+        const float ux = tangent_part(left, x[p - du], right, x[p + du], xp);
+        const float uy = tangent_part(left, y[p - du], right, y[p + du], yp);
+        const float uz = tangent_part(left, z[p - du], right, z[p + du], zp);
+        const float vx = tangent_part(up, x[p - dv], down, x[p + dv], xp);
+        const float vy = tangent_part(up, y[p - dv], down, y[p + dv], yp);
+        const float vz = tangent_part(up, z[p - dv], down, z[p + dv], zp);
+        const float cx = vy * uz - vz * uy, cy = vz * ux - vx * uz, cz = vx * uy - vy * ux;
+        const float len = std::sqrt(cx * cx + cy * cy + cz * cz);
+        const bool ok = (valid[p] != 0) & (left | right) & (up | down) & (len > 1e-12f);
+        const float s = 1.0f / len;
+        const float sc = pick(cx * xp + cy * yp + cz * zp > 0, -s, s);
+        nx[p] = pick(ok, cx * sc, 0.0f);
+        ny[p] = pick(ok, cy * sc, 0.0f);
+        nz[p] = pick(ok, cz * sc, 0.0f);
+        valid_out[p] = ok;
+    }
+}
+
+/// The normal at pixel (u, v) of any row and column, bounds checked: tangents along both
+/// axes (tangent()), their cross product, oriented towards the camera. The kernel of the
+/// pixels near the frame's border (interior_normals does the others). Cost: O(1).
+void edge_normal(const OrganizedCloud& cloud, int u, int v, int r, float jump_per_m, NormalMap& out) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t p = static_cast<std::size_t>(v) * W + u;
+    out.nx[p] = out.ny[p] = out.nz[p] = 0.0f;
+    out.valid[p] = 0;
+    if (!cloud.valid[p]) return;
+    const float max_jump = jump_per_m * cloud.z[p];
+    Vec3 du, dv;
+    if (!tangent(cloud, p, p - r, p + r, u - r >= 0, u + r < W, max_jump, du)) return;
+    if (!tangent(cloud, p, p - static_cast<std::size_t>(r) * W, p + static_cast<std::size_t>(r) * W, v - r >= 0,
+                 v + r < H, max_jump, dv))
+        return;
+    // n = dv x du points towards the camera for a surface facing it (x right, y down).
+    Vec3 n{dv.y * du.z - dv.z * du.y, dv.z * du.x - dv.x * du.z, dv.x * du.y - dv.y * du.x};
+    const float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+    if (!(len > 1e-12f)) return;
+    float s = 1.0f / len;
+    // Orient towards the camera: the normal and the ray to the point are opposed.
+    if (n.x * cloud.x[p] + n.y * cloud.y[p] + n.z * cloud.z[p] > 0) s = -s;
+    out.nx[p] = n.x * s;
+    out.ny[p] = n.y * s;
+    out.nz[p] = n.z * s;
+    out.valid[p] = 1;
+}
+
 }  // namespace
 
 void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, NormalMap& out) {
@@ -70,31 +144,19 @@ void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, N
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            out.nx[p] = out.ny[p] = out.nz[p] = 0.0f;
-            out.valid[p] = 0;
-            if (!cloud.valid[p]) continue;
-            const float max_jump = jump_per_m * cloud.z[p];
-            Vec3 du, dv;
-            if (!tangent(cloud, p, p - r, p + r, u - r >= 0, u + r < W, max_jump, du)) continue;
-            if (!tangent(cloud, p, p - static_cast<std::size_t>(r) * W,
-                         p + static_cast<std::size_t>(r) * W, v - r >= 0, v + r < H, max_jump,
-                         dv))
-                continue;
-            // n = dv x du points towards the camera for a surface facing it (x right, y down).
-            Vec3 n{dv.y * du.z - dv.z * du.y, dv.z * du.x - dv.x * du.z,
-                   dv.x * du.y - dv.y * du.x};
-            const float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-            if (!(len > 1e-12f)) continue;
-            float s = 1.0f / len;
-            // Orient towards the camera: the normal and the ray to the point are opposed.
-            if (n.x * cloud.x[p] + n.y * cloud.y[p] + n.z * cloud.z[p] > 0) s = -s;
-            out.nx[p] = n.x * s;
-            out.ny[p] = n.y * s;
-            out.nz[p] = n.z * s;
-            out.valid[p] = 1;
+        // The pixels whose neighbours r columns and r rows away all lie in the frame take
+        // the vectorized kernel, those nearer the border the bounds-checked one.
+        const bool inner_row = v >= r && v + r < H && W > 2 * r;
+        if (!inner_row) {
+            for (int u = 0; u < W; ++u) edge_normal(cloud, u, v, r, jump_per_m, out);
+            continue;
         }
+        for (int u = 0; u < r; ++u) edge_normal(cloud, u, v, r, jump_per_m, out);
+        const std::size_t row = static_cast<std::size_t>(v) * W;
+        interior_normals(cloud.x.data(), cloud.y.data(), cloud.z.data(), cloud.valid.data(), row + r, row + W - r,
+                         static_cast<std::size_t>(r), static_cast<std::size_t>(r) * W, jump_per_m, out.nx.data(),
+                         out.ny.data(), out.nz.data(), out.valid.data());
+        for (int u = W - r; u < W; ++u) edge_normal(cloud, u, v, r, jump_per_m, out);
     }
 }
 
