@@ -77,7 +77,12 @@ inline float pick(bool ok, float a, float b) {
 /// The normal of each pixel of [p0, p1), pixels of one row whose neighbours `du` and `dv`
 /// away (r columns, r rows) all lie in the frame: the arithmetic of tangent() and of
 /// estimate_normals' pixel loop, with selects in place of branches so that the loop
-/// vectorizes. Same operations on each pixel, hence the same bits. Cost: one pass.
+/// vectorizes. Same operations on each pixel, hence the same bits. Built for AVX2 and for
+/// baseline x86-64, picked at load time (as assign_block in clustering.cpp; AVX2 brings no
+/// FMA, so the same bits). Cost: one pass.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void interior_normals(const float* __restrict x, const float* __restrict y, const float* __restrict z,
                       const std::uint8_t* __restrict valid, std::size_t p0, std::size_t p1, std::size_t du,
                       std::size_t dv, float jump_per_m, float* __restrict nx, float* __restrict ny,
