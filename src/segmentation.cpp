@@ -138,15 +138,20 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
         const int v0 = H * band / kBands, v1 = H * (band + 1) / kBands;
         int* const seeds = ws.queue.data() + static_cast<std::size_t>(v0) * W;
         int count = 0;
-        for (int v = v0; v < v1; ++v)
+        for (int v = v0; v < v1; ++v) {
+            const std::size_t row = static_cast<std::size_t>(v) * W;
+            const int* const label = ws.label.data() + row;
+            // The distances first, in a loop of their own that vectorizes.
+            int* const dist = ws.dist.data() + row;
+            for (int u = 0; u < W; ++u) dist[u] = label[u] ? 0 : -1;
             for (int u = 0; u < W; ++u) {
-                const std::size_t p = static_cast<std::size_t>(v) * W + u;
-                ws.dist[p] = ws.label[p] ? 0 : -1;
-                if (!ws.label[p]) continue;
+                if (!label[u]) continue;
+                const std::size_t p = row + u;
                 if ((u > 0 && grows_into(p - 1)) || (u + 1 < W && grows_into(p + 1)) ||
                     (v > 0 && grows_into(p - W)) || (v + 1 < H && grows_into(p + W)))
                     seeds[count++] = static_cast<int>(p);
             }
+        }
         band_seeds[band] = count;
     }
     for (int band = 0; band < kBands; ++band) {
