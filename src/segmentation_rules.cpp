@@ -895,8 +895,10 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 ws.scope_outline[li] += on_edge;
                 ws.scope_outside[li] += on_edge;
             }
-            if (u + 1 < fe.right) pair(p, p + 1);
-            if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
+            // Most pairs join equal labels and add nothing: that test stays here, in line
+            // (GCC does not inline `pair`, called twice).
+            if (u + 1 < fe.right && label[p] != label[p + 1]) pair(p, p + 1);
+            if (v + 1 < fe.bottom && label[p] != label[p + W]) pair(p, p + static_cast<std::size_t>(W));
         }
     }
     std::sort(ws.edges.begin(), ws.edges.end());
