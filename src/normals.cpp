@@ -1,7 +1,6 @@
 #include "wul3d/normals.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
 #include <cmath>
 #include <sstream>
@@ -10,6 +9,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "branch_free.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -67,12 +67,7 @@ inline bool tangent(const OrganizedCloud& c, std::size_t p, std::size_t lo, std:
     return true;
 }
 
-/// ok ? a : b with a mask in place of a branch: GCC would sink the loads of `a` and `b`
-/// into the branch, and then cannot vectorize the loop (a conditional load may trap).
-inline float pick(bool ok, float a, float b) {
-    const std::uint32_t m = 0u - static_cast<std::uint32_t>(ok);
-    return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & m) | (std::bit_cast<std::uint32_t>(b) & ~m));
-}
+using detail::pick;
 
 /// The normal of each pixel of [p0, p1), pixels of one row whose neighbours `du` and `dv`
 /// away (r columns, r rows) all lie in the frame: the arithmetic of tangent() and of
