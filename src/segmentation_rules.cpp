@@ -448,13 +448,15 @@ double principal_axis(const double (&cov)[3][3], double (&e)[3]) {
 /// a line of mixed colour at an edge, pull 2-means into a part of their own, which the
 /// share test then rejects; they move the principal axis little (generated tune seeds
 /// 88.5 -> 89.8 Overlap F, docs/ABLATION.md). False, and no seeds, when the colour spread
-/// cannot hold parts `min_spread` apart (feature units). Cost: three passes over the
-/// segment's planes.
-bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6]) {
-    double mean[6] = {};
+/// cannot hold parts `min_spread` apart (feature units). `total`: the planes' sums (in
+/// double, pixel order), which two_means needs too. Cost: three passes over the segment's
+/// planes.
+bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6], double (&total)[6]) {
+    double mean[6];
     for (int q = 0; q < 6; ++q) {
-        for (int i = 0; i < m; ++i) mean[q] += f[q][i];
-        mean[q] /= m;
+        total[q] = 0;
+        for (int i = 0; i < m; ++i) total[q] += f[q][i];
+        mean[q] = total[q] / m;
     }
     const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
     // The parts' mean colours lie among the segment's colours, so they are at most the
@@ -483,15 +485,14 @@ bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2
 
 /// 2-means (eq. 4 squared) on one segment's feature planes, m pixels, from the centres `cen`:
 /// side[i] gets pixel i's part, `cen` the parts' means and `count` their sizes (the last
-/// iteration's; a part may be empty). Cost: at most 6 passes over the 6 planes, stopping when
-/// no pixel changes part; float sums per block of 1024, added up in double; no allocation.
-void two_means(const float* const* planes, int m, std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+/// iteration's; a part may be empty). `total`: the planes' sums (seed_centres'); part 0's
+/// sums are the totals minus part 1's. Cost: at most 6 passes over the 6 planes, stopping
+/// when no pixel changes part; float sums per block of 1024, added up in double; no
+/// allocation.
+void two_means(const float* const* planes, int m, const double (&total)[6], std::uint8_t* side, float (&cen)[2][6],
+               int (&count)[2]) {
     const float* f[6];  // a local copy: the stores to `side` cannot alias it
     for (int q = 0; q < 6; ++q) f[q] = planes[q];
-    // Totals once: part 0's sums are the totals minus part 1's.
-    double total[6] = {};
-    for (int q = 0; q < 6; ++q)
-        for (int i = 0; i < m; ++i) total[q] += f[q][i];
     for (int it = 0; it < 6; ++it) {
         // Nearer centre 1 than centre 0 (eq. 4 squared): |f - c1|^2 < |f - c0|^2, i.e.
         // 2 f . (c0 - c1) < |c0|^2 - |c1|^2, a linear test per pixel.
@@ -649,10 +650,11 @@ bool try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane
     const float* f[6];  // the segment's features
     for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
     float cen[2][6];
-    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen)) return false;
+    double total[6];
+    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen, total)) return false;
     std::uint8_t* const side = ws.part_in_order.data() + o;
     int count[2] = {0, 0};
-    two_means(f, m, side, cen, count);
+    two_means(f, m, total, side, cen, count);
     std::uint8_t* part = ws.part.data();
     for (int i = 0; i < m; ++i) part[px[i]] = side[i];
     const int small = std::min(count[0], count[1]);
