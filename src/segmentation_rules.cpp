@@ -519,10 +519,11 @@ void two_means(const float* const* planes, int m, const double (&total)[6], std:
                 side[i] = j;
                 block_ones += j;
             }
-            for (int i = i0; i < i1; ++i) {
-                const float mask = side[i];
-                for (int q = 0; q < 6; ++q) block[q] += mask * f[q][i];
-            }
+            // Part 1's pixels only: a pixel of part 0 would add 0 * f = +-0, which changes
+            // no sum (the features are finite).
+            for (int i = i0; i < i1; ++i)
+                if (side[i])
+                    for (int q = 0; q < 6; ++q) block[q] += f[q][i];
             for (int q = 0; q < 6; ++q) sum1[q] += block[q];
             ones += block_ones;
             changed += block_changed;
