@@ -141,9 +141,15 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
         for (int v = v0; v < v1; ++v) {
             const std::size_t row = static_cast<std::size_t>(v) * W;
             const int* const label = ws.label.data() + row;
-            // The distances first, in a loop of their own that vectorizes.
+            // The distances first, in a loop of their own that vectorizes; it also tells a
+            // row without labels, which has no seed.
             int* const dist = ws.dist.data() + row;
-            for (int u = 0; u < W; ++u) dist[u] = label[u] ? 0 : -1;
+            int any = 0;
+            for (int u = 0; u < W; ++u) {
+                dist[u] = label[u] ? 0 : -1;
+                any |= label[u];
+            }
+            if (!any) continue;
             for (int u = 0; u < W; ++u) {
                 if (!label[u]) continue;
                 const std::size_t p = row + u;
