@@ -247,33 +247,39 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
     if (prm.merge_max_concave <= 0 || n < 2) return 0;
     const int W = x.W, H = x.H, s = prm.crease_step_px;
     ws.edges.clear();
-    for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
-            const int p = v * W + u;
-            const int a = ws.label[static_cast<std::size_t>(p)];
-            if (a == 0) continue;
-            const int dirs[2][2] = {{1, 0}, {0, 1}};
-            for (const auto& d : dirs) {
-                if (u + d[0] >= W || v + d[1] >= H) continue;
-                const int q = p + d[0] + d[1] * W;
-                const int b = ws.label[static_cast<std::size_t>(q)];
-                if (b == 0 || b == a) continue;
-                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
-                const int pu = u - s * d[0], pv = v - s * d[1];
-                const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
-                std::uint64_t tested = 0, concave = 0;
-                if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
-                    const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
-                    const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
-                    if (ws.label[pp] == a && ws.label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
-                        tested = 1;
-                        concave = x.concavity(pp, qq) > prm.concavity;
-                    }
-                }
-                const auto lo = static_cast<std::uint64_t>(std::min(a, b));
-                const auto hi = static_cast<std::uint64_t>(std::max(a, b));
-                ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+    const int* const label = ws.label.data();
+    // The pair (p, q = p + d) of segments a and b, q right of or below p.
+    auto boundary_pair = [&](int u, int v, int a, int b, const int (&d)[2]) {
+        const int p = v * W + u, q = p + d[0] + d[1] * W;
+        if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) return;
+        const int pu = u - s * d[0], pv = v - s * d[1];
+        const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
+        std::uint64_t tested = 0, concave = 0;
+        if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
+            const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
+            const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
+            if (label[pp] == a && label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
+                tested = 1;
+                concave = x.concavity(pp, qq) > prm.concavity;
             }
+        }
+        const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+        const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+        ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+    };
+    static constexpr int kRight[2] = {1, 0}, kDown[2] = {0, 1};
+    for (int v = 0; v < H; ++v) {
+        const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
+        // A row without labels has no pair (told by a loop that vectorizes).
+        int any = 0;
+        for (int u = 0; u < W; ++u) any |= row[u];
+        if (!any) continue;
+        for (int u = 0; u < W; ++u) {
+            const int a = row[u];
+            if (a == 0) continue;
+            // Right, then down, as before; most neighbours are unlabelled or of segment a.
+            if (u + 1 < W && row[u + 1] != 0 && row[u + 1] != a) boundary_pair(u, v, a, row[u + 1], kRight);
+            if (v + 1 < H && row[u + W] != 0 && row[u + W] != a) boundary_pair(u, v, a, row[u + W], kDown);
         }
     }
     std::sort(ws.edges.begin(), ws.edges.end());
