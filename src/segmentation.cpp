@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -377,7 +378,21 @@ void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentWor
     const float concavity = x.prm.concavity, steps = static_cast<float>(s);
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
+        // Only the columns from the row's first object pixel (memchr) to its last can hold
+        // a pair; the others get no bits.
+        const std::uint8_t* const cls_row = cls + static_cast<std::size_t>(v) * W;
+        std::uint8_t* const crease_row = crease + static_cast<std::size_t>(v) * W;
+        const void* const first = std::memchr(cls_row, kPlaneObject, static_cast<std::size_t>(W));
+        if (!first) {
+            std::memset(crease_row, 0, static_cast<std::size_t>(W));
+            continue;
+        }
+        const int u0 = static_cast<int>(static_cast<const std::uint8_t*>(first) - cls_row);
+        int u1 = W;
+        while (cls_row[u1 - 1] != kPlaneObject) --u1;
+        std::memset(crease_row, 0, static_cast<std::size_t>(u0));
+        std::memset(crease_row + u1, 0, static_cast<std::size_t>(W - u1));
+        for (int u = u0; u < u1; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             std::uint8_t bits = 0;
             if (cls[p] == kPlaneObject && has_normal[p]) {
