@@ -172,7 +172,11 @@ void row_window_sums(const float* h, int W, int r, float* o) {
 
 /// (x, y, z)[u] scaled to unit length where `valid` and the length exceeds 1e-6 (valid_out
 /// = 1), else to 0 (valid_out = 0). A multiply by the picked scale, never a branch: the
-/// loop vectorizes. Cost: one pass over the row.
+/// loop vectorizes; built for AVX2 and baseline x86-64 (no FMA either way: the same bits).
+/// Cost: one pass over the row.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
 void renormalize_row(const std::uint8_t* __restrict valid, int W, float* __restrict x, float* __restrict y,
                      float* __restrict z, std::uint8_t* __restrict valid_out) {
     for (int u = 0; u < W; ++u) {
