@@ -96,16 +96,18 @@ void decimate_frame(const RgbdView& in, int factor, RgbdFrame& out, const DepthR
             const std::size_t top_left = static_cast<std::size_t>(v) * factor * W + static_cast<std::size_t>(u) * factor;
             std::size_t pick = top_left;
             bool in_range = depth[top_left] != 0 && limits.contains(static_cast<float>(depth[top_left]) * scale);
-            const int rows = std::min(factor, H - v * factor), cols = std::min(factor, W - u * factor);
-            bool with_depth = false;
-            for (int dv = 0; dv < rows && !in_range; ++dv)
-                for (int du = 0; du < cols && !in_range; ++du) {
-                    const std::size_t q = top_left + static_cast<std::size_t>(dv) * W + du;
-                    if (depth[q] == 0) continue;
-                    in_range = limits.contains(static_cast<float>(depth[q]) * scale);
-                    if (in_range || !with_depth) pick = q;
-                    with_depth = true;
-                }
+            if (!in_range) {
+                const int rows = std::min(factor, H - v * factor), cols = std::min(factor, W - u * factor);
+                bool with_depth = false;
+                for (int dv = 0; dv < rows && !in_range; ++dv)
+                    for (int du = 0; du < cols && !in_range; ++du) {
+                        const std::size_t q = top_left + static_cast<std::size_t>(dv) * W + du;
+                        if (depth[q] == 0) continue;
+                        in_range = limits.contains(static_cast<float>(depth[q]) * scale);
+                        if (in_range || !with_depth) pick = q;
+                        with_depth = true;
+                    }
+            }
             const std::size_t o = static_cast<std::size_t>(v) * w + u;
             out_depth[o] = depth[pick];
             if (rgb)
