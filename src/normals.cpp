@@ -1,8 +1,8 @@
 #include "wul3d/normals.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #if defined(__SSE2__)
@@ -84,7 +84,7 @@ void interior_normals(const float* __restrict x, const float* __restrict y, cons
                       float* __restrict nz, std::uint8_t* __restrict valid_out) {
     for (std::size_t p = p0; p < p1; ++p) {
         const float xp = x[p], yp = y[p], zp = z[p], max_jump = jump_per_m * zp;
-        // `&`, not `&&`, and every load made whatever the selects pick (all lie in the
+        // `&`, not `&&`, and every load done whatever the selects pick (all lie in the
         // frame): a branch would stop vectorization.
         auto near = [&](std::size_t q) { return (valid[q] != 0) & (std::fabs(z[q] - zp) <= max_jump); };
         const bool left = near(p - du), right = near(p + du), up = near(p - dv), down = near(p + dv);
