@@ -2,8 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include "branch_free.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -61,6 +67,129 @@ inline bool tangent(const OrganizedCloud& c, std::size_t p, std::size_t lo, std:
     return true;
 }
 
+using detail::pick;
+
+/// The normal of each pixel of [p0, p1), pixels of one row whose neighbours `du` and `dv`
+/// away (r columns, r rows) all lie in the frame: the arithmetic of tangent() and of
+/// estimate_normals' pixel loop, with selects in place of branches so that the loop
+/// vectorizes. Same operations on each pixel, hence the same bits. Built for AVX2 and for
+/// baseline x86-64, picked at load time (as assign_block in clustering.cpp; AVX2 brings no
+/// FMA, so the same bits). Cost: one pass.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void interior_normals(const float* __restrict x, const float* __restrict y, const float* __restrict z,
+                      const std::uint8_t* __restrict valid, std::size_t p0, std::size_t p1, std::size_t du,
+                      std::size_t dv, float jump_per_m, float* __restrict nx, float* __restrict ny,
+                      float* __restrict nz, std::uint8_t* __restrict valid_out) {
+    for (std::size_t p = p0; p < p1; ++p) {
+        const float xp = x[p], yp = y[p], zp = z[p], max_jump = jump_per_m * zp;
+        // `&`, not `&&`, and every load done whatever the selects pick (all lie in the
+        // frame): a branch would stop vectorization.
+        auto near = [&](std::size_t q) { return (valid[q] != 0) & (std::fabs(z[q] - zp) <= max_jump); };
+        const bool left = near(p - du), right = near(p + du), up = near(p - dv), down = near(p + dv);
+        // tangent(): from the near neighbour below (else the pixel) to the one above (else
+        // the pixel), i.e. hi - lo, hi - p or p - lo.
+        auto tangent_part = [](bool lo_ok, float lo, bool hi_ok, float hi, float at_p) {
+            return pick(hi_ok, hi, at_p) - pick(lo_ok, lo, at_p);
+        };
+        const float ux = tangent_part(left, x[p - du], right, x[p + du], xp);
+        const float uy = tangent_part(left, y[p - du], right, y[p + du], yp);
+        const float uz = tangent_part(left, z[p - du], right, z[p + du], zp);
+        const float vx = tangent_part(up, x[p - dv], down, x[p + dv], xp);
+        const float vy = tangent_part(up, y[p - dv], down, y[p + dv], yp);
+        const float vz = tangent_part(up, z[p - dv], down, z[p + dv], zp);
+        const float cx = vy * uz - vz * uy, cy = vz * ux - vx * uz, cz = vx * uy - vy * ux;
+        const float len = std::sqrt(cx * cx + cy * cy + cz * cz);
+        const bool ok = (valid[p] != 0) & (left | right) & (up | down) & (len > 1e-12f);
+        const float s = 1.0f / len;
+        const float sc = pick(cx * xp + cy * yp + cz * zp > 0, -s, s);
+        nx[p] = pick(ok, cx * sc, 0.0f);
+        ny[p] = pick(ok, cy * sc, 0.0f);
+        nz[p] = pick(ok, cz * sc, 0.0f);
+        valid_out[p] = ok;
+    }
+}
+
+/// The normal at pixel (u, v) of any row and column, bounds checked: tangents along both
+/// axes (tangent()), their cross product, oriented towards the camera. The kernel of the
+/// pixels near the frame's border (interior_normals does the others). Cost: O(1).
+void edge_normal(const OrganizedCloud& cloud, int u, int v, int r, float jump_per_m, NormalMap& out) {
+    const int W = cloud.width, H = cloud.height;
+    const std::size_t p = static_cast<std::size_t>(v) * W + u;
+    out.nx[p] = out.ny[p] = out.nz[p] = 0.0f;
+    out.valid[p] = 0;
+    if (!cloud.valid[p]) return;
+    const float max_jump = jump_per_m * cloud.z[p];
+    Vec3 du, dv;
+    if (!tangent(cloud, p, p - r, p + r, u - r >= 0, u + r < W, max_jump, du)) return;
+    if (!tangent(cloud, p, p - static_cast<std::size_t>(r) * W, p + static_cast<std::size_t>(r) * W, v - r >= 0,
+                 v + r < H, max_jump, dv))
+        return;
+    // n = dv x du points towards the camera for a surface facing it (x right, y down).
+    Vec3 n{dv.y * du.z - dv.z * du.y, dv.z * du.x - dv.x * du.z, dv.x * du.y - dv.y * du.x};
+    const float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+    if (!(len > 1e-12f)) return;
+    float s = 1.0f / len;
+    // Orient towards the camera: the normal and the ray to the point are opposed.
+    if (n.x * cloud.x[p] + n.y * cloud.y[p] + n.z * cloud.z[p] > 0) s = -s;
+    out.nx[p] = n.x * s;
+    out.ny[p] = n.y * s;
+    out.nz[p] = n.z * s;
+    out.valid[p] = 1;
+}
+
+/// o[u] = the sum of h[u - r .. u + r] (the part inside [0, W)), added left to right from
+/// 0 (the sum's order fixes its bits). With SSE2, blocks of 16 columns keep their sums in
+/// four registers while the window slides over them: one load and one add per 4 columns
+/// and window pixel, where a pass per shifted row also loads and stores the sums (and
+/// GCC, given the block as a loop, keeps the sums in memory). Cost: O(W r).
+void row_window_sums(const float* h, int W, int r, float* o) {
+    auto one = [&](int u) {
+        float sum = 0.0f;
+        for (int k = std::max(-r, -u); k <= std::min(r, W - 1 - u); ++k) sum += h[u + k];
+        o[u] = sum;
+    };
+    int u = 0;
+    for (; u < std::min(r, W); ++u) one(u);
+#if defined(__SSE2__)
+    for (; u + 16 <= W - r; u += 16) {
+        __m128 s0 = _mm_setzero_ps(), s1 = s0, s2 = s0, s3 = s0;
+        for (const float* q = h + u - r; q <= h + u + r; ++q) {
+            s0 = _mm_add_ps(s0, _mm_loadu_ps(q));
+            s1 = _mm_add_ps(s1, _mm_loadu_ps(q + 4));
+            s2 = _mm_add_ps(s2, _mm_loadu_ps(q + 8));
+            s3 = _mm_add_ps(s3, _mm_loadu_ps(q + 12));
+        }
+        _mm_storeu_ps(o + u, s0);
+        _mm_storeu_ps(o + u + 4, s1);
+        _mm_storeu_ps(o + u + 8, s2);
+        _mm_storeu_ps(o + u + 12, s3);
+    }
+#endif
+    for (; u < W; ++u) one(u);
+}
+
+/// (x, y, z)[u] scaled to unit length where `valid` and the length exceeds 1e-6 (valid_out
+/// = 1), else to 0 (valid_out = 0). A multiply by the picked scale, never a branch: the
+/// loop vectorizes; built for AVX2 and baseline x86-64 (no FMA either way: the same bits).
+/// Cost: one pass over the row.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void renormalize_row(const std::uint8_t* __restrict valid, int W, float* __restrict x, float* __restrict y,
+                     float* __restrict z, std::uint8_t* __restrict valid_out) {
+    for (int u = 0; u < W; ++u) {
+        const float len = std::sqrt(x[u] * x[u] + y[u] * y[u] + z[u] * z[u]);
+        const bool ok = (valid[u] != 0) & (len > 1e-6f);
+        const float sc = pick(ok, 1.0f / len, 0.0f);
+        x[u] *= sc;
+        y[u] *= sc;
+        z[u] *= sc;
+        valid_out[u] = ok;
+    }
+}
+
 }  // namespace
 
 void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, NormalMap& out) {
@@ -70,31 +199,19 @@ void estimate_normals(const NormalParams& params, const OrganizedCloud& cloud, N
 
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            out.nx[p] = out.ny[p] = out.nz[p] = 0.0f;
-            out.valid[p] = 0;
-            if (!cloud.valid[p]) continue;
-            const float max_jump = jump_per_m * cloud.z[p];
-            Vec3 du, dv;
-            if (!tangent(cloud, p, p - r, p + r, u - r >= 0, u + r < W, max_jump, du)) continue;
-            if (!tangent(cloud, p, p - static_cast<std::size_t>(r) * W,
-                         p + static_cast<std::size_t>(r) * W, v - r >= 0, v + r < H, max_jump,
-                         dv))
-                continue;
-            // n = dv x du points towards the camera for a surface facing it (x right, y down).
-            Vec3 n{dv.y * du.z - dv.z * du.y, dv.z * du.x - dv.x * du.z,
-                   dv.x * du.y - dv.y * du.x};
-            const float len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-            if (!(len > 1e-12f)) continue;
-            float s = 1.0f / len;
-            // Orient towards the camera: the normal and the ray to the point are opposed.
-            if (n.x * cloud.x[p] + n.y * cloud.y[p] + n.z * cloud.z[p] > 0) s = -s;
-            out.nx[p] = n.x * s;
-            out.ny[p] = n.y * s;
-            out.nz[p] = n.z * s;
-            out.valid[p] = 1;
+        // The pixels whose neighbours r columns and r rows away all lie in the frame take
+        // the vectorized kernel, those nearer the border the bounds-checked one.
+        const bool inner_row = v >= r && v + r < H && W > 2 * r;
+        if (!inner_row) {
+            for (int u = 0; u < W; ++u) edge_normal(cloud, u, v, r, jump_per_m, out);
+            continue;
         }
+        for (int u = 0; u < r; ++u) edge_normal(cloud, u, v, r, jump_per_m, out);
+        const std::size_t row = static_cast<std::size_t>(v) * W;
+        interior_normals(cloud.x.data(), cloud.y.data(), cloud.z.data(), cloud.valid.data(), row + r, row + W - r,
+                         static_cast<std::size_t>(r), static_cast<std::size_t>(r) * W, jump_per_m, out.nx.data(),
+                         out.ny.data(), out.nz.data(), out.valid.data());
+        for (int u = W - r; u < W; ++u) edge_normal(cloud, u, v, r, jump_per_m, out);
     }
 }
 
@@ -152,31 +269,13 @@ void smooth_normals(const NormalMap& in, int radius_px, std::vector<float>& scra
             }
         }
     }
-    // Horizontal window sums straight into the output, one shifted row at a time (each
-    // pass vectorizes), then renormalized.
+    // Horizontal window sums straight into the output, then renormalized.
 #pragma omp parallel for schedule(static)
     for (int v = rb; v < re; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * W;
         float* const dst[3] = {out.nx.data() + row, out.ny.data() + row, out.nz.data() + row};
-        for (int c = 0; c < 3; ++c) {
-            const float* const h = planes[c] + row;
-            float* const o = dst[c];
-            std::fill(o, o + W, 0.0f);
-            for (int k = -r; k <= r; ++k) {
-                const int ua = std::max(0, -k), ub = std::min(W, W - k);  // 0 <= u + k < W
-                for (int u = ua; u < ub; ++u) o[u] += h[u + k];
-            }
-        }
-        for (int u = 0; u < W; ++u) {
-            const float x = dst[0][u], y = dst[1][u], z = dst[2][u];
-            const float len = std::sqrt(x * x + y * y + z * z);
-            const bool ok = in.valid[row + u] && len > 1e-6f;
-            const float sc = ok ? 1.0f / len : 0.0f;
-            dst[0][u] = x * sc;
-            dst[1][u] = y * sc;
-            dst[2][u] = z * sc;
-            out.valid[row + u] = ok;
-        }
+        for (int c = 0; c < 3; ++c) row_window_sums(planes[c] + row, W, r, dst[c]);
+        renormalize_row(in.valid.data() + row, W, dst[0], dst[1], dst[2], out.valid.data() + row);
     }
 }
 

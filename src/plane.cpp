@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "branch_free.hpp"
 #include "param_check.hpp"
 #include "point_moments.hpp"
 #include "wul3d/error.hpp"
@@ -140,9 +141,15 @@ struct HullMask {
         if (!(gu >= 0.0f && gv >= 0.0f && gu < fw && gv < fh)) return -1;
         return static_cast<std::ptrdiff_t>(static_cast<std::size_t>(gv) * w + static_cast<std::size_t>(gu));
     }
-    bool has_foot(float x, float y, float z, float h) const {
-        const std::ptrdiff_t cell = foot_cell(x, y, z, h);
-        return cell >= 0 && mask[cell] != 0;
+    /// foot_cell as int, without a branch (vectorizes): -1 off the image.
+    int foot_cell_or_none(float x, float y, float z, float h) const {
+        const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
+        const float inv_z = 1.0f / fz;
+        const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
+        const bool in = (fz > 1e-3f) & (gu >= 0.0f) & (gv >= 0.0f) & (gu < fw) & (gv < fh);
+        // Off the image gu, gv may be anything (inf, NaN): 0 instead, so the conversion is defined.
+        const int cu = static_cast<int>(detail::pick(in, gu, 0.0f)), cv = static_cast<int>(detail::pick(in, gv, 0.0f));
+        return cv * static_cast<int>(w) + cu - !in;  // cu = cv = 0 off the image
     }
 };
 
@@ -606,6 +613,50 @@ std::size_t keep_all_active(const std::vector<std::uint8_t>& active, std::vector
     return static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
 }
 
+/// What classify_pixels tests per pixel: the cloud, normals and active mask (raw
+/// pointers), the support and its band, and its extent.
+struct PixelTest {
+    const float *xs, *ys, *zs, *nxs, *nys, *nzs;
+    const std::uint8_t *act, *has_normal;
+    Plane pl;
+    Band on_band;
+    float cos_inlier;
+    HullMask hull;
+};
+
+/// classify_pixels' per-pixel test up to the hull lookup, for pixels [p0, p0 + n): what the
+/// hull decides (`hull_makes`: object above the band, foot on it where the normal faces
+/// otherwise, else removed; removed where inactive), the hull cell under the pixel (`cell`,
+/// -1 off the image) and whether it lies on the band (`near`). Branch-free so that it
+/// vectorizes; built for AVX2 and baseline x86-64 (no FMA either way: the same bits).
+/// Cost: one pass.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void hull_candidates(const PixelTest& t, std::size_t p0, int n, std::uint8_t* __restrict hull_makes,
+                     std::uint8_t* __restrict near, int* __restrict cell) {
+    // Locals: a byte store may alias `t` as far as the compiler knows.
+    const float *const xs = t.xs, *const ys = t.ys, *const zs = t.zs;
+    const float *const nxs = t.nxs, *const nys = t.nys, *const nzs = t.nzs;
+    const std::uint8_t *const act = t.act, *const has_normal = t.has_normal;
+    const float pnx = t.pl.nx, pny = t.pl.ny, pnz = t.pl.nz, pd = t.pl.d, cos_inlier = t.cos_inlier;
+    const Band on_band = t.on_band;
+    const HullMask hull = t.hull;
+    for (int j = 0; j < n; ++j) {
+        const std::size_t p = p0 + j;
+        const float x = xs[p], y = ys[p], z = zs[p];
+        const float h = pnx * x + pny * y + pnz * z + pd, band = on_band(z);
+        const bool faces_otherwise = (h > -band) & (has_normal[p] != 0) &
+                                     (nxs[p] * pnx + nys[p] * pny + nzs[p] * pnz < cos_inlier);
+        // Arithmetic, not `?:`, which GCC keeps as branches here.
+        const bool above = h > band;
+        const int makes = above * kPlaneObject + (!above & faces_otherwise) * kPlaneFoot;
+        hull_makes[j] = static_cast<std::uint8_t>(makes * (act[p] != 0));
+        near[j] = (act[p] != 0) & (std::fabs(h) <= band);
+        cell[j] = hull.foot_cell_or_none(x, y, z, h);
+    }
+}
+
 /// 6. Classify every pixel: below or on the plane (and facing like it) is removed; on the
 /// band but facing otherwise is a candidate foot; above and over the support is object.
 /// In: the support `pl` and its extent `ws.hull`. Out: `classes` (N, PlaneClass), `ws.on_band`
@@ -627,35 +678,33 @@ std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const 
     const std::uint8_t *const act = active.data(), *const has_normal = normals.valid.data();
     std::uint8_t* const cls = classes.data();
     std::uint8_t* const band_out = ws.on_band.data();
-    // ... and the plane as plain values (a byte store could change it too, as far as the
-    // compiler knows); the mask and `on_band` are local copies for the same reason.
+    // ... and the mask a local copy for the same reason. Per chunk of a row, the arithmetic
+    // in hull_candidates (vectorized), then the hull lookups and counts here.
     const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
-    const float pnx = pl.nx, pny = pl.ny, pnz = pl.nz, pd = pl.d;
+    const PixelTest test{xs, ys, zs, nxs, nys, nzs, act, has_normal, pl, on_band, cos_inlier, hull};
+    constexpr int kChunk = 64;  // pixels per call of hull_candidates
 #pragma omp parallel for schedule(static) reduction(+ : kept)
     for (int v = 0; v < H; ++v) {
         int runs = 0;
         std::uint8_t previous = 0;
-        for (int u = 0; u < W; ++u) {
-            const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            std::uint8_t c = kPlaneRemoved;
-            std::uint8_t on_band_removed = 0;
-            if (act[p]) {
-                const float x = xs[p], y = ys[p], z = zs[p];
-                const float h = pnx * x + pny * y + pnz * z + pd, band = on_band(z);
-                if (h > band) {
-                    if (hull.has_foot(x, y, z, h)) c = kPlaneObject;
-                } else if (h > -band && has_normal[p] &&
-                           nxs[p] * pnx + nys[p] * pny + nzs[p] * pnz < cos_inlier &&
-                           hull.has_foot(x, y, z, h)) {
-                    c = kPlaneFoot;
-                }
-                on_band_removed = c == kPlaneRemoved && std::fabs(h) <= band;
+        for (int u0 = 0; u0 < W; u0 += kChunk) {
+            const std::size_t p0 = static_cast<std::size_t>(v) * W + u0;
+            const int n = std::min(kChunk, W - u0);
+            std::uint8_t hull_makes[kChunk], near[kChunk];
+            int cell[kChunk];
+            hull_candidates(test, p0, n, hull_makes, near, cell);
+            // Then the hull lookups where the hull decides, and the counts.
+            for (int j = 0; j < n; ++j) {
+                const std::uint8_t c = hull_makes[j] != kPlaneRemoved && cell[j] >= 0 && hull.mask[cell[j]] != 0
+                                           ? hull_makes[j]
+                                           : std::uint8_t{kPlaneRemoved};
+                const std::uint8_t on_band_removed = c == kPlaneRemoved && near[j];
+                cls[p0 + j] = c;
+                band_out[p0 + j] = on_band_removed;
+                kept += c != kPlaneRemoved;
+                runs += on_band_removed > previous;
+                previous = on_band_removed;
             }
-            cls[p] = c;
-            band_out[p] = on_band_removed;
-            kept += c != kPlaneRemoved;
-            runs += on_band_removed > previous;
-            previous = on_band_removed;
         }
         ws.row_first_run[static_cast<std::size_t>(v) + 1] = runs;
     }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
@@ -85,17 +87,25 @@ void SegmentParams::validate() const {
 namespace detail {
 namespace {
 
-/// Connected components of the pixels with `seedable[p]`, 4-connected where depth is
-/// continuous; `ws.label` gets 1..n, returns n. Sizes in ws.sizes[1..n]. Cost: one pass over
-/// the pixels and a breadth-first search over the seedable ones (ws.queue).
+/// Connected components of the pixels with `seedable[p]` = 1 (else 0, as ws.cut holds),
+/// 4-connected where depth is continuous; `ws.label` gets 1..n, returns n. Sizes in
+/// ws.sizes[1..n]. Cost: a memchr over the pixels for the seeds and a breadth-first search
+/// over the seedable ones (ws.queue).
 int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentWorkspace& ws) {
     const int W = x.W, H = x.H;
     const std::size_t N = static_cast<std::size_t>(W) * H;
     std::fill(ws.label.begin(), ws.label.end(), 0);
     ws.sizes.assign(1, 0);
     int n = 0;
+    const std::uint8_t* const seeds = seedable.data();
     for (std::size_t seed = 0; seed < N; ++seed) {
-        if (!seedable[seed] || ws.label[seed]) continue;
+        if (!seeds[seed]) {
+            // The next seedable pixel: memchr skips the run of others (most of the frame).
+            const void* const next = std::memchr(seeds + seed, 1, N - seed);
+            if (!next) break;
+            seed = static_cast<std::size_t>(static_cast<const std::uint8_t*>(next) - seeds);
+        }
+        if (ws.label[seed]) continue;
         const int id = ++n;
         int head = 0, tail = 0;
         ws.queue[tail++] = static_cast<int>(seed);
@@ -139,15 +149,26 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
         const int v0 = H * band / kBands, v1 = H * (band + 1) / kBands;
         int* const seeds = ws.queue.data() + static_cast<std::size_t>(v0) * W;
         int count = 0;
-        for (int v = v0; v < v1; ++v)
+        for (int v = v0; v < v1; ++v) {
+            const std::size_t row = static_cast<std::size_t>(v) * W;
+            const int* const label = ws.label.data() + row;
+            // The distances first, in a loop of their own that vectorizes; it also tells a
+            // row without labels, which has no seed.
+            int* const dist = ws.dist.data() + row;
+            int any = 0;
             for (int u = 0; u < W; ++u) {
-                const std::size_t p = static_cast<std::size_t>(v) * W + u;
-                ws.dist[p] = ws.label[p] ? 0 : -1;
-                if (!ws.label[p]) continue;
+                dist[u] = label[u] ? 0 : -1;
+                any |= label[u];
+            }
+            if (!any) continue;
+            for (int u = 0; u < W; ++u) {
+                if (!label[u]) continue;
+                const std::size_t p = row + u;
                 if ((u > 0 && grows_into(p - 1)) || (u + 1 < W && grows_into(p + 1)) ||
                     (v > 0 && grows_into(p - W)) || (v + 1 < H && grows_into(p + W)))
                     seeds[count++] = static_cast<int>(p);
             }
+        }
         band_seeds[band] = count;
     }
     for (int band = 0; band < kBands; ++band) {
@@ -237,33 +258,39 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
     if (prm.merge_max_concave <= 0 || n < 2) return 0;
     const int W = x.W, H = x.H, s = prm.crease_step_px;
     ws.edges.clear();
-    for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
-            const int p = v * W + u;
-            const int a = ws.label[static_cast<std::size_t>(p)];
-            if (a == 0) continue;
-            const int dirs[2][2] = {{1, 0}, {0, 1}};
-            for (const auto& d : dirs) {
-                if (u + d[0] >= W || v + d[1] >= H) continue;
-                const int q = p + d[0] + d[1] * W;
-                const int b = ws.label[static_cast<std::size_t>(q)];
-                if (b == 0 || b == a) continue;
-                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
-                const int pu = u - s * d[0], pv = v - s * d[1];
-                const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
-                std::uint64_t tested = 0, concave = 0;
-                if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
-                    const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
-                    const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
-                    if (ws.label[pp] == a && ws.label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
-                        tested = 1;
-                        concave = x.concavity(pp, qq) > prm.concavity;
-                    }
-                }
-                const auto lo = static_cast<std::uint64_t>(std::min(a, b));
-                const auto hi = static_cast<std::uint64_t>(std::max(a, b));
-                ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+    const int* const label = ws.label.data();
+    // The pair (p, q = p + d) of segments a and b, q right of or below p.
+    auto boundary_pair = [&](int u, int v, int a, int b, const int (&d)[2]) {
+        const int p = v * W + u, q = p + d[0] + d[1] * W;
+        if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) return;
+        const int pu = u - s * d[0], pv = v - s * d[1];
+        const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
+        std::uint64_t tested = 0, concave = 0;
+        if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
+            const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
+            const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
+            if (label[pp] == a && label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
+                tested = 1;
+                concave = x.concavity(pp, qq) > prm.concavity;
             }
+        }
+        const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+        const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+        ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+    };
+    static constexpr int kRight[2] = {1, 0}, kDown[2] = {0, 1};
+    for (int v = 0; v < H; ++v) {
+        const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
+        // A row without labels has no pair (told by a loop that vectorizes).
+        int any = 0;
+        for (int u = 0; u < W; ++u) any |= row[u];
+        if (!any) continue;
+        for (int u = 0; u < W; ++u) {
+            const int a = row[u];
+            if (a == 0) continue;
+            // Right, then down, as before; most neighbours are unlabelled or of segment a.
+            if (u + 1 < W && row[u + 1] != 0 && row[u + 1] != a) boundary_pair(u, v, a, row[u + 1], kRight);
+            if (v + 1 < H && row[u + W] != 0 && row[u + W] != a) boundary_pair(u, v, a, row[u + W], kDown);
         }
     }
     std::sort(ws.edges.begin(), ws.edges.end());
@@ -361,7 +388,21 @@ void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentWor
     const float concavity = x.prm.concavity, steps = static_cast<float>(s);
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
-        for (int u = 0; u < W; ++u) {
+        // Only the columns from the row's first object pixel (memchr) to its last can hold
+        // a pair; the others get no bits.
+        const std::uint8_t* const cls_row = cls + static_cast<std::size_t>(v) * W;
+        std::uint8_t* const crease_row = crease + static_cast<std::size_t>(v) * W;
+        const void* const first = std::memchr(cls_row, kPlaneObject, static_cast<std::size_t>(W));
+        if (!first) {
+            std::memset(crease_row, 0, static_cast<std::size_t>(W));
+            continue;
+        }
+        const int u0 = static_cast<int>(static_cast<const std::uint8_t*>(first) - cls_row);
+        int u1 = W;
+        while (cls_row[u1 - 1] != kPlaneObject) --u1;
+        std::memset(crease_row, 0, static_cast<std::size_t>(u0));
+        std::memset(crease_row + u1, 0, static_cast<std::size_t>(W - u1));
+        for (int u = u0; u < u1; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             std::uint8_t bits = 0;
             if (cls[p] == kPlaneObject && has_normal[p]) {

@@ -458,13 +458,15 @@ double principal_axis(const double (&cov)[3][3], double (&e)[3]) {
 /// a line of mixed colour at an edge, pull 2-means into a part of their own, which the
 /// share test then rejects; they move the principal axis little (generated tune seeds
 /// 88.5 -> 89.8 Overlap F, docs/ABLATION.md). False, and no seeds, when the colour spread
-/// cannot hold parts `min_spread` apart (feature units). Cost: three passes over the
-/// segment's planes.
-bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6]) {
-    double mean[6] = {};
+/// cannot hold parts `min_spread` apart (feature units). `total`: the planes' sums (in
+/// double, pixel order), which two_means needs too. Cost: three passes over the segment's
+/// planes.
+bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6], double (&total)[6]) {
+    double mean[6];
     for (int q = 0; q < 6; ++q) {
-        for (int i = 0; i < m; ++i) mean[q] += f[q][i];
-        mean[q] /= m;
+        total[q] = 0;
+        for (int i = 0; i < m; ++i) total[q] += f[q][i];
+        mean[q] = total[q] / m;
     }
     const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
     // The parts' mean colours lie among the segment's colours, so they are at most the
@@ -493,15 +495,14 @@ bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2
 
 /// 2-means (eq. 4 squared) on one segment's feature planes, m pixels, from the centres `cen`:
 /// side[i] gets pixel i's part, `cen` the parts' means and `count` their sizes (the last
-/// iteration's; a part may be empty). Cost: at most 6 passes over the 6 planes, stopping when
-/// no pixel changes part; float sums per block of 1024, added up in double; no allocation.
-void two_means(const float* const* planes, int m, std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+/// iteration's; a part may be empty). `total`: the planes' sums (seed_centres'); part 0's
+/// sums are the totals minus part 1's. Cost: at most 6 passes over the 6 planes, stopping
+/// when no pixel changes part; float sums per block of 1024, added up in double; no
+/// allocation.
+void two_means(const float* const* planes, int m, const double (&total)[6], std::uint8_t* side, float (&cen)[2][6],
+               int (&count)[2]) {
     const float* f[6];  // a local copy: the stores to `side` cannot alias it
     for (int q = 0; q < 6; ++q) f[q] = planes[q];
-    // Totals once: part 0's sums are the totals minus part 1's.
-    double total[6] = {};
-    for (int q = 0; q < 6; ++q)
-        for (int i = 0; i < m; ++i) total[q] += f[q][i];
     for (int it = 0; it < 6; ++it) {
         // Nearer centre 1 than centre 0 (eq. 4 squared): |f - c1|^2 < |f - c0|^2, i.e.
         // 2 f . (c0 - c1) < |c0|^2 - |c1|^2, a linear test per pixel.
@@ -528,10 +529,11 @@ void two_means(const float* const* planes, int m, std::uint8_t* side, float (&ce
                 side[i] = j;
                 block_ones += j;
             }
-            for (int i = i0; i < i1; ++i) {
-                const float mask = side[i];
-                for (int q = 0; q < 6; ++q) block[q] += mask * f[q][i];
-            }
+            // Part 1's pixels only: a pixel of part 0 would add 0 * f = +-0, which changes
+            // no sum (the features are finite).
+            for (int i = i0; i < i1; ++i)
+                if (side[i])
+                    for (int q = 0; q < 6; ++q) block[q] += f[q][i];
             for (int q = 0; q < 6; ++q) sum1[q] += block[q];
             ones += block_ones;
             changed += block_changed;
@@ -649,10 +651,11 @@ bool try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane
     const float* f[6];  // the segment's features
     for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
     float cen[2][6];
-    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen)) return false;
+    double total[6];
+    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen, total)) return false;
     std::uint8_t* const side = ws.part_in_order.data() + o;
     int count[2] = {0, 0};
-    two_means(f, m, side, cen, count);
+    two_means(f, m, total, side, cen, count);
     std::uint8_t* part = ws.part.data();
     for (int i = 0; i < m; ++i) part[px[i]] = side[i];
     const int small = std::min(count[0], count[1]);
@@ -807,16 +810,31 @@ FrameEdge find_frame_edge(const Ctx& x) {
 /// The support's middle in depth: the mean depth of the removed points on it. Walls and
 /// furniture leave the volume beyond it; on the near half an object cut by the frame (at
 /// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
-/// table's near edge, is still on the table. Cost: one pass over the pixels.
+/// table's near edge, is still on the table. Cost: one pass over the pixels, per chunk a
+/// branch-free loop that tells the points on the support (vectorizes), then the sum over
+/// them in pixel order (a double sum in another order would round otherwise).
 float support_middle_depth(const Ctx& x, const Plane& pl) {
+    const float *const xs = x.c.x.data(), *const ys = x.c.y.data(), *const zs = x.c.z.data();
+    const std::uint8_t *const valid = x.c.valid.data(), *const cls = x.cls.data();
+    const float jump_m = x.prm.depth_jump_m, jump_rel = x.prm.depth_jump_rel;
+    const Plane plane = pl;
+    constexpr std::size_t kChunk = 256;
+    std::uint8_t on[kChunk];
     double table_z = 0, table_n = 0;
-    for (std::size_t p = 0; p < x.c.size(); ++p) {
-        if (!x.c.valid[p] || x.cls[p] != kPlaneRemoved) continue;
-        const float z = x.c.z[p];
-        if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p])) > x.depth_step(z))
-            continue;
-        table_z += z;
-        table_n += 1;
+    for (std::size_t p0 = 0; p0 < x.c.size(); p0 += kChunk) {
+        const std::size_t n = std::min(kChunk, x.c.size() - p0);
+        for (std::size_t j = 0; j < n; ++j) {
+            const std::size_t p = p0 + j;
+            const float z = zs[p];
+            // Ctx::depth_step(z), written out on the plain values; `!(a > b)` as before.
+            on[j] = (valid[p] != 0) & (cls[p] == kPlaneRemoved) &
+                    !(std::fabs(plane.height(xs[p], ys[p], z)) > jump_m + jump_rel * z * z);
+        }
+        for (std::size_t j = 0; j < n; ++j) {
+            if (!on[j]) continue;
+            table_z += zs[p0 + j];
+            table_n += 1;
+        }
     }
     return table_n > 0 ? static_cast<float>(table_z / table_n) : 0.0f;
 }
@@ -905,8 +923,10 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 ws.scope_outside[li] += on_top;
                 ws.scope_frame[li] += on_edge - on_top;
             }
-            if (u + 1 < fe.right) pair(p, p + 1);
-            if (v + 1 < fe.bottom) pair(p, p + static_cast<std::size_t>(W));
+            // Most pairs join equal labels and add nothing: that test stays here, in line
+            // (GCC does not inline `pair`, called twice).
+            if (u + 1 < fe.right && label[p] != label[p + 1]) pair(p, p + 1);
+            if (v + 1 < fe.bottom && label[p] != label[p + W]) pair(p, p + static_cast<std::size_t>(W));
         }
     }
     std::sort(ws.edges.begin(), ws.edges.end());
