@@ -1,7 +1,18 @@
 #pragma once
-// Selects without a branch, for the per-pixel loops that GCC should vectorize.
+// Selects without a branch, for the per-pixel loops that GCC should vectorize, and the
+// attribute that builds such a loop twice.
 #include <bit>
 #include <cstdint>
+
+/// Before a function: built for AVX2 and for baseline x86-64, the one the CPU runs picked at
+/// load time (GCC's target_clones, an ifunc). No FMA either way, so both give the same bits.
+/// Off under AddressSanitizer: an ifunc's resolver runs while the program is relocated,
+/// before the sanitizer's runtime is up.
+#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
+#define WUL3D_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define WUL3D_AVX2_CLONES
+#endif
 
 namespace wul3d::detail {
 

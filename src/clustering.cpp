@@ -9,6 +9,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "branch_free.hpp"
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/stop.hpp"
@@ -261,9 +262,7 @@ struct CentreView {
 /// (as FAISS does): the inner loop runs over contiguous points and vectorizes whatever k
 /// is. Built twice, for AVX2 and for baseline x86-64, picked at load time: baseline SSE2 has
 /// no blend, so GCC keeps the arg-min scalar there.
-#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+WUL3D_AVX2_CLONES
 void assign_block(const CentreView& c, const PointView& pb, int* winner, float* fmin) {
     const std::size_t m = pb.m;
     // Colours and the normal flag as floats first: with 8-bit loads in it, GCC does not

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 
+#include "branch_free.hpp"
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/pipeline.hpp"
@@ -61,9 +62,7 @@ struct OwnBlockTest {
 /// same float operations: the same answers. `&`, not `&&`: a branch per pixel would keep
 /// the loop from vectorizing. Built for AVX2 and baseline x86-64 (no FMA either way).
 /// Cost: one pass over the W pixels.
-#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+WUL3D_AVX2_CLONES
 void takes_own_block(const std::uint16_t* __restrict full, const float* __restrict block, int W, OwnBlockTest t,
                      std::uint8_t* __restrict takes_own) {
     for (int u = 0; u < W; ++u) {

@@ -75,9 +75,7 @@ using detail::pick;
 /// vectorizes. Same operations on each pixel, hence the same bits. Built for AVX2 and for
 /// baseline x86-64, picked at load time (as assign_block in clustering.cpp; AVX2 brings no
 /// FMA, so the same bits). Cost: one pass.
-#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+WUL3D_AVX2_CLONES
 void interior_normals(const float* __restrict x, const float* __restrict y, const float* __restrict z,
                       const std::uint8_t* __restrict valid, std::size_t p0, std::size_t p1, std::size_t du,
                       std::size_t dv, float jump_per_m, float* __restrict nx, float* __restrict ny,
@@ -174,9 +172,7 @@ void row_window_sums(const float* h, int W, int r, float* o) {
 /// = 1), else to 0 (valid_out = 0). A multiply by the picked scale, never a branch: the
 /// loop vectorizes; built for AVX2 and baseline x86-64 (no FMA either way: the same bits).
 /// Cost: one pass over the row.
-#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+WUL3D_AVX2_CLONES
 void renormalize_row(const std::uint8_t* __restrict valid, int W, float* __restrict x, float* __restrict y,
                      float* __restrict z, std::uint8_t* __restrict valid_out) {
     for (int u = 0; u < W; ++u) {

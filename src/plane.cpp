@@ -630,9 +630,7 @@ struct PixelTest {
 /// -1 off the image) and whether it lies on the band (`near`). Branch-free so that it
 /// vectorizes; built for AVX2 and baseline x86-64 (no FMA either way: the same bits).
 /// Cost: one pass.
-#if defined(__x86_64__) && !defined(__SANITIZE_ADDRESS__)
-__attribute__((target_clones("avx2", "default")))
-#endif
+WUL3D_AVX2_CLONES
 void hull_candidates(const PixelTest& t, std::size_t p0, int n, std::uint8_t* __restrict hull_makes,
                      std::uint8_t* __restrict near, int* __restrict cell) {
     // Locals: a byte store may alias `t` as far as the compiler knows.
