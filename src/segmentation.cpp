@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <cstring>
 #include <limits>
 #include <sstream>
 
