@@ -122,7 +122,9 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
     if (m < 3) return;
     mean /= m;
     height /= m;
-    const auto [centre, R2] = fit_circle(x, plane_xy, mean, for_edge);
+    const std::pair<Eigen::Vector2d, double> fit = fit_circle(x, plane_xy, mean, for_edge);
+    const Eigen::Vector2d centre = fit.first;  // not a structured binding: lambdas capture it
+    const double R2 = fit.second;
     if (!(R2 > 0) || !std::isfinite(R2)) return;
     const double R = std::sqrt(R2);
     // Geometric residual, and the widest chord: the farthest edge pixel from the mean,
@@ -616,7 +618,9 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     });
     if (walls < 3 || 4 * walls < m) return false;
     mean /= walls;
-    const auto [centre, R2] = fit_circle(x, plane_xy, mean, for_walls);
+    const std::pair<Eigen::Vector2d, double> fit = fit_circle(x, plane_xy, mean, for_walls);
+    const Eigen::Vector2d centre = fit.first;  // not a structured binding: lambdas capture it
+    const double R2 = fit.second;
     const double max_r = prm.color_round_max_radius_m;
     if (!(R2 > 0) || !std::isfinite(R2) || R2 > max_r * max_r) return false;
     const double R = std::sqrt(R2), cos_radial = std::cos(prm.color_round_deg * kDegToRad);
