@@ -16,6 +16,11 @@ namespace wul3d::detail {
 
 constexpr float kDegToRad = 3.14159265358979f / 180.0f;
 
+/// The largest depth step between neighbours on one surface at depth z, metres: the
+/// sensor's noise, which grows with z^2. On plain values, so that loops that call it keep
+/// vectorizing.
+inline float sensor_depth_step(float jump_m, float jump_rel, float z) { return jump_m + jump_rel * z * z; }
+
 /// What every phase reads: the parameters, the frame and the normals of the crease tests
 /// (smoothed when normal_smooth_px > 0), the plane's classes per pixel.
 struct Ctx {
@@ -25,9 +30,8 @@ struct Ctx {
     const std::vector<std::uint8_t>& cls;
     int W, H;
 
-    /// The largest depth step between neighbours on one surface at depth z, metres: the
-    /// sensor's noise, which grows with z^2.
-    float depth_step(float z) const { return prm.depth_jump_m + prm.depth_jump_rel * z * z; }
+    /// sensor_depth_step with this frame's parameters.
+    float depth_step(float z) const { return sensor_depth_step(prm.depth_jump_m, prm.depth_jump_rel, z); }
     bool connected(std::size_t p, std::size_t q, float steps = 1.0f) const {
         const float z = c.z[p];
         return std::fabs(z - c.z[q]) <= steps * depth_step(z);

@@ -830,9 +830,9 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
         for (std::size_t j = 0; j < n; ++j) {
             const std::size_t p = p0 + j;
             const float z = zs[p];
-            // Ctx::depth_step(z), written out on the plain values; `!(a > b)` as before.
+            // `!(a > b)` as before.
             on[j] = (valid[p] != 0) & (cls[p] == kPlaneRemoved) &
-                    !(std::fabs(plane.height(xs[p], ys[p], z)) > jump_m + jump_rel * z * z);
+                    !(std::fabs(plane.height(xs[p], ys[p], z)) > sensor_depth_step(jump_m, jump_rel, z));
         }
         for (std::size_t j = 0; j < n; ++j) {
             if (!on[j]) continue;
