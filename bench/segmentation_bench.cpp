@@ -30,6 +30,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
         sum.containers += stats.ms.containers;
         sum.color += stats.ms.color;
         sum.gaps += stats.ms.gaps;
+        sum.occluded += stats.ms.occluded;
         sum.scope += stats.ms.scope;
         sum.compact += stats.ms.compact;
     }
@@ -43,6 +44,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     state.counters["containers_ms"] = Counter(sum.containers, Counter::kAvgIterations);
     state.counters["color_ms"] = Counter(sum.color, Counter::kAvgIterations);
     state.counters["gaps_ms"] = Counter(sum.gaps, Counter::kAvgIterations);
+    state.counters["occluded_ms"] = Counter(sum.occluded, Counter::kAvgIterations);
     state.counters["scope_ms"] = Counter(sum.scope, Counter::kAvgIterations);
     state.counters["compact_ms"] = Counter(sum.compact, Counter::kAvgIterations);
 }

@@ -77,6 +77,10 @@ void SegmentParams::validate() const {
     require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
     require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
     require(gap_max_px >= 0, "gap_max_px", gap_max_px, ">= 0");
+    require(occluded_min_lines >= 0, "occluded_min_lines", occluded_min_lines, ">= 0");
+    require(occluded_max_offset > 0, "occluded_max_offset", occluded_max_offset, "> 0");
+    require(occluded_max_gap_m > 0, "occluded_max_gap_m", occluded_max_gap_m, "> 0");
+    require(occluded_max_deg > 0 && occluded_max_deg < 90, "occluded_max_deg", occluded_max_deg, "in (0, 90)");
     require(scope_contact_m > 0, "scope_contact_m", scope_contact_m, "> 0");
     require(scope_max_height_m > 0, "scope_max_height_m", scope_max_height_m, "> 0");
     require(scope_max_outside >= 0 && scope_max_outside <= 1, "scope_max_outside", scope_max_outside, "in [0, 1]");
@@ -516,6 +520,8 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     if (!kmeans) {
         stats.gaps_filled = fill_container_gaps(x, ws);
         stats.ms.gaps = ms_since();
+        stats.occluded = join_occluded(x, ws, n);
+        stats.ms.occluded = ms_since();
     }
     if (support && params.scope == Scope::Support) {
         stats.support_scope = true;

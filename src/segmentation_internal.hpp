@@ -92,6 +92,10 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
 /// n + 1, n + 2, ... in segment order. Returns the splits.
 int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n);
 
+/// Occlusion (SegmentParams, "Occlusion"): joins the two parts of a surface that a nearer
+/// object divides in view. Returns the joins.
+int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n);
+
 /// Scope::Support (docs/DESIGN.md, "Scope"): clears the labels of the segments the support
 /// does not hold. Returns the segments of min_points or more left out.
 int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);

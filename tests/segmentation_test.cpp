@@ -574,3 +574,52 @@ TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
     expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the sticker hid the contact between the boxes");
     EXPECT_EQ(stats.color_splits, 1);
 }
+
+namespace {
+/// A long box lying across the table, and a narrow tall box standing before its middle: the
+/// lying box shows one part each side of the standing one. With `two_boxes`, two short
+/// boxes stand there instead, the right one 2.5 cm farther back and 2.5 cm taller: two
+/// objects whose faces are parallel but not one plane.
+Scene box_behind_an_occluder(bool two_boxes) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 3;
+    const SceneBox occluder{.x = 0.0f, .z = 0.88f, .w = 0.07f, .h = 0.22f, .d = 0.06f, .r = 60, .g = 160, .b = 60};
+    if (!two_boxes) {
+        s.boxes = {SceneBox{.x = 0.0f, .z = 1.0f, .w = 0.4f, .h = 0.08f, .d = 0.1f}, occluder};
+    } else {
+        s.boxes = {SceneBox{.x = -0.11f, .z = 1.0f, .w = 0.18f, .h = 0.08f, .d = 0.1f},
+                   SceneBox{.x = 0.11f, .z = 1.025f, .w = 0.18f, .h = 0.105f, .d = 0.1f}, occluder};
+    }
+    return s;
+}
+}  // namespace
+
+// A box lying behind a standing one: the sensor sees two parts, left and right, with the
+// standing box between them in view. They lie on one surface, and what lies between stands
+// in front of it: the occlusion rule joins them. Its premise is asserted: without the rule
+// the lying box comes out in two parts.
+TEST(SegmentObjects, BoxSeenBothSidesOfAnOccluder_IsOneObject) {
+    const PlaneStage st = up_to_the_plane(box_behind_an_occluder(false));
+    SegmentParams off;
+    off.occluded_min_lines = 0;
+    const LabelImage apart = segment(st, off);
+    ASSERT_LT(dominant_share(apart.labels, st.truth, kTruthBox0), 0.7)
+        << "the standing box should divide the lying one (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    expect_separate(out, st.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the lying box was joined to the standing one");
+    EXPECT_GE(stats.occluded, 1);
+}
+
+// The same view with two boxes behind the standing one, at different depths and heights:
+// their faces are not one surface, so the rule leaves them apart.
+TEST(SegmentObjects, TwoBoxesBehindAnOccluder_StayApart) {
+    const PlaneStage st = up_to_the_plane(box_behind_an_occluder(true));
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    expect_separate(out, st.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "two boxes behind the occluder were joined");
+    int c = 0;
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 2, &c), 0.9);
+    EXPECT_EQ(stats.occluded, 0);
+}

@@ -5,13 +5,14 @@
 /// crease: a per-pixel version of LCCP's convexity test between neighbouring normals) and
 /// where depth jumps, takes connected components, then re-attaches the cut pixels and the
 /// objects' feet to the component they touch, merges segments that meet along a boundary
-/// that is mostly not concave, and joins a container's inside, seen over its rim, to its
-/// outer wall. The hybrid segmenter adds the colour cue of
-/// the paper's weighted clustering where geometry is silent (two flush boxes of different
-/// colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
+/// that is mostly not concave, joins a container's inside, seen over its rim, to its outer
+/// wall, and joins the two parts of a surface that a nearer object divides in view. The
+/// hybrid segmenter adds the colour cue of the paper's weighted clustering where geometry
+/// is silent (two flush boxes of different colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "wul3d/cloud.hpp"
@@ -104,6 +105,17 @@ struct SegmentParams {
     /// plane's island test) joins that segment. A true hole (a mug's handle, the table seen
     /// through it) touches no inside and stays. Patches up to this many pixels; 0 = off.
     int gap_max_px = 500;
+    // Occlusion: a nearer object that hides the middle of a surface (a box standing before a
+    // lying one) leaves two segments, one each side, where there is one object. The two
+    // parts lie on one plane and face the same way, and what lies between them in view
+    // stands in front of that plane. Lines of pixels that cross from one part, over the
+    // occluder, onto the other part's surface are the evidence; such a pair is joined.
+    int occluded_min_lines = 8;        ///< crossing lines to join two parts; >= 0, 0 = off
+    float occluded_max_offset = 1.0f;  ///< their mean height over the first part's plane, in
+                                       ///< sensor steps (depth_jump_m + depth_jump_rel z^2),
+                                       ///< at most; > 0
+    float occluded_max_gap_m = 0.3f;   ///< a line's two ends at most this far apart; > 0
+    float occluded_max_deg = 20;       ///< the normals at a line's two ends within this; (0, 90)
     // Scope (needs the support plane; docs/DESIGN.md, "Scope"): with Scope::Support a segment
     // is an object when it stands on the support, or rests on a segment that does, and stays
     // within the support's volume: over its hull (PlaneParams::hull_margin_px) and up to a
@@ -157,6 +169,8 @@ struct SegmentWorkspace {
     std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
+    std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
+                                                                  ///< offset per line (steps)
     // Containers:
     std::vector<BoundaryStep> steps;   ///< boundary pairs of two segments
     std::vector<int> rim_rows;         ///< first and last row of each segment
@@ -184,16 +198,18 @@ struct SegmentStats {
     int color_splits = 0;  ///< splits the colour cue made, both rounds (each adds a segment)
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim
+    int occluded = 0;      ///< parts of one surface joined across the object before them
     std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached
     bool support_scope = false;  ///< Scope::Support was applied (a support was found)
     int out_of_scope = 0;        ///< segments of min_points or more the scope left out
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
     /// components, re-attachment, convexity merge, container rule, colour cue, floor gaps,
-    /// the scope, and the renumbering passes with the output. For the profile in bench/.
+    /// occlusion, the scope, and the renumbering passes with the output. For the profile in
+    /// bench/.
     struct Phases {
         double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
-               color = 0, gaps = 0, scope = 0, compact = 0;
+               color = 0, gaps = 0, occluded = 0, scope = 0, compact = 0;
     } ms;
 };
 
