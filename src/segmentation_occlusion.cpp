@@ -18,7 +18,8 @@ namespace {
 /// two sensor steps, and 5 % of the distance for the surface's curvature and the normals'
 /// noise), faces the same way (normals within occluded_max_deg), is at most
 /// occluded_max_gap_m away, and is not the occluder's own far edge; `offset` gets its height
-/// over the plane in sensor steps. Returns 0 otherwise. Cost: the pixels crossed.
+/// over the plane in sensor steps. Returns 0 otherwise. Cost: the pixels crossed; a line
+/// ends at 0.3 m (occluded_max_gap_m) or after 4 crease steps without a point.
 int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, int dv, float cos_max,
                    float& offset) {
     const OrganizedCloud& c = x.c;
@@ -30,7 +31,7 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
     float nx = x.n.nx[p], ny = x.n.ny[p], nz = x.n.nz[p];
     if (nx * c.x[p] + ny * c.y[p] + nz * c.z[p] > 0) nx = -nx, ny = -ny, nz = -nz;  // toward the camera
     const float step = x.depth_step(c.z[p]);
-    int crossed = 0, n_occ = 0;
+    int crossed = 0, n_occ = 0, skipped = 0;
     int occluders[4] = {0, 0, 0, 0};  // the last four segments crossed, and their pixels
     int occluder_px[4] = {0, 0, 0, 0};
     for (int k = 1;; ++k) {
@@ -39,8 +40,14 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
         const std::size_t r = static_cast<std::size_t>(rv) * x.W + ru;
         const int b = label[r];
         if (b == a) return 0;
-        // The occluder's shadow, and points left between segments (a depth edge's mixed pixels).
-        if (!c.valid[r] || (b == 0 && x.cls[r] != kPlaneRemoved)) continue;
+        // The occluder's shadow, and points left between segments (a depth edge's mixed
+        // pixels), up to 4 crease steps in a row: a longer run without depth is no shadow
+        // but the view past the depth range or a cropped frame, and it bounds the line.
+        if (!c.valid[r] || (b == 0 && x.cls[r] != kPlaneRemoved)) {
+            if (++skipped > 4 * s) return 0;
+            continue;
+        }
+        skipped = 0;
         const float dx = c.x[r] - c.x[p], dy = c.y[r] - c.y[p], dz = c.z[r] - c.z[p];
         const float dist = std::sqrt(dx * dx + dy * dy + dz * dz);
         if (dist > x.prm.occluded_max_gap_m) return 0;
