@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "segmentation_internal.hpp"
@@ -103,15 +104,25 @@ int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n) {
         const auto hi = static_cast<std::uint64_t>(std::max(a, b));
         lines.push_back({(lo << 32) | hi, offset});
     };
+    ws.occluded_outline.resize(static_cast<std::size_t>(W));
+    std::uint8_t* const outline = ws.occluded_outline.data();
     for (int v = 0; v < H; ++v) {
         const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
         // A row without labels starts no line (told by a loop that vectorizes).
         int any = 0;
         for (int u = 0; u < W; ++u) any |= row[u];
         if (!any) continue;
-        for (int u = 0; u < W; ++u) {  // right, then down; each pair is met from one side
+        // Outline pixels, whose right or lower neighbour is not of their segment, in a
+        // branch-free pass; the lines start from those few.
+        const int* const below = v + 1 < H ? row + W : row;
+        for (int u = 0; u + 1 < W; ++u)
+            outline[u] = static_cast<std::uint8_t>((row[u] != 0) & ((row[u + 1] != row[u]) | (below[u] != row[u])));
+        outline[W - 1] = static_cast<std::uint8_t>((row[W - 1] != 0) & (below[W - 1] != row[W - 1]));
+        for (int u = 0;; ++u) {  // right, then down; each pair is met from one side
+            const void* next = std::memchr(outline + u, 1, static_cast<std::size_t>(W - u));
+            if (!next) break;
+            u = static_cast<int>(static_cast<const std::uint8_t*>(next) - outline);
             const int a = row[u];
-            if (a == 0) continue;
             if (u + 1 < W && row[u + 1] != a) try_line(a, u, v, 1, 0);
             if (v + 1 < H && row[u + W] != a) try_line(a, u, v, 0, 1);
         }

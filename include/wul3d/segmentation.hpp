@@ -171,6 +171,7 @@ struct SegmentWorkspace {
     std::vector<int> parent;           ///< union-find over segments
     std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
                                                                   ///< offset per line (steps)
+    std::vector<std::uint8_t> occluded_outline;  ///< occlusion: 1 = outline pixel, one row
     // Containers:
     std::vector<BoundaryStep> steps;   ///< boundary pairs of two segments
     std::vector<int> rim_rows;         ///< first and last row of each segment
