@@ -8,7 +8,8 @@
 /// that is mostly not concave, joins a container's inside, seen over its rim, to its outer
 /// wall, and joins the two parts of a surface that a nearer object divides in view. The
 /// hybrid segmenter adds the colour cue of the paper's weighted clustering where geometry
-/// is silent (two flush boxes of different colours). The kmeans segmenter is the paper's clustering alone, split into connected parts.
+/// is silent (two flush boxes of different colours). The kmeans segmenter is the paper's
+/// clustering alone, split into connected parts.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -114,7 +115,8 @@ struct SegmentParams {
     float occluded_max_offset = 1.0f;  ///< their mean height over the first part's plane, in
                                        ///< sensor steps (depth_jump_m + depth_jump_rel z^2),
                                        ///< at most; > 0
-    float occluded_max_gap_m = 0.3f;   ///< a line's two ends at most this far apart; > 0
+    float occluded_max_gap_m = 0.3f;   ///< a line's points at most this far from its start
+                                       ///< (the occluder, the landing); > 0
     float occluded_max_deg = 20;       ///< the normals at a line's two ends within this; (0, 90)
     // Scope (needs the support plane; docs/DESIGN.md, "Scope"): with Scope::Support a segment
     // is an object when it stands on the support, or rests on a segment that does, and stays
