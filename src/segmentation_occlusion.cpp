@@ -70,25 +70,14 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
     }
 }
 
-}  // namespace
-
-/// The occlusion rule (SegmentParams, "Occlusion"). From each outline pixel of a segment a
-/// whose right or lower neighbour is a nearer segment (or points between segments), crosses
-/// what stands in front of a's plane (cross_occluder); each crossing that lands on another
-/// segment b lying on that plane is a line of evidence that a and b are one surface with
-/// the occluder before its middle. A pair joins with occluded_min_lines lines or more whose
-/// mean offset from a's plane is at most occluded_max_offset sensor steps: one line's
-/// tolerance takes the sensor's noise, the mean takes two faces a little apart. In:
-/// ws.label (1..n with gaps). Out: ws.label with the pairs joined. Cost: one pass over the
-/// pixels; each line crosses its occluder; a sort of the lines; a relabel pass when
-/// anything joined.
-int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n) {
-    const SegmentParams& prm = x.prm;
-    if (prm.occluded_min_lines <= 0 || n < 2) return 0;
+/// The lines of evidence (cross_occluder) from every outline pixel of every segment whose
+/// right or lower neighbour is nearer (a segment, or points between segments), into
+/// ws.occluded_lines as (segment pair, offset). Cost: a branch-free pass per row with labels
+/// to find the outline pixels, then the lines from those.
+void collect_lines(const Ctx& x, SegmentWorkspace& ws, float cos_max) {
     const int W = x.W, H = x.H;
     const int* const label = ws.label.data();
     const OrganizedCloud& c = x.c;
-    const float cos_max = std::cos(prm.occluded_max_deg * kDegToRad);
     auto& lines = ws.occluded_lines;
     lines.clear();
     // A line starts where a's outline meets a nearer segment, or points between segments.
@@ -127,6 +116,22 @@ int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n) {
             if (v + 1 < H && row[u + W] != a) try_line(a, u, v, 0, 1);
         }
     }
+}
+
+}  // namespace
+
+/// The occlusion rule (SegmentParams, "Occlusion"). Each line of evidence (collect_lines,
+/// cross_occluder) that lands on another segment b lying on a's plane says that a and b are
+/// one surface with the occluder before its middle. A pair joins with occluded_min_lines
+/// lines or more whose mean offset from a's plane is at most occluded_max_offset sensor
+/// steps: one line's tolerance takes the sensor's noise, the mean takes two faces a little
+/// apart. In: ws.label (1..n with gaps). Out: ws.label with the pairs joined. Cost:
+/// collect_lines; a sort of the lines; a relabel pass when anything joined.
+int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    if (prm.occluded_min_lines <= 0 || n < 2) return 0;
+    collect_lines(x, ws, std::cos(prm.occluded_max_deg * kDegToRad));
+    auto& lines = ws.occluded_lines;
     if (lines.empty()) return 0;
     std::sort(lines.begin(), lines.end());
     reset_sets(ws.parent, n);
