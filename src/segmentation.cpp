@@ -284,10 +284,7 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
     static constexpr int kRight[2] = {1, 0}, kDown[2] = {0, 1};
     for (int v = 0; v < H; ++v) {
         const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
-        // A row without labels has no pair (told by a loop that vectorizes).
-        int any = 0;
-        for (int u = 0; u < W; ++u) any |= row[u];
-        if (!any) continue;
+        if (!row_has_label(row, 0, W)) continue;  // a row without labels has no pair
         for (int u = 0; u < W; ++u) {
             const int a = row[u];
             if (a == 0) continue;

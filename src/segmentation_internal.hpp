@@ -21,6 +21,15 @@ constexpr float kDegToRad = 3.14159265358979f / 180.0f;
 /// vectorizing.
 inline float sensor_depth_step(float jump_m, float jump_rel, float z) { return jump_m + jump_rel * z * z; }
 
+/// Whether any of row[from, to) holds a label: an OR over the row, a loop that vectorizes,
+/// so that the per-pixel passes skip the rows without objects (most rows above and below
+/// them).
+inline bool row_has_label(const int* row, int from, int to) {
+    int any = 0;
+    for (int u = from; u < to; ++u) any |= row[u];
+    return any != 0;
+}
+
 /// What every phase reads: the parameters, the frame and the normals of the crease tests
 /// (smoothed when normal_smooth_px > 0), the plane's classes per pixel.
 struct Ctx {

@@ -30,7 +30,8 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
     const std::size_t p = static_cast<std::size_t>(av) * x.W + au;  // the plane's anchor
     if (label[p] != a || !c.valid[p] || !x.n.valid[p]) return 0;
     float nx = x.n.nx[p], ny = x.n.ny[p], nz = x.n.nz[p];
-    if (nx * c.x[p] + ny * c.y[p] + nz * c.z[p] > 0) nx = -nx, ny = -ny, nz = -nz;  // toward the camera
+    // Toward the camera: the normals are, but a smoothed one at a grazing angle may not be.
+    if (nx * c.x[p] + ny * c.y[p] + nz * c.z[p] > 0) nx = -nx, ny = -ny, nz = -nz;
     const float step = x.depth_step(c.z[p]);
     int crossed = 0, n_occ = 0, skipped = 0;
     int occluders[4] = {0, 0, 0, 0};  // the last four segments crossed, and their pixels
@@ -97,10 +98,7 @@ void collect_lines(const Ctx& x, SegmentWorkspace& ws, float cos_max) {
     std::uint8_t* const outline = ws.occluded_outline.data();
     for (int v = 0; v < H; ++v) {
         const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
-        // A row without labels starts no line (told by a loop that vectorizes).
-        int any = 0;
-        for (int u = 0; u < W; ++u) any |= row[u];
-        if (!any) continue;
+        if (!row_has_label(row, 0, W)) continue;  // a row without labels starts no line
         // Outline pixels, whose right or lower neighbour is not of their segment, in a
         // branch-free pass; the lines start from those few.
         const int* const below = v + 1 < H ? row + W : row;

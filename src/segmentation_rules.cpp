@@ -30,12 +30,8 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
     ws.steps.clear();
     ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
     for (int v = 0; v < H; ++v) {
-        // Only labelled pixels add anything: a row without one is told by an OR over it (a
-        // loop that vectorizes) and skipped.
-        const int* const row = label.data() + static_cast<std::size_t>(v) * W;
-        int any = 0;
-        for (int u = 0; u < W; ++u) any |= row[u];
-        if (any == 0) continue;
+        // Only labelled pixels add anything.
+        if (!row_has_label(label.data() + static_cast<std::size_t>(v) * W, 0, W)) continue;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int a = label[p];
@@ -78,6 +74,12 @@ struct PlaneAxes {
         return Eigen::Vector2d(X.dot(e1), X.dot(e2));
     }
 };
+
+/// Whether pixel p has a normal within the angle whose sine is `sin_max` of the support
+/// plane: it faces sideways (a wall, a can's side). Shared by the round test and the scope.
+bool faces_sideways(const Ctx& x, const Plane& pl, std::size_t p, float sin_max) {
+    return x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_max;
+}
 
 /// A circle on the support plane through the points `for_points` visits (it calls its
 /// argument with each pixel), by algebraic least squares (Kasa), centred on their mean
@@ -606,8 +608,7 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     auto for_walls = [&](auto&& visit) {
         for (int i = 0; i < m; ++i) {
             const auto p = static_cast<std::size_t>(px[i]);
-            if (x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_wall)
-                visit(p);
+            if (faces_sideways(x, pl, p, sin_wall)) visit(p);
         }
     };
     double walls = 0;
@@ -893,17 +894,14 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
         }
     };
     // A row without a label whose next row has none either adds nothing (every pair in it
-    // and down from it joins two unlabelled pixels): told by a loop that vectorizes, and
-    // skipped. Mostly the rows above and below the objects.
-    auto row_has_label = [&](int v) {
-        int any = 0;
-        for (int u = fe.left; u < fe.right; ++u) any |= label[static_cast<std::size_t>(v) * W + u];
-        return any != 0;
+    // and down from it joins two unlabelled pixels), and is skipped.
+    auto labelled_row = [&](int v) {
+        return row_has_label(label + static_cast<std::size_t>(v) * W, fe.left, fe.right);
     };
-    bool next_has_label = fe.top < fe.bottom && row_has_label(fe.top);
+    bool next_has_label = fe.top < fe.bottom && labelled_row(fe.top);
     for (int v = fe.top; v < fe.bottom; ++v) {
         const bool has_label = next_has_label;
-        next_has_label = v + 1 < fe.bottom && row_has_label(v + 1);
+        next_has_label = v + 1 < fe.bottom && labelled_row(v + 1);
         if (!has_label && !next_has_label) continue;
         for (int u = fe.left; u < fe.right; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
@@ -948,8 +946,8 @@ void count_upright(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     const float sin_upright = std::sin(kUprightDeg * kDegToRad);
     for (std::size_t p = 0; p < x.c.size(); ++p) {
         const auto l = static_cast<std::size_t>(ws.label[p]);
-        if (l == 0 || ws.scope_frame[l] == 0 || !x.n.valid[p]) continue;
-        ws.scope_upright[l] += std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_upright;
+        if (l == 0 || ws.scope_frame[l] == 0) continue;
+        ws.scope_upright[l] += faces_sideways(x, pl, p, sin_upright);
     }
 }
 
