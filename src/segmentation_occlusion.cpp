@@ -32,6 +32,7 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
     float nx = x.n.nx[p], ny = x.n.ny[p], nz = x.n.nz[p];
     // Toward the camera: the normals are, but a smoothed one at a grazing angle may not be.
     if (nx * c.x[p] + ny * c.y[p] + nz * c.z[p] > 0) nx = -nx, ny = -ny, nz = -nz;
+    const float anchor_side = nx * c.x[p] + ny * c.y[p] + nz * c.z[p];  // < 0: the plane faces the camera
     const float step = x.depth_step(c.z[p]);
     int crossed = 0, n_occ = 0, skipped = 0;
     int occluders[4] = {0, 0, 0, 0};  // the last four segments crossed, and their pixels
@@ -51,9 +52,16 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
         }
         skipped = 0;
         const float dx = c.x[r] - c.x[p], dy = c.y[r] - c.y[p], dz = c.z[r] - c.z[p];
-        const float dist = std::sqrt(dx * dx + dy * dy + dz * dz);
-        if (dist > x.prm.occluded_max_gap_m) return 0;
         const float h = nx * dx + ny * dy + nz * dz;  // over a's plane, toward the camera
+        // How far along a's surface the line has come: from the anchor to where r's
+        // viewing ray meets a's plane. Not r's own distance, which for an occluder near
+        // the camera is its height in front of a, not the width it hides.
+        const float toward = nx * c.x[r] + ny * c.y[r] + nz * c.z[r];
+        if (toward > -1e-6f) return 0;  // r's ray runs along a's plane or away from it
+        const float t = anchor_side / toward;
+        const float gx = t * c.x[r] - c.x[p], gy = t * c.y[r] - c.y[p], gz = t * c.z[r] - c.z[p];
+        const float dist = std::sqrt(gx * gx + gy * gy + gz * gz);
+        if (dist > x.prm.occluded_max_gap_m) return 0;
         const float tol = 2.0f * step + 0.05f * dist;
         if (h > tol) {
             if (b == 0) return 0;  // in front of a but the support's: no occluder

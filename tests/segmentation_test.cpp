@@ -579,11 +579,12 @@ namespace {
 /// A long box lying across the table, and a narrow tall box standing before its middle: the
 /// lying box shows one part each side of the standing one. With `two_boxes`, two short
 /// boxes stand there instead, the right one 2.5 cm farther back and 2.5 cm taller: two
-/// objects whose faces are parallel but not one plane.
-Scene box_behind_an_occluder(bool two_boxes) {
+/// objects whose faces are parallel but not one plane. The standing box is `occluder_z` from
+/// the camera and `occluder_h` tall.
+Scene box_behind_an_occluder(bool two_boxes, float occluder_z = 0.88f, float occluder_h = 0.22f) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 3;
-    const SceneBox occluder{.x = 0.0f, .z = 0.88f, .w = 0.07f, .h = 0.22f, .d = 0.06f, .r = 60, .g = 160, .b = 60};
+    const SceneBox occluder{.x = 0.0f, .z = occluder_z, .w = 0.07f, .h = occluder_h, .d = 0.06f, .r = 60, .g = 160, .b = 60};
     if (!two_boxes) {
         s.boxes = {SceneBox{.x = 0.0f, .z = 1.0f, .w = 0.4f, .h = 0.08f, .d = 0.1f}, occluder};
     } else {
@@ -600,6 +601,25 @@ Scene box_behind_an_occluder(bool two_boxes) {
 // the lying box comes out in two parts.
 TEST(SegmentObjects, BoxSeenBothSidesOfAnOccluder_IsOneObject) {
     const PlaneStage st = up_to_the_plane(box_behind_an_occluder(false));
+    SegmentParams off;
+    off.occluded_min_lines = 0;
+    const LabelImage apart = segment(st, off);
+    ASSERT_LT(dominant_share(apart.labels, st.truth, kTruthBox0), 0.7)
+        << "the standing box should divide the lying one (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    expect_separate(out, st.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the lying box was joined to the standing one");
+    EXPECT_GE(stats.occluded, 1);
+}
+
+// The same with the standing box 0.4 m nearer the camera than the lying one (and taller, to
+// hide its middle still): its points lie
+// farther from the lying box than occluded_max_gap_m, but that bounds the width a line
+// spans on the lying box's plane, which is what the occluder hides, not its height in
+// front of it.
+TEST(SegmentObjects, BoxBehindAnOccluderNearTheCamera_IsOneObject) {
+    const PlaneStage st = up_to_the_plane(box_behind_an_occluder(false, 0.6f, 0.4f));
     SegmentParams off;
     off.occluded_min_lines = 0;
     const LabelImage apart = segment(st, off);
