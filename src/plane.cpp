@@ -132,12 +132,21 @@ struct HullMask {
     float gfx, gfy, gcx, gcy;  // intrinsics in grid cells, centres + 0.5 (cell by truncation)
     float nx, ny, nz;        // the plane's normal
 
+    /// A foot below the frame's bottom edge is tested on that edge's row. A camera looking
+    /// down on a table cuts off the table's near part with the frame's bottom, and a foot
+    /// lies lower in the image than its point, so the nearest objects' feet fall out of
+    /// the frame with the table running on under them: where the hull reaches the bottom
+    /// edge there, they are over the support; where the table's near edge is in view, the
+    /// hull stops above it and they are not. Beyond the top and sides a foot stays off the
+    /// image (docs/ABLATION.md, "Feet below the frame").
+    float below_to_edge(float gv) const { return std::min(gv, fh - 0.5f); }
+
     /// The grid cell the foot projects into, -1 off the image.
     std::ptrdiff_t foot_cell(float x, float y, float z, float h) const {
         const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
         if (fz <= 1e-3f) return -1;
         const float inv_z = 1.0f / fz;
-        const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
+        const float gu = gfx * fx * inv_z + gcx, gv = below_to_edge(gfy * fy * inv_z + gcy);
         if (!(gu >= 0.0f && gv >= 0.0f && gu < fw && gv < fh)) return -1;
         return static_cast<std::ptrdiff_t>(static_cast<std::size_t>(gv) * w + static_cast<std::size_t>(gu));
     }
@@ -145,7 +154,7 @@ struct HullMask {
     int foot_cell_or_none(float x, float y, float z, float h) const {
         const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
         const float inv_z = 1.0f / fz;
-        const float gu = gfx * fx * inv_z + gcx, gv = gfy * fy * inv_z + gcy;
+        const float gu = gfx * fx * inv_z + gcx, gv = below_to_edge(gfy * fy * inv_z + gcy);
         const bool in = (fz > 1e-3f) & (gu >= 0.0f) & (gv >= 0.0f) & (gu < fw) & (gv < fh);
         // Off the image gu, gv may be anything (inf, NaN): 0 instead, so the conversion is defined.
         const int cu = static_cast<int>(detail::pick(in, gu, 0.0f)), cv = static_cast<int>(detail::pick(in, gv, 0.0f));

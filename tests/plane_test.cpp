@@ -158,6 +158,50 @@ TEST(RemoveSupportPlane, TiltedTable_RemovesTableKeepsBoxesAndTheirFeet) {
     }
 }
 
+// A box standing where the frame's bottom cuts it, on a table that runs on out of the
+// frame toward the camera: its nearest points' feet (moved down the table's normal) fall
+// below the frame, off the image. They are tested on the frame's bottom row, which the
+// table's extent reaches: the box is kept whole, the table under it still removed.
+TEST(RemoveSupportPlane, BoxCutByTheFramesBottom_KeptWhereTheTableRunsOn) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox near_box;
+    near_box.z = 0.5f;
+    near_box.d = 0.1f;
+    near_box.h = 0.1f;
+    SceneBox far_box = near_box;
+    far_box.x = 0.25f;
+    far_box.z = 1.1f;
+    s.boxes = {near_box, far_box};
+    std::vector<int> truth;
+    Prepared f = prepared(render_scene(s, &truth));
+    // Premise: the frame's bottom row shows the near box and the table beside it.
+    const std::size_t bottom = static_cast<std::size_t>(s.height - 1) * s.width;
+    int box_at_bottom = 0, table_at_bottom = 0;
+    for (int u = 0; u < s.width; ++u) {
+        box_at_bottom += truth[bottom + u] == kTruthBox0;
+        table_at_bottom += truth[bottom + u] == kTruthTable;
+    }
+    ASSERT_GT(box_at_bottom, 10);
+    ASSERT_GT(table_at_bottom, 100);
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
+    ASSERT_TRUE(r.found);
+    std::size_t table = 0, table_kept = 0, box[2] = {0, 0}, box_kept[2] = {0, 0};
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        if (!f.active[p]) continue;
+        const bool kept = classes[p] != kPlaneRemoved;
+        if (truth[p] == kTruthTable) { ++table; table_kept += kept; }
+        for (int i = 0; i < 2; ++i)
+            if (truth[p] == kTruthBox0 + i) { ++box[i]; box_kept[i] += kept; }
+    }
+    EXPECT_LT(static_cast<double>(table_kept) / static_cast<double>(table), 0.005);
+    for (int i = 0; i < 2; ++i) {
+        ASSERT_GT(box[i], 500u);
+        EXPECT_GT(static_cast<double>(box_kept[i]) / static_cast<double>(box[i]), 0.97) << "box " << i;
+    }
+}
+
 TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
     // Only a wall in view: nothing faces up, so there is no support.
     Scene s;
