@@ -349,8 +349,58 @@ void fit_candidates(const PlaneParams& params, const std::vector<int>& roots, st
             candidates.push_back(pl);
 }
 
+/// The frame's bottom and side edges on the grid: the last row and the first and last
+/// columns that hold an active point, where the band beyond is at most 1/8 of the image (a
+/// Kinect v1's registration border without depth, a dataset's crop); -1 where it is wider,
+/// a view past the depth range, which is no edge of the frame. As the scope's frame edge
+/// (segmentation). Cost: the rows and columns of those bands, most frames a few.
+struct GridEdges {
+    int bottom = -1, left = -1, right = -1;
+};
+GridEdges find_grid_edges(const Grid& grid, const std::vector<std::uint8_t>& active) {
+    auto row_active = [&](int gv) {
+        const auto* row = active.data() + static_cast<std::size_t>(gv) * grid.w;
+        return std::any_of(row, row + grid.w, [](std::uint8_t a) { return a != 0; });
+    };
+    auto col_active = [&](int gu) {
+        for (int gv = 0; gv < grid.h; ++gv)
+            if (active[static_cast<std::size_t>(gv) * grid.w + gu]) return true;
+        return false;
+    };
+    GridEdges e;
+    for (int k = 0; k <= grid.h / 8 && e.bottom < 0; ++k)
+        if (row_active(grid.h - 1 - k)) e.bottom = grid.h - 1 - k;
+    for (int k = 0; k <= grid.w / 8 && e.left < 0; ++k)
+        if (col_active(k)) e.left = k;
+    for (int k = 0; k <= grid.w / 8 && e.right < 0; ++k)
+        if (col_active(grid.w - 1 - k)) e.right = grid.w - 1 - k;
+    return e;
+}
+
+/// Where the support's inliers (`hull_points`, each row's outermost) reach the frame's
+/// bottom edge and one of its sides (within a grid cell), the corner between them joins
+/// the hull's points. The table runs out of the frame on both, toward the camera, and an
+/// object standing in that corner hides whether the table's own corner lies there; its
+/// feet had fallen off the hull (the books in the bottom-right corner of OSD's cluttered
+/// frames). Not the top corners: beyond them lie the table's far side and the walls, and
+/// with them the extent took in the lower halves of boards hanging on the wall. O(rows).
+void add_near_corners(const GridEdges& e, std::vector<int>& hull_points) {
+    if (e.bottom < 0) return;
+    bool bottom = false, left = false, right = false;
+    for (std::size_t i = 0; i + 3 < hull_points.size(); i += 4) {
+        const int first = hull_points[i], gv = hull_points[i + 1], last = hull_points[i + 2];
+        bottom |= gv >= e.bottom - 1;
+        left |= e.left >= 0 && first <= e.left + 1;
+        right |= e.right >= 0 && last >= e.right - 1;
+    }
+    if (!bottom) return;
+    if (left) hull_points.insert(hull_points.end(), {e.left, e.bottom, e.left, e.bottom});
+    if (right) hull_points.insert(hull_points.end(), {e.right, e.bottom, e.right, e.bottom});
+}
+
 /// The support's extent: the image-space convex hull of `pl`'s inliers on the grid, widened
-/// by hull_margin_px; a point belongs over the support when its foot (the point moved down
+/// by hull_margin_px, with the frame's near corners where the inliers reach them
+/// (add_near_corners); a point belongs over the support when its foot (the point moved down
 /// the normal onto the plane) projects into it (HullMask). Out: `ws.hull` (G, 1 = inside;
 /// all 0 when fewer than 3 rows hold inliers), `ws.hull_points`. O(G) for the inlier test,
 /// then the hull of at most 2 grid.h points and a dilation over G; OpenCV allocates the
@@ -371,6 +421,7 @@ void build_hull(const PlaneParams& params, const Grid& grid, const InlierTest& i
         ws.hull_points.insert(ws.hull_points.end(), {first, gv, last, gv});
     }
     if (ws.hull_points.size() < 6) return;
+    add_near_corners(find_grid_edges(grid, ws.grid.active), ws.hull_points);
     cv::Mat pts(static_cast<int>(ws.hull_points.size() / 2), 1, CV_32SC2, ws.hull_points.data());
     std::vector<cv::Point> hull;
     cv::convexHull(pts, hull);

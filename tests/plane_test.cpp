@@ -202,6 +202,46 @@ TEST(RemoveSupportPlane, BoxCutByTheFramesBottom_KeptWhereTheTableRunsOn) {
     }
 }
 
+// A large box in the frame's bottom-right corner, on a table that runs out of the frame at
+// the bottom and at the right: the table's points reach both edges but not the corner,
+// which the box hides, and the hull of those points cuts across the box. The corner joins
+// the hull where the table reaches both edges: the box is kept whole.
+TEST(RemoveSupportPlane, BoxInTheFramesNearCorner_KeptWhereTheTableRunsOutOnBothSides) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox corner_box;
+    corner_box.x = 0.24f;
+    corner_box.z = 0.58f;
+    corner_box.w = 0.3f;
+    corner_box.d = 0.25f;
+    corner_box.h = 0.15f;
+    s.boxes = {corner_box};
+    std::vector<int> truth;
+    Prepared f = prepared(render_scene(s, &truth));
+    // Premise: the box fills the corner, and the table shows on the bottom row and on the
+    // right column.
+    const auto at = [&](int u, int v) { return truth[static_cast<std::size_t>(v) * s.width + u]; };
+    ASSERT_EQ(at(s.width - 1, s.height - 1), kTruthBox0);
+    int table_bottom = 0, table_right = 0;
+    for (int u = 0; u < s.width; ++u) table_bottom += at(u, s.height - 1) == kTruthTable;
+    for (int v = 0; v < s.height; ++v) table_right += at(s.width - 1, v) == kTruthTable;
+    ASSERT_GT(table_bottom, 20);
+    ASSERT_GT(table_right, 20);
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
+    ASSERT_TRUE(r.found);
+    std::size_t table = 0, table_kept = 0, box = 0, box_kept = 0;
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        if (!f.active[p]) continue;
+        const bool kept = classes[p] != kPlaneRemoved;
+        if (truth[p] == kTruthTable) { ++table; table_kept += kept; }
+        if (truth[p] == kTruthBox0) { ++box; box_kept += kept; }
+    }
+    EXPECT_LT(static_cast<double>(table_kept) / static_cast<double>(table), 0.005);
+    ASSERT_GT(box, 2000u);
+    EXPECT_GT(static_cast<double>(box_kept) / static_cast<double>(box), 0.97);
+}
+
 TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
     // Only a wall in view: nothing faces up, so there is no support.
     Scene s;
