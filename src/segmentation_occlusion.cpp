@@ -15,12 +15,13 @@ namespace {
 /// One line of evidence: from segment a's outline pixel (u, v) along (du, dv), across what
 /// stands in front of a's tangent plane (the occluder), to the first pixel that does not.
 /// The plane is a's tangent plane a crease step inside its outline, where the smoothed
-/// normals are not bent by the occluder's. Returns that pixel's segment b when it lies on the plane (within
-/// two sensor steps, and 5 % of the distance for the surface's curvature and the normals'
-/// noise), faces the same way (normals within occluded_max_deg), lies (as every point
-/// crossed) within occluded_max_gap_m of the plane's anchor, and is not the occluder's own far edge; `offset` gets its height
-/// over the plane in sensor steps. Returns 0 otherwise. Cost: the pixels crossed; a line
-/// ends at 0.3 m (occluded_max_gap_m) or after 4 crease steps without a point.
+/// normals are not bent by the occluder's. Returns that pixel's segment b when it lies on
+/// the plane (within two sensor steps, and 5 % of the distance for the surface's curvature
+/// and the normals' noise), faces the same way (normals within occluded_max_deg) and is
+/// not the occluder's own far edge; `offset` gets its height over the plane in sensor
+/// steps. Returns 0 otherwise. Cost: the pixels crossed; a line ends after
+/// occluded_max_gap_m of a's plane (each pixel measured where its viewing ray meets it) or
+/// after 4 crease steps without a point.
 int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, int dv, float cos_max,
                    float& offset) {
     const OrganizedCloud& c = x.c;

@@ -115,8 +115,10 @@ struct SegmentParams {
     float occluded_max_offset = 1.0f;  ///< their mean height over the first part's plane, in
                                        ///< sensor steps (depth_jump_m + depth_jump_rel z^2),
                                        ///< at most; > 0
-    float occluded_max_gap_m = 0.3f;   ///< a line's points at most this far from its start
-                                       ///< (the occluder, the landing); > 0
+    float occluded_max_gap_m = 0.3f;   ///< a line spans at most this much of the plane it
+                                       ///< starts on (each pixel where its ray meets the
+                                       ///< plane: the width hidden, not the occluder's
+                                       ///< height in front); > 0
     float occluded_max_deg = 20;       ///< the normals at a line's two ends within this; (0, 90)
     // Scope (needs the support plane; docs/DESIGN.md, "Scope"): with Scope::Support a segment
     // is an object when it stands on the support, or rests on a segment that does, and stays
