@@ -314,9 +314,11 @@ void DecimatedSource::own_blocks_of_row(int v, const std::uint8_t* usable, const
 
 // ---- the way back: expand_result --------------------------------------------------------
 
+namespace {
+
 /// expand_result's scratch: track id -> object_list index, and per row band the active pixels
 /// and each object's pixels and box; the edge blocks and their colour vote.
-struct ExpandWorkspace::Buffers {
+struct ExpandBuffers {
     /// Pixels and 2D box of one object within one band of rows.
     struct Box {
         int u_min, v_min, u_max, v_max;
@@ -357,31 +359,16 @@ struct ExpandWorkspace::Buffers {
     std::vector<BlockRow> band_rows;
 };
 
-ExpandWorkspace::ExpandWorkspace() : b_(std::make_unique<Buffers>()) {}
-ExpandWorkspace::~ExpandWorkspace() = default;
-ExpandWorkspace::ExpandWorkspace(ExpandWorkspace&&) noexcept = default;
-ExpandWorkspace& ExpandWorkspace::operator=(ExpandWorkspace&&) noexcept = default;
-
-void expand_result(const PipelineParams& params, const RgbdView& frame,
-                   const RgbdFrame& decimated, const FrameResult& s, ExpandWorkspace& ws,
-                   FrameResult& r) {
-    ExpandWorkspace::Buffers& buf = *ws.b_;
-    const int W = frame.width, H = frame.height;
-    // An input pixel takes a neighbouring block's results across a depth step no larger
-    // than the segmentation's own connection rule over the block's width.
-    const float n = static_cast<float>(params.decimation);
-    DecimatedSource source(frame.depth, W, H, frame.depth_scale_m_per_unit, decimated.depth,
-                           params.decimation,
-                           n * params.segmentation.depth_jump_m,
-                           n * params.segmentation.depth_jump_rel);
-    // Edge blocks: an object (or, without the object stages, a cluster) other than the
-    // block's own in its 3 x 3 neighbourhood. There the input's colour places the outline.
-    const LabelImage& outline = params.detect_objects ? s.objects : s.labels;
+/// 1. Edge blocks: an object (or, without the object stages, a cluster) other than the
+/// block's own in its 3 x 3 neighbourhood; there the input's colour places the outline.
+/// Separable: each pixel's row-wise minimum and maximum over three, then column-wise; an
+/// edge where the 3 x 3 minimum and maximum differ. Plain loops over rows through raw
+/// pointers, the borders clamped by the row pointers' choice, not per pixel: they
+/// vectorize. In: `outline` (w x h). Out: buf.edge_blocks (and edge_lo, edge_hi). O(w h),
+/// two parallel passes, no allocation.
+void mark_edge_blocks(const LabelImage& outline, ExpandBuffers& buf) {
     const int w = outline.width, h = outline.height;
     const std::size_t n_small = outline.labels.size();
-    // Separable: each pixel's row-wise minimum and maximum over three, then column-wise;
-    // an edge where the 3 x 3 minimum and maximum differ. Plain loops over rows through raw
-    // pointers, the borders clamped by the row pointers' choice, not per pixel: they vectorize.
     buf.edge_blocks.resize(n_small);
     buf.edge_lo.resize(n_small);
     buf.edge_hi.resize(n_small);
@@ -416,16 +403,18 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
         for (int u = 0; u < w; ++u)
             out[u] = min3(lo_up[u], lo_row[u], lo_down[u]) != max3(hi_up[u], hi_row[u], hi_down[u]);
     }
-    if (frame.has_color() && !frame.color_matches())
-        throw InputError(std::string(frame.name) + ": colour and depth sizes differ");
-    source.use_colour_at_edges(frame.rgb, decimated.color, buf.edge_blocks.data(), l, buf.block_source);
-    r.stats = s.stats;
-    r.plane = s.plane;
-    r.segment_stats = s.segment_stats;
-    r.object_list = s.object_list;
-    const bool objects = params.detect_objects;
+}
+
+/// 2. The result at the input's size W x H: `small`'s stats, plane and object list copied,
+/// its images sized (without the object stages theirs stay empty, as run_on leaves them).
+/// The pixels are written by expand_bands. O(objects) plus the resizes (none from the
+/// second frame of a size).
+void shape_result(const FrameResult& small, int W, int H, bool objects, FrameResult& r) {
+    r.stats = small.stats;
+    r.plane = small.plane;
+    r.segment_stats = small.segment_stats;
+    r.object_list = small.object_list;
     const std::size_t N = static_cast<std::size_t>(W) * H;
-    // Without the object stages their images stay empty, as run_on leaves them.
     auto shape = [](LabelImage& img, int width, int height) {
         img.width = width;
         img.height = height;
@@ -439,85 +428,104 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
     r.colors.rgb.resize(3 * N);
     r.active.resize(N);
     r.plane_classes.resize(objects ? N : 0);
+}
 
-    // Track id -> index in object_list, for each object's pixel count and 2D box.
+/// 3. Each band's counts and block row made ready: track id -> index in `objects` (for each
+/// object's pixels and 2D box), empty boxes and counts per band, and each band's block row
+/// sized for W input columns and w blocks. O(bands x objects), no allocation once sized.
+void prepare_bands(const std::vector<DetectedObject>& objects, int W, int H, int w, bool with_objects,
+                   ExpandBuffers& buf) {
     int max_id = 0;
-    for (const DetectedObject& d : r.object_list) max_id = std::max(max_id, d.id);
+    for (const DetectedObject& d : objects) max_id = std::max(max_id, d.id);
     buf.object_index.assign(static_cast<std::size_t>(max_id) + 1, -1);
-    for (std::size_t i = 0; i < r.object_list.size(); ++i)
-        buf.object_index[static_cast<std::size_t>(r.object_list[i].id)] = static_cast<int>(i);
-    const std::size_t n_obj = r.object_list.size();
-    buf.band_boxes.assign(ExpandWorkspace::Buffers::kBands * n_obj, ExpandWorkspace::Buffers::Box{W, H, -1, -1, 0});
-    buf.band_active.assign(ExpandWorkspace::Buffers::kBands, 0);
-    buf.band_rows.resize(ExpandWorkspace::Buffers::kBands);
-    for (ExpandWorkspace::Buffers::BlockRow& b : buf.band_rows) {
-        const auto n_row = static_cast<std::size_t>(W);
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        buf.object_index[static_cast<std::size_t>(objects[i].id)] = static_cast<int>(i);
+    buf.band_boxes.assign(ExpandBuffers::kBands * objects.size(), ExpandBuffers::Box{W, H, -1, -1, 0});
+    buf.band_active.assign(ExpandBuffers::kBands, 0);
+    buf.band_rows.resize(ExpandBuffers::kBands);
+    const auto n_row = static_cast<std::size_t>(W);
+    for (ExpandBuffers::BlockRow& b : buf.band_rows) {
         b.bv = -1;  // a new frame: no block row held
         b.labels.resize(n_row);
-        b.segments.resize(objects ? n_row : 0);
-        b.objects.resize(objects ? n_row : 0);
+        b.segments.resize(with_objects ? n_row : 0);
+        b.objects.resize(with_objects ? n_row : 0);
         b.rgb.resize(3 * n_row);
         b.active.resize(n_row);
-        b.classes.resize(objects ? n_row : 0);
+        b.classes.resize(with_objects ? n_row : 0);
         b.scratch.resize(n_row + static_cast<std::size_t>(w));
         b.takes_own.resize(n_row);
     }
+}
 
-    // Per row: first every pixel from its own block (nearly every pixel's source: a plain
-    // copy of the block row, each block's results loaded once), then the pixels whose source
-    // is another block or none (no depth, off their block's surface, at an outline, out of
-    // the range or on a block out of it) written again; last the row's counts and boxes.
-    // Counts and boxes per fixed row band, reduced in band order below.
-    // Raw pointers: through the vectors, every byte store would make the compiler reload
-    // every data pointer.
-    const std::uint8_t* const frame_rgb = frame.has_color() && frame.color_matches() ? frame.rgb : nullptr;
-    const std::uint16_t *const in_labels = s.labels.labels.data(), *const in_segments = s.segments.labels.data(),
-                        *const in_objects = s.objects.labels.data();
-    const std::uint8_t *const in_rgb = s.colors.rgb.data(), *const in_active = s.active.data(),
-                       *const in_classes = s.plane_classes.data();
-    std::uint16_t *const labels = r.labels.labels.data(), *const segments = r.segments.labels.data(),
-                  *const objects_out = r.objects.labels.data();
-    std::uint8_t *const colors = r.colors.rgb.data(), *const active_out = r.active.data(),
-                 *const classes = r.plane_classes.data();
-    const int* const object_index = buf.object_index.data();
-    // A pixel is in the depth range by its own depth, as at every pixel (select_depth_range):
-    // the block it takes can lie on the other side of a limit. In range, on a block that is
-    // not, it takes the nearest in depth of the 3 x 3 blocks that are (its own is: the frame
-    // was decimated to blocks in range where they could be); out of range, none.
+/// The per-pixel results, in (`small`'s, per block) and out (`r`'s, per input pixel), as
+/// raw pointers: through the vectors, every byte store would make the compiler reload every
+/// data pointer. Copied by value into each band's closures for the same reason.
+struct PixelArrays {
+    const std::uint8_t* frame_rgb;  ///< the input's colour, or nullptr
+    const std::uint16_t *in_labels, *in_segments, *in_objects;
+    const std::uint8_t *in_rgb, *in_active, *in_classes;
+    std::uint16_t *labels, *segments, *objects;
+    std::uint8_t *colors, *active, *classes;
+    bool with_objects;
+};
+
+PixelArrays pixel_arrays(const RgbdView& frame, const FrameResult& s, bool with_objects, FrameResult& r) {
+    return {frame.has_color() && frame.color_matches() ? frame.rgb : nullptr,
+            s.labels.labels.data(), s.segments.labels.data(), s.objects.labels.data(),
+            s.colors.rgb.data(), s.active.data(), s.plane_classes.data(),
+            r.labels.labels.data(), r.segments.labels.data(), r.objects.labels.data(),
+            r.colors.rgb.data(), r.active.data(), r.plane_classes.data(), with_objects};
+}
+
+/// 4. Every input pixel's results, band by band of rows in parallel. Per row: first every
+/// pixel from its own block (nearly every pixel's source: a plain copy of the block row,
+/// each block's results loaded once), then the pixels whose source is another block or none
+/// (no depth, off their block's surface, at an outline, out of the range or on a block out
+/// of it) written again; last the row's count of active pixels and each object's runs,
+/// into the band's counts and boxes (reduced in band order by count_objects). A pixel is in
+/// the depth range by its own depth, as at every pixel (select_depth_range): the block it
+/// takes can lie on the other side of a limit. In range, on a block that is not, it takes
+/// the nearest in depth of the 3 x 3 blocks that are (its own is: the frame was decimated
+/// to blocks in range where they could be); out of range, none. O(W H), one parallel pass.
+void expand_bands(const DepthRange& range, const RgbdView& frame, const DecimatedSource& source, int w,
+                  const PixelArrays& arrays, ExpandBuffers& buf) {
+    const int W = frame.width, H = frame.height;
     const float scale = frame.depth_scale_m_per_unit;
-    const DepthRange& range = params.range;
     const std::uint16_t* const depth = frame.depth;
     const int factor = source.factor();
+    const std::size_t n_obj = buf.band_boxes.size() / ExpandBuffers::kBands;
+    const int max_id = static_cast<int>(buf.object_index.size()) - 1;
+    const int* const object_index = buf.object_index.data();
+    const PixelArrays a = arrays;  // a local copy: see PixelArrays
+    const bool objects = a.with_objects;
 #pragma omp parallel for schedule(static)
-    for (int band = 0; band < ExpandWorkspace::Buffers::kBands; ++band) {
-        ExpandWorkspace::Buffers::Box* const boxes = buf.band_boxes.data() + static_cast<std::size_t>(band) * n_obj;
-        ExpandWorkspace::Buffers::BlockRow& block_row = buf.band_rows[static_cast<std::size_t>(band)];
+    for (int band = 0; band < ExpandBuffers::kBands; ++band) {
+        ExpandBuffers::Box* const boxes = buf.band_boxes.data() + static_cast<std::size_t>(band) * n_obj;
+        ExpandBuffers::BlockRow& block_row = buf.band_rows[static_cast<std::size_t>(band)];
         std::size_t active = 0;
-        // Pixel p's results from block q, or "no point" for q < 0. The pointers copied into
-        // the thread's own closure: read through the shared ones, each would be loaded again
-        // after every byte stored.
+        // Pixel p's results from block q, or "no point" for q < 0.
         auto take = [=](std::size_t p, std::int32_t q) {
-            std::uint8_t* const rgb = colors + 3 * p;
+            std::uint8_t* const rgb = a.colors + 3 * p;
             if (q < 0) {
-                labels[p] = 0;
-                rgb[0] = rgb[1] = rgb[2] = frame_rgb ? dimmed_grey(frame_rgb + 3 * p) : 0;
-                active_out[p] = 0;
+                a.labels[p] = 0;
+                rgb[0] = rgb[1] = rgb[2] = a.frame_rgb ? dimmed_grey(a.frame_rgb + 3 * p) : 0;
+                a.active[p] = 0;
                 if (!objects) return;
-                classes[p] = kPlaneRemoved;
-                segments[p] = 0;
-                objects_out[p] = 0;
+                a.classes[p] = kPlaneRemoved;
+                a.segments[p] = 0;
+                a.objects[p] = 0;
                 return;
             }
             const auto sq = static_cast<std::size_t>(q);
-            labels[p] = in_labels[sq];
-            rgb[0] = in_rgb[3 * sq];
-            rgb[1] = in_rgb[3 * sq + 1];
-            rgb[2] = in_rgb[3 * sq + 2];
-            active_out[p] = in_active[sq];
+            a.labels[p] = a.in_labels[sq];
+            rgb[0] = a.in_rgb[3 * sq];
+            rgb[1] = a.in_rgb[3 * sq + 1];
+            rgb[2] = a.in_rgb[3 * sq + 2];
+            a.active[p] = a.in_active[sq];
             if (!objects) return;
-            classes[p] = in_classes[sq];
-            segments[p] = in_segments[sq];
-            objects_out[p] = in_objects[sq];
+            a.classes[p] = a.in_classes[sq];
+            a.segments[p] = a.in_segments[sq];
+            a.objects[p] = a.in_objects[sq];
         };
         std::uint16_t *const row_labels = block_row.labels.data(), *const row_segments = block_row.segments.data(),
                       *const row_objects = block_row.objects.data();
@@ -526,17 +534,17 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
         // Block row bv's results, each block's over its columns.
         auto widen = [=](int bv) {
             const std::size_t first = static_cast<std::size_t>(bv) * w;
-            widen_row<1>(in_labels + first, factor, W, row_labels);
-            widen_row<3>(in_rgb + 3 * first, factor, W, row_rgb);
-            widen_row<1>(in_active + first, factor, W, row_active);
+            widen_row<1>(a.in_labels + first, factor, W, row_labels);
+            widen_row<3>(a.in_rgb + 3 * first, factor, W, row_rgb);
+            widen_row<1>(a.in_active + first, factor, W, row_active);
             if (!objects) return;
-            widen_row<1>(in_classes + first, factor, W, row_classes);
-            widen_row<1>(in_segments + first, factor, W, row_segments);
-            widen_row<1>(in_objects + first, factor, W, row_objects);
+            widen_row<1>(a.in_classes + first, factor, W, row_classes);
+            widen_row<1>(a.in_segments + first, factor, W, row_segments);
+            widen_row<1>(a.in_objects + first, factor, W, row_objects);
         };
         float* const scratch = block_row.scratch.data();
         std::uint8_t* const takes_own = block_row.takes_own.data();
-        for (int v = band * H / ExpandWorkspace::Buffers::kBands; v < (band + 1) * H / ExpandWorkspace::Buffers::kBands; ++v) {
+        for (int v = band * H / ExpandBuffers::kBands; v < (band + 1) * H / ExpandBuffers::kBands; ++v) {
             const int bv = v / factor;
             const std::size_t row = static_cast<std::size_t>(v) * W;
             // First every pixel from its own block, copied from the block row.
@@ -545,17 +553,17 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
                 block_row.bv = bv;
             }
             const auto n_row = static_cast<std::size_t>(W);
-            std::copy_n(row_labels, n_row, labels + row);
-            std::copy_n(row_rgb, 3 * n_row, colors + 3 * row);
-            std::copy_n(row_active, n_row, active_out + row);
+            std::copy_n(row_labels, n_row, a.labels + row);
+            std::copy_n(row_rgb, 3 * n_row, a.colors + 3 * row);
+            std::copy_n(row_active, n_row, a.active + row);
             if (objects) {
-                std::copy_n(row_classes, n_row, classes + row);
-                std::copy_n(row_segments, n_row, segments + row);
-                std::copy_n(row_objects, n_row, objects_out + row);
+                std::copy_n(row_classes, n_row, a.classes + row);
+                std::copy_n(row_segments, n_row, a.segments + row);
+                std::copy_n(row_objects, n_row, a.objects + row);
             }
             // Then the pixels that do not take their own block as it is (off its surface, out
             // of range, on a block out of it, or at an outline), one by one.
-            source.own_blocks_of_row(v, in_active, &range, scratch, takes_own);
+            source.own_blocks_of_row(v, a.in_active, &range, scratch, takes_own);
             const std::uint8_t* const end = takes_own + W;
             for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(takes_own, 0, n_row)); at != nullptr;
                  at = static_cast<const std::uint8_t*>(std::memchr(at + 1, 0, static_cast<std::size_t>(end - at - 1)))) {
@@ -565,20 +573,20 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
                 if (q >= 0) {
                     if (!range.contains(static_cast<float>(depth[p]) * scale))
                         q = -1;
-                    else if (!in_active[q])
-                        q = source.nearest_in_depth(bu, bv, depth[p], in_active);
+                    else if (!a.in_active[q])
+                        q = source.nearest_in_depth(bu, bv, depth[p], a.in_active);
                 }
                 take(p, q);
             }
             // Last the row's counts. A row's count fits in 32 bits, which sum faster.
             unsigned in_row = 0;
-            for (std::size_t u = 0; u < n_row; ++u) in_row += active_out[row + u];
+            for (std::size_t u = 0; u < n_row; ++u) in_row += a.active[row + u];
             active += in_row;
             if (!objects) continue;
             // Each run of one object id adds to its box at once. The runs' starts are found
             // by memchr in a flag per column (0: a run starts), set by a loop that
             // vectorizes; takes_own is free again to hold them.
-            const std::uint16_t* const ids = objects_out + row;
+            const std::uint16_t* const ids = a.objects + row;
             std::uint8_t* const continues = takes_own;
             continues[0] = 0;
             for (int u = 1; u < W; ++u) continues[u] = ids[u] == ids[u - 1];
@@ -594,12 +602,18 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
         }
         buf.band_active[static_cast<std::size_t>(band)] = active;
     }
+}
+
+/// 5. The bands' counts reduced in band order: r.active_points, and each object's pixels
+/// and 2D box at the input's size. O(bands x objects).
+void count_objects(int W, int H, const ExpandBuffers& buf, FrameResult& r) {
     r.active_points = 0;
     for (std::size_t a : buf.band_active) r.active_points += a;
+    const std::size_t n_obj = r.object_list.size();
     for (std::size_t i = 0; i < n_obj; ++i) {
         DetectedObject& d = r.object_list[i];
-        ExpandWorkspace::Buffers::Box total{W, H, -1, -1, 0};
-        for (int band = 0; band < ExpandWorkspace::Buffers::kBands; ++band)
+        ExpandBuffers::Box total{W, H, -1, -1, 0};
+        for (int band = 0; band < ExpandBuffers::kBands; ++band)
             total.merge(buf.band_boxes[static_cast<std::size_t>(band) * n_obj + i]);
         d.pixels = total.pixels;
         d.u_min = total.u_min;
@@ -607,11 +621,17 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
         d.u_max = total.u_max;
         d.v_max = total.v_max;
     }
-    // The tracker's minimum (ObjectParams::min_points) counts the input's pixels: the stages
-    // checked it divided by N^2 on blocks, and an object can come back a few pixels short.
-    const auto min_pixels = static_cast<std::size_t>(params.objects.min_points);
+}
+
+/// 6. Objects under `min_pixels` input pixels dropped from r.object_list and cleared from
+/// r.objects. The tracker's minimum (ObjectParams::min_points) counts the input's pixels:
+/// the stages checked it divided by N^2 on blocks, and an object can come back a few pixels
+/// short. O(objects), plus each dropped object's box.
+void drop_small_objects(std::size_t min_pixels, FrameResult& r) {
+    const int W = r.objects.width;
+    std::uint16_t* const ids = r.objects.labels.data();
     std::size_t kept = 0;
-    for (std::size_t i = 0; i < n_obj; ++i) {
+    for (std::size_t i = 0; i < r.object_list.size(); ++i) {
         DetectedObject& d = r.object_list[i];
         if (d.pixels >= min_pixels) {
             if (kept != i) r.object_list[kept] = std::move(d);
@@ -620,12 +640,49 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
         }
         for (int v = d.v_min; v <= d.v_max; ++v)
             for (int u = d.u_min; u <= d.u_max; ++u) {
-                std::uint16_t& id = objects_out[static_cast<std::size_t>(v) * W + u];
+                std::uint16_t& id = ids[static_cast<std::size_t>(v) * W + u];
                 if (id == d.id) id = 0;
             }
     }
     r.object_list.resize(kept);
 }
 
+}  // namespace
+
+/// The workspace's buffers (opaque in decimation.hpp): ExpandBuffers.
+struct ExpandWorkspace::Buffers : ExpandBuffers {};
+
+ExpandWorkspace::ExpandWorkspace() : b_(std::make_unique<Buffers>()) {}
+ExpandWorkspace::~ExpandWorkspace() = default;
+ExpandWorkspace::ExpandWorkspace(ExpandWorkspace&&) noexcept = default;
+ExpandWorkspace& ExpandWorkspace::operator=(ExpandWorkspace&&) noexcept = default;
+
+void expand_result(const PipelineParams& params, const RgbdView& frame,
+                   const RgbdFrame& decimated, const FrameResult& s, ExpandWorkspace& ws,
+                   FrameResult& r) {
+    ExpandBuffers& buf = *ws.b_;
+    const int W = frame.width, H = frame.height;
+    // An input pixel takes a neighbouring block's results across a depth step no larger
+    // than the segmentation's own connection rule over the block's width.
+    const float n = static_cast<float>(params.decimation);
+    DecimatedSource source(frame.depth, W, H, frame.depth_scale_m_per_unit, decimated.depth,
+                           params.decimation,
+                           n * params.segmentation.depth_jump_m,
+                           n * params.segmentation.depth_jump_rel);
+    // At the objects' outlines (without the object stages, the clusters') the input's
+    // colour places the outline.
+    const bool objects = params.detect_objects;
+    const LabelImage& outline = objects ? s.objects : s.labels;
+    mark_edge_blocks(outline, buf);
+    if (frame.has_color() && !frame.color_matches())
+        throw InputError(std::string(frame.name) + ": colour and depth sizes differ");
+    source.use_colour_at_edges(frame.rgb, decimated.color, buf.edge_blocks.data(), outline.labels.data(),
+                               buf.block_source);
+    shape_result(s, W, H, objects, r);
+    prepare_bands(r.object_list, W, H, outline.width, objects, buf);
+    expand_bands(params.range, frame, source, outline.width, pixel_arrays(frame, s, objects, r), buf);
+    count_objects(W, H, buf, r);
+    drop_small_objects(static_cast<std::size_t>(params.objects.min_points), r);
+}
 
 }  // namespace wul3d
