@@ -71,6 +71,23 @@ struct TableAndBooks {
     }
 };
 
+/// Of `f`'s active pixels whose ground truth is `id`: how many, and how many plane removal
+/// kept (`classes`).
+struct KeptCount {
+    std::size_t points = 0, kept = 0;
+    double share() const { return static_cast<double>(kept) / static_cast<double>(points); }
+};
+KeptCount kept_of(const Prepared& f, const std::vector<std::uint8_t>& classes, const std::vector<int>& truth,
+                  int id) {
+    KeptCount k;
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        if (!f.active[p] || truth[p] != id) continue;
+        ++k.points;
+        k.kept += classes[p] != kPlaneRemoved;
+    }
+    return k;
+}
+
 /// Tallies `f` after plane removal; `truth_of(p)` gives pixel p's ground-truth id.
 template <class TruthOf>
 TableAndBooks tally(const Prepared& f, const PlaneResult& r, const std::vector<std::uint8_t>& classes,
@@ -187,18 +204,11 @@ TEST(RemoveSupportPlane, BoxCutByTheFramesBottom_KeptWhereTheTableRunsOn) {
     std::vector<std::uint8_t> classes;
     const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
     ASSERT_TRUE(r.found);
-    std::size_t table = 0, table_kept = 0, box[2] = {0, 0}, box_kept[2] = {0, 0};
-    for (std::size_t p = 0; p < truth.size(); ++p) {
-        if (!f.active[p]) continue;
-        const bool kept = classes[p] != kPlaneRemoved;
-        if (truth[p] == kTruthTable) { ++table; table_kept += kept; }
-        for (int i = 0; i < 2; ++i)
-            if (truth[p] == kTruthBox0 + i) { ++box[i]; box_kept[i] += kept; }
-    }
-    EXPECT_LT(static_cast<double>(table_kept) / static_cast<double>(table), 0.005);
+    EXPECT_LT(kept_of(f, classes, truth, kTruthTable).share(), 0.005);
     for (int i = 0; i < 2; ++i) {
-        ASSERT_GT(box[i], 500u);
-        EXPECT_GT(static_cast<double>(box_kept[i]) / static_cast<double>(box[i]), 0.97) << "box " << i;
+        const KeptCount box = kept_of(f, classes, truth, kTruthBox0 + i);
+        ASSERT_GT(box.points, 500u);
+        EXPECT_GT(box.share(), 0.97) << "box " << i;
     }
 }
 
@@ -230,16 +240,10 @@ TEST(RemoveSupportPlane, BoxInTheFramesNearCorner_KeptWhereTheTableRunsOutOnBoth
     std::vector<std::uint8_t> classes;
     const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
     ASSERT_TRUE(r.found);
-    std::size_t table = 0, table_kept = 0, box = 0, box_kept = 0;
-    for (std::size_t p = 0; p < truth.size(); ++p) {
-        if (!f.active[p]) continue;
-        const bool kept = classes[p] != kPlaneRemoved;
-        if (truth[p] == kTruthTable) { ++table; table_kept += kept; }
-        if (truth[p] == kTruthBox0) { ++box; box_kept += kept; }
-    }
-    EXPECT_LT(static_cast<double>(table_kept) / static_cast<double>(table), 0.005);
-    ASSERT_GT(box, 2000u);
-    EXPECT_GT(static_cast<double>(box_kept) / static_cast<double>(box), 0.97);
+    EXPECT_LT(kept_of(f, classes, truth, kTruthTable).share(), 0.005);
+    const KeptCount box = kept_of(f, classes, truth, kTruthBox0);
+    ASSERT_GT(box.points, 2000u);
+    EXPECT_GT(box.share(), 0.97);
 }
 
 TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
