@@ -128,6 +128,101 @@ void set_all(ImageScore& s, double p, double r, double f, double detected_share)
     s.detected_share = detected_share;
 }
 
+/// Overlap: each object's pixels and every (ground truth, prediction) pair's common pixels,
+/// one pass over the image, and each pair's overlap F (the harmonic mean of tp / |p| and
+/// tp / |g|). Pairs index as g * np + p. Cost: O(pixels + np ng).
+struct OverlapTable {
+    std::vector<std::int64_t> size_p, size_g, tp;
+    std::int64_t all_p = 0, all_g = 0;
+    std::vector<double> f;
+};
+OverlapTable overlap_table(const LabelImage& pred, const Compact& cp, const LabelImage& gt, const Compact& cg) {
+    const int np = cp.size(), ng = cg.size();
+    const std::size_t npg = static_cast<std::size_t>(np) * static_cast<std::size_t>(ng);
+    OverlapTable t;
+    t.size_p.assign(static_cast<std::size_t>(np), 0);
+    t.size_g.assign(static_cast<std::size_t>(ng), 0);
+    t.tp.assign(npg, 0);
+    for (std::size_t q = 0; q < gt.labels.size(); ++q) {
+        const std::uint16_t a = pred.labels[q], b = gt.labels[q];
+        const int i = a ? cp.index[a] : -1;
+        const int k = b ? cg.index[b] : -1;
+        if (i >= 0) ++t.size_p[static_cast<std::size_t>(i)];
+        if (k >= 0) ++t.size_g[static_cast<std::size_t>(k)];
+        if (i >= 0 && k >= 0) ++t.tp[static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i)];
+    }
+    for (const auto n : t.size_p) t.all_p += n;
+    for (const auto n : t.size_g) t.all_g += n;
+    t.f.assign(npg, 0.0);
+    for (int k = 0; k < ng; ++k)
+        for (int i = 0; i < np; ++i) {
+            const std::size_t e = static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i);
+            t.f[e] = 2.0 * static_cast<double>(t.tp[e]) /
+                     static_cast<double>(t.size_p[static_cast<std::size_t>(i)] +
+                                         t.size_g[static_cast<std::size_t>(k)]);
+        }
+    return t;
+}
+
+/// Boundaries: the boundary pixels of both images, and for every pair the pixels of one's
+/// boundary within `tolerance_px` of the other's (hit_p[p * ng + g], hit_g[g * np + p]).
+/// Cost: O(boundary pixels x disk area).
+struct BoundaryTable {
+    std::vector<std::int64_t> hit_p, hit_g;
+    std::int64_t all_bp = 0, all_bg = 0;
+};
+BoundaryTable boundary_table(const LabelImage& pred, const Compact& cp, const LabelImage& gt, const Compact& cg,
+                             int tolerance_px) {
+    std::vector<int> bp, bg;
+    std::vector<std::int64_t> bcount_p, bcount_g;
+    boundary_pixels(pred, cp, bp, bcount_p);
+    boundary_pixels(gt, cg, bg, bcount_g);
+    BoundaryTable t;
+    for (const auto n : bcount_p) t.all_bp += n;
+    for (const auto n : bcount_g) t.all_bg += n;
+    const std::vector<Offset> offsets = disk(tolerance_px);
+    const std::size_t npg = static_cast<std::size_t>(cp.size()) * static_cast<std::size_t>(cg.size());
+    t.hit_p.assign(npg, 0);
+    t.hit_g.assign(npg, 0);
+    boundary_hits(pred, cp, bp, gt, cg, offsets, t.hit_p);
+    boundary_hits(gt, cg, bg, pred, cp, offsets, t.hit_g);
+    return t;
+}
+
+/// The scores of the matched pairs (`match`: ground truth -> prediction, -1 none) into `s`:
+/// its matches, detected objects, and the overlap and boundary precision, recall and F over
+/// all objects. Cost: O(ng).
+void score_matches(const OverlapTable& ot, const BoundaryTable& bt, const std::vector<int>& match,
+                   const Compact& cp, const Compact& cg, const EvalParams& params, ImageScore& s) {
+    const int np = cp.size(), ng = cg.size();
+    std::int64_t tp_sum = 0, bp_sum = 0, bg_sum = 0;
+    for (int k = 0; k < ng; ++k) {
+        const int i = match[static_cast<std::size_t>(k)];
+        if (i < 0) continue;
+        const std::size_t e = static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i);
+        // F = 0 (no common pixel) is no match. The reference keeps such Hungarian pairs and
+        // adds their boundary hits; which F = 0 pairs it picks is an arbitrary tie-break.
+        if (ot.tp[e] == 0) continue;
+        MatchedPair m;
+        m.gt_id = cg.ids[static_cast<std::size_t>(k)];
+        m.pred_id = cp.ids[static_cast<std::size_t>(i)];
+        m.true_positives = ot.tp[e];
+        m.overlap_f = ot.f[e];
+        s.matches.push_back(m);
+        if (ot.f[e] > params.detected_f) ++s.detected;
+        tp_sum += ot.tp[e];
+        bp_sum += bt.hit_p[static_cast<std::size_t>(i) * ng + static_cast<std::size_t>(k)];
+        bg_sum += bt.hit_g[e];
+    }
+    s.overlap_p = ratio(static_cast<double>(tp_sum), static_cast<double>(ot.all_p));
+    s.overlap_r = ratio(static_cast<double>(tp_sum), static_cast<double>(ot.all_g));
+    s.overlap_f = harmonic(s.overlap_p, s.overlap_r);
+    s.boundary_p = ratio(static_cast<double>(bp_sum), static_cast<double>(bt.all_bp));
+    s.boundary_r = ratio(static_cast<double>(bg_sum), static_cast<double>(bt.all_bg));
+    s.boundary_f = harmonic(s.boundary_p, s.boundary_r);
+    s.detected_share = static_cast<double>(s.detected) / ng;
+}
+
 }  // namespace
 
 void EvalParams::validate() const {
@@ -261,71 +356,11 @@ ImageScore score_image(const LabelImage& pred, const LabelImage& gt, const EvalP
         return s;
     }
 
-    // Overlap: object sizes and all pairwise intersections in one pass.
-    const std::size_t npg = static_cast<std::size_t>(np) * static_cast<std::size_t>(ng);
-    std::vector<std::int64_t> size_p(static_cast<std::size_t>(np), 0),
-        size_g(static_cast<std::size_t>(ng), 0), tp(npg, 0);  // tp[g * np + p]
-    std::int64_t all_p = 0, all_g = 0;
-    for (std::size_t q = 0; q < gt.labels.size(); ++q) {
-        const std::uint16_t a = pred.labels[q], b = gt.labels[q];
-        const int i = a ? cp.index[a] : -1;
-        const int k = b ? cg.index[b] : -1;
-        if (i >= 0) ++size_p[static_cast<std::size_t>(i)];
-        if (k >= 0) ++size_g[static_cast<std::size_t>(k)];
-        if (i >= 0 && k >= 0) ++tp[static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i)];
-    }
-    for (const auto n : size_p) all_p += n;
-    for (const auto n : size_g) all_g += n;
-    std::vector<double> f(npg, 0.0);
-    for (int k = 0; k < ng; ++k)
-        for (int i = 0; i < np; ++i) {
-            const std::size_t e = static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i);
-            // Harmonic mean of tp/|p| and tp/|g|.
-            f[e] = 2.0 * static_cast<double>(tp[e]) /
-                   static_cast<double>(size_p[static_cast<std::size_t>(i)] +
-                                       size_g[static_cast<std::size_t>(k)]);
-        }
-    const std::vector<int> match = hungarian_max(f, ng, np);
-
-    // Boundaries: the boundary pixels of both images, then tolerance hits for every pair.
-    std::vector<int> bp, bg;
-    std::vector<std::int64_t> bcount_p, bcount_g;
-    boundary_pixels(pred, cp, bp, bcount_p);
-    boundary_pixels(gt, cg, bg, bcount_g);
-    std::int64_t all_bp = 0, all_bg = 0;
-    for (const auto n : bcount_p) all_bp += n;
-    for (const auto n : bcount_g) all_bg += n;
-    const std::vector<Offset> offsets = disk(s.boundary_tolerance_px);
-    std::vector<std::int64_t> hit_p(npg, 0), hit_g(npg, 0);  // hit_p[p * ng + g], hit_g[g * np + p]
-    boundary_hits(pred, cp, bp, gt, cg, offsets, hit_p);
-    boundary_hits(gt, cg, bg, pred, cp, offsets, hit_g);
-
-    std::int64_t tp_sum = 0, bp_sum = 0, bg_sum = 0;
-    for (int k = 0; k < ng; ++k) {
-        const int i = match[static_cast<std::size_t>(k)];
-        if (i < 0) continue;
-        const std::size_t e = static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i);
-        // F = 0 (no common pixel) is no match. The reference keeps such Hungarian pairs and
-        // adds their boundary hits; which F = 0 pairs it picks is an arbitrary tie-break.
-        if (tp[e] == 0) continue;
-        MatchedPair m;
-        m.gt_id = cg.ids[static_cast<std::size_t>(k)];
-        m.pred_id = cp.ids[static_cast<std::size_t>(i)];
-        m.true_positives = tp[e];
-        m.overlap_f = f[e];
-        s.matches.push_back(m);
-        if (f[e] > params.detected_f) ++s.detected;
-        tp_sum += tp[e];
-        bp_sum += hit_p[static_cast<std::size_t>(i) * ng + static_cast<std::size_t>(k)];
-        bg_sum += hit_g[e];
-    }
-    s.overlap_p = ratio(static_cast<double>(tp_sum), static_cast<double>(all_p));
-    s.overlap_r = ratio(static_cast<double>(tp_sum), static_cast<double>(all_g));
-    s.overlap_f = harmonic(s.overlap_p, s.overlap_r);
-    s.boundary_p = ratio(static_cast<double>(bp_sum), static_cast<double>(all_bp));
-    s.boundary_r = ratio(static_cast<double>(bg_sum), static_cast<double>(all_bg));
-    s.boundary_f = harmonic(s.boundary_p, s.boundary_r);
-    s.detected_share = static_cast<double>(s.detected) / ng;
+    // Overlap, the best one-to-one matching by overlap F, then the boundaries.
+    const OverlapTable ot = overlap_table(pred, cp, gt, cg);
+    const std::vector<int> match = hungarian_max(ot.f, ng, np);
+    const BoundaryTable bt = boundary_table(pred, cp, gt, cg, s.boundary_tolerance_px);
+    score_matches(ot, bt, match, cp, cg, params, s);
     return s;
 }
 
