@@ -400,13 +400,13 @@ void add_near_corners(const GridEdges& e, std::vector<int>& hull_points) {
 
 /// The support's extent: the image-space convex hull of `pl`'s inliers on the grid, widened
 /// by hull_margin_px, with the frame's near corners where the inliers reach them
-/// (add_near_corners); a point belongs over the support when its foot (the point moved down
+/// (add_near_corners, the frame's `edges`); a point belongs over the support when its foot (the point moved down
 /// the normal onto the plane) projects into it (HullMask). Out: `ws.hull` (G, 1 = inside;
 /// all 0 when fewer than 3 rows hold inliers), `ws.hull_points`. O(G) for the inlier test,
 /// then the hull of at most 2 grid.h points and a dilation over G; OpenCV allocates the
 /// hull's corners and the kernel.
-void build_hull(const PlaneParams& params, const Grid& grid, const InlierTest& is_inlier,
-                const Plane& pl, PlaneWorkspace& ws) {
+void build_hull(const PlaneParams& params, const Grid& grid, const GridEdges& edges,
+                const InlierTest& is_inlier, const Plane& pl, PlaneWorkspace& ws) {
     ws.hull.assign(static_cast<std::size_t>(grid.size()), 0);
     ws.hull_points.clear();
     // The hull of a set is the hull of each row's leftmost and rightmost members.
@@ -421,7 +421,7 @@ void build_hull(const PlaneParams& params, const Grid& grid, const InlierTest& i
         ws.hull_points.insert(ws.hull_points.end(), {first, gv, last, gv});
     }
     if (ws.hull_points.size() < 6) return;
-    add_near_corners(find_grid_edges(grid, ws.grid.active), ws.hull_points);
+    add_near_corners(edges, ws.hull_points);
     cv::Mat pts(static_cast<int>(ws.hull_points.size() / 2), 1, CV_32SC2, ws.hull_points.data());
     std::vector<cv::Point> hull;
     cv::convexHull(pts, hull);
@@ -482,12 +482,12 @@ struct SupportChoice {
 /// the same foot) + 0.1 x its extent. A candidate scores at most
 /// 1.1 x its extent, so once one scores more, smaller candidates are not counted (each
 /// count builds a hull and passes over the grid). Largest first; ties go to the lower
-/// index, as in index order. In: `candidates`, `ws.grid`. Out: the choice; each counted
+/// index, as in index order. In: `candidates`, `ws.grid`, the frame's `edges`. Out: the choice; each counted
 /// candidate's `above`; `ws.by_extent`, `ws.sliver`, `ws.hull` of the last one counted.
 /// O(C log C) to rank, mark_slivers, then O(G) (a hull, a pass and a parallel pass) per
 /// candidate counted, usually one or two.
 SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics& K, const Grid& grid,
-                             const InlierTest& inliers, PlaneWorkspace& ws,
+                             const GridEdges& edges, const InlierTest& inliers, PlaneWorkspace& ws,
                              std::vector<Plane>& candidates) {
     const int G = grid.size();
     const auto& gp = ws.grid;
@@ -508,7 +508,7 @@ SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics&
         if (pl.up < params.min_up || (rank < ws.sliver.size() && ws.sliver[rank])) continue;
         const double extent = static_cast<double>(pl.inliers);
         if (extent + 0.1 * extent < best_score) break;  // the score's largest value, as computed
-        build_hull(params, grid, inliers, pl, ws);
+        build_hull(params, grid, edges, inliers, pl, ws);
         choice.hull_of = c;
         const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
         // What rises from its foot higher than anything standing on the plane is not an
@@ -940,6 +940,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     PlaneResult result;
     const Grid grid = make_grid(cloud.width, cloud.height, params.grid_stride_px);
     gather_grid(grid, cloud, normals, active, ws.grid);
+    const GridEdges edges = find_grid_edges(grid, ws.grid.active);  // the same for every hull
     const Band band{params.on_plane_m, params.on_plane_rel};
     const float cos_inlier = std::cos(params.inlier_angle_deg * kDegToRad);
     const auto& gp = ws.grid;
@@ -952,7 +953,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     fit_candidates(params, roots, grown.with_normal, inliers, ws, result.candidates);
 
     // 4-5: the support among them, refined.
-    const SupportChoice choice = choose_support(params, K, grid, inliers, ws, result.candidates);
+    const SupportChoice choice = choose_support(params, K, grid, edges, inliers, ws, result.candidates);
     if (choice.best < 0) {
         result.kept = keep_all_active(active, classes);
         return result;
@@ -963,7 +964,7 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     const Plane pl = result.support;
     // The support's extent: the chosen plane's serves unless the refinement moved the plane.
     if (choice.hull_of != choice.best || support_moved(params, chosen, pl))
-        build_hull(params, grid, inliers, pl, ws);
+        build_hull(params, grid, edges, inliers, pl, ws);
 
     // 6-7: every pixel classified; enclosed on-plane patches given back to the objects.
     std::size_t kept = classify_pixels(grid, K, cloud, normals, active, pl, band, cos_inlier, ws, classes);

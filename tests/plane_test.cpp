@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <string>
 #include <utility>
 
@@ -86,6 +88,29 @@ KeptCount kept_of(const Prepared& f, const std::vector<std::uint8_t>& classes, c
         k.kept += classes[p] != kPlaneRemoved;
     }
     return k;
+}
+
+/// Pixels of ground truth `id` on row v of a w-wide truth image, and on column u of one h high.
+int truth_on_row(const std::vector<int>& truth, int w, int v, int id) {
+    const auto row = truth.begin() + static_cast<std::ptrdiff_t>(v) * w;
+    return static_cast<int>(std::count(row, row + w, id));
+}
+int truth_on_column(const std::vector<int>& truth, int w, int h, int u, int id) {
+    int n = 0;
+    for (int v = 0; v < h; ++v) n += truth[static_cast<std::size_t>(v) * w + u] == id;
+    return n;
+}
+
+/// Plane removal on `f` with the default parameters.
+struct Removal {
+    PlaneResult result;
+    std::vector<std::uint8_t> classes;
+};
+Removal remove_with_defaults(const Prepared& f) {
+    PlaneWorkspace ws;
+    Removal out;
+    out.result = f.remove_plane(PlaneParams{}, ws, out.classes);
+    return out;
 }
 
 /// Tallies `f` after plane removal; `truth_of(p)` gives pixel p's ground-truth id.
@@ -192,21 +217,13 @@ TEST(RemoveSupportPlane, BoxCutByTheFramesBottom_KeptWhereTheTableRunsOn) {
     std::vector<int> truth;
     Prepared f = prepared(render_scene(s, &truth));
     // Premise: the frame's bottom row shows the near box and the table beside it.
-    const std::size_t bottom = static_cast<std::size_t>(s.height - 1) * s.width;
-    int box_at_bottom = 0, table_at_bottom = 0;
-    for (int u = 0; u < s.width; ++u) {
-        box_at_bottom += truth[bottom + u] == kTruthBox0;
-        table_at_bottom += truth[bottom + u] == kTruthTable;
-    }
-    ASSERT_GT(box_at_bottom, 10);
-    ASSERT_GT(table_at_bottom, 100);
-    PlaneWorkspace ws;
-    std::vector<std::uint8_t> classes;
-    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
-    ASSERT_TRUE(r.found);
-    EXPECT_LT(kept_of(f, classes, truth, kTruthTable).share(), 0.005);
+    ASSERT_GT(truth_on_row(truth, s.width, s.height - 1, kTruthBox0), 10);
+    ASSERT_GT(truth_on_row(truth, s.width, s.height - 1, kTruthTable), 100);
+    const Removal rm = remove_with_defaults(f);
+    ASSERT_TRUE(rm.result.found);
+    EXPECT_LT(kept_of(f, rm.classes, truth, kTruthTable).share(), 0.005);
     for (int i = 0; i < 2; ++i) {
-        const KeptCount box = kept_of(f, classes, truth, kTruthBox0 + i);
+        const KeptCount box = kept_of(f, rm.classes, truth, kTruthBox0 + i);
         ASSERT_GT(box.points, 500u);
         EXPECT_GT(box.share(), 0.97) << "box " << i;
     }
@@ -229,19 +246,13 @@ TEST(RemoveSupportPlane, BoxInTheFramesNearCorner_KeptWhereTheTableRunsOutOnBoth
     Prepared f = prepared(render_scene(s, &truth));
     // Premise: the box fills the corner, and the table shows on the bottom row and on the
     // right column.
-    const auto at = [&](int u, int v) { return truth[static_cast<std::size_t>(v) * s.width + u]; };
-    ASSERT_EQ(at(s.width - 1, s.height - 1), kTruthBox0);
-    int table_bottom = 0, table_right = 0;
-    for (int u = 0; u < s.width; ++u) table_bottom += at(u, s.height - 1) == kTruthTable;
-    for (int v = 0; v < s.height; ++v) table_right += at(s.width - 1, v) == kTruthTable;
-    ASSERT_GT(table_bottom, 20);
-    ASSERT_GT(table_right, 20);
-    PlaneWorkspace ws;
-    std::vector<std::uint8_t> classes;
-    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
-    ASSERT_TRUE(r.found);
-    EXPECT_LT(kept_of(f, classes, truth, kTruthTable).share(), 0.005);
-    const KeptCount box = kept_of(f, classes, truth, kTruthBox0);
+    ASSERT_EQ(truth[truth.size() - 1], kTruthBox0);
+    ASSERT_GT(truth_on_row(truth, s.width, s.height - 1, kTruthTable), 20);
+    ASSERT_GT(truth_on_column(truth, s.width, s.height, s.width - 1, kTruthTable), 20);
+    const Removal rm = remove_with_defaults(f);
+    ASSERT_TRUE(rm.result.found);
+    EXPECT_LT(kept_of(f, rm.classes, truth, kTruthTable).share(), 0.005);
+    const KeptCount box = kept_of(f, rm.classes, truth, kTruthBox0);
     ASSERT_GT(box.points, 2000u);
     EXPECT_GT(box.share(), 0.97);
 }
