@@ -29,6 +29,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
         sum.merge += stats.ms.merge;
         sum.containers += stats.ms.containers;
         sum.color += stats.ms.color;
+        sum.stacks += stats.ms.stacks;
         sum.gaps += stats.ms.gaps;
         sum.occluded += stats.ms.occluded;
         sum.scope += stats.ms.scope;
@@ -43,6 +44,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     state.counters["merge_ms"] = Counter(sum.merge, Counter::kAvgIterations);
     state.counters["containers_ms"] = Counter(sum.containers, Counter::kAvgIterations);
     state.counters["color_ms"] = Counter(sum.color, Counter::kAvgIterations);
+    state.counters["stacks_ms"] = Counter(sum.stacks, Counter::kAvgIterations);
     state.counters["gaps_ms"] = Counter(sum.gaps, Counter::kAvgIterations);
     state.counters["occluded_ms"] = Counter(sum.occluded, Counter::kAvgIterations);
     state.counters["scope_ms"] = Counter(sum.scope, Counter::kAvgIterations);

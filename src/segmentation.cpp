@@ -71,6 +71,9 @@ void SegmentParams::validate() const {
     require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
     require(color_round_deg >= 0 && color_round_deg < 90, "color_round_deg", color_round_deg, "in [0, 90)");
     require(color_round_max_radius_m > 0, "color_round_max_radius_m", color_round_max_radius_m, "> 0");
+    require(stack_min_step_m >= 0 && stack_min_step_m <= 0.5f, "stack_min_step_m", stack_min_step_m,
+            "in [0, 0.5], 0 = off");
+    require(stack_min_share > 0 && stack_min_share <= 0.5f, "stack_min_share", stack_min_share, "in (0, 0.5]");
     require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");
     require(rim_max_residual_m > 0, "rim_max_residual_m", rim_max_residual_m, "> 0");
     require(rim_min_arc > 0 && rim_min_arc <= 1, "rim_min_arc", rim_min_arc, "in (0, 1]");
@@ -513,6 +516,11 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
         stats.color_splits = color_splits(x, support, ws, n);
         n += stats.color_splits;
         stats.ms.color = ms_since();
+    }
+    if (!kmeans && support) {
+        stats.stack_splits = split_stacks(x, *support, ws, n);
+        n += stats.stack_splits;
+        stats.ms.stacks = ms_since();
     }
     if (!kmeans) {
         stats.gaps_filled = fill_container_gaps(x, ws);

@@ -97,6 +97,11 @@ int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
 /// inside, enclosed by one segment, join it. Returns the points filled.
 std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
 
+/// Stacks (SegmentParams, "Stacks"; segmentation_stacks.cpp): cuts a segment whose upward
+/// faces lie at two heights in two, the upper object's part numbered n + 1, n + 2, ... in
+/// segment order. Returns the cuts.
+int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
+
 /// The colour cue (hybrid): splits segments in two by colour; the new parts are numbered
 /// n + 1, n + 2, ... in segment order. Returns the splits.
 int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n);

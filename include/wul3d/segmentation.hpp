@@ -88,6 +88,14 @@ struct SegmentParams {
                                       ///< rim_ fit's residual and arc) and face within this
                                       ///< of its radii; [0, 90), 0 = off
     float color_round_max_radius_m = 0.15f;  ///< ... a circle of at most this radius; > 0
+    // Stacks (needs the support plane; not kmeans): a segment whose upward faces lie at two
+    // heights over the support, nothing facing up between them, is two objects, one resting
+    // on the other; it is cut just over the lower one's top.
+    float stack_min_step_m = 0.02f;  ///< the layers lie this far apart at least, and the lower
+                                     ///< this far above the support (a book's thickness);
+                                     ///< [0, 0.5], 0 = off
+    float stack_min_share = 0.04f;   ///< each layer holds this share of the segment's pixels
+                                     ///< (and min_points); (0, 0.5]
     // Containers (needs the support plane): a bowl or a cup seen from above shows its outer
     // wall and, over the front rim, its inside; the rim hides the inside's lower part, so
     // the two meet only across a depth step, where no crease test or merge can join them.
@@ -150,6 +158,12 @@ struct BoundaryStep {
     std::uint32_t near;  ///< the nearer pixel
 };
 
+/// The stack rule: the two layers of one segment's upward faces, heights over the support
+/// (m), and the height that parts them; cut < 0: none.
+struct StackLayers {
+    float lo = -1, hi = -1, cut = -1;
+};
+
 /// Scratch, sized once per resolution.
 struct SegmentWorkspace {
     NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
@@ -195,12 +209,16 @@ struct SegmentWorkspace {
     std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
                                                   ///< bottom; pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
+    // Stacks:
+    std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
+    std::vector<StackLayers> stack_layers;   ///< per segment
 };
 
 /// What segmentation did, as data.
 struct SegmentStats {
     int segments = 0;      ///< objects written to `out`
     int color_splits = 0;  ///< splits the colour cue made, both rounds (each adds a segment)
+    int stack_splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim
     int occluded = 0;      ///< parts of one surface joined across the object before them
@@ -209,12 +227,12 @@ struct SegmentStats {
     bool support_scope = false;  ///< Scope::Support was applied (a support was found)
     int out_of_scope = 0;        ///< segments of min_points or more the scope left out
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
-    /// components, re-attachment, convexity merge, container rule, colour cue, floor gaps,
-    /// occlusion, the scope, and the renumbering passes with the output. For the profile in
-    /// bench/.
+    /// components, re-attachment, convexity merge, container rule, colour cue, stack rule,
+    /// floor gaps, occlusion, the scope, and the renumbering passes with the output. For the
+    /// profile in bench/.
     struct Phases {
         double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
-               color = 0, gaps = 0, occluded = 0, scope = 0, compact = 0;
+               color = 0, stacks = 0, gaps = 0, occluded = 0, scope = 0, compact = 0;
     } ms;
 };
 
