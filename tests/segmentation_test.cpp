@@ -505,10 +505,8 @@ TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
     EXPECT_EQ(stats.color_splits, 1);
 }
 
-// A cup with a printed band round its outer wall: two colours on one solid of revolution,
-// as a can's or a bottle's label. The band is a compact piece the colour cue would cut off;
-// the cup's walls lie on one upright circle and face along its radii, so it stays one
-// object (color_round_deg).
+namespace {
+
 /// Segments `in` with no crease cuts, as where sensor noise blurs a low side into the top
 /// beside it (generated scenes; osd_mosd test56's book on a book): the renderer has no
 /// depth noise, so its creases are crisp and would split every pair here. With the stack
@@ -531,8 +529,10 @@ void expect_split_by_height(const PlaneStage& in, int ta, int tb, double share, 
     EXPECT_EQ(stats.stack_splits, 1);
 }
 
+}  // namespace
+
 // A box lying on a larger box of the same colour: no colour to split. Their tops face up
-// at two heights, with nothing facing up between: the stack rule cuts between them.
+// at two heights, with nothing facing up between: the stack rule cuts just over the lower top.
 TEST(SegmentObjects, SameColourBoxLyingOnABox_SeparatedByTheirHeights) {
     Scene s = pitched_tabletop_scene();
     const SceneBox base{.z = 1.0f, .w = 0.26f, .h = 0.08f, .d = 0.24f, .r = 60, .g = 90, .b = 200};
@@ -555,6 +555,10 @@ TEST(SegmentObjects, BoxStandingFlushOnTheCornerOfABox_TheLowerKeepsItsFront) {
     expect_split_by_height(up_to_the_plane(s), kTruthBox0, kTruthBox0 + 1, 0.9, "the two boxes are one object");
 }
 
+// A cup with a printed band round its outer wall: two colours on one solid of revolution,
+// as a can's or a bottle's label. The band is a compact piece the colour cue would cut off;
+// the cup's walls lie on one upright circle and face along its radii, so it stays one
+// object (color_round_deg).
 TEST(SegmentObjects, CupWithAPrintedBand_StaysOneObject) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 5;
