@@ -400,8 +400,8 @@ void add_near_corners(const GridEdges& e, std::vector<int>& hull_points) {
 
 /// The support's extent: the image-space convex hull of `pl`'s inliers on the grid, widened
 /// by hull_margin_px, with the frame's near corners where the inliers reach them
-/// (add_near_corners, the frame's `edges`); a point belongs over the support when its foot (the point moved down
-/// the normal onto the plane) projects into it (HullMask). Out: `ws.hull` (G, 1 = inside;
+/// (add_near_corners, the frame's `edges`); a point belongs over the support when its foot
+/// (the point moved down the normal onto the plane) projects into it (HullMask). Out: `ws.hull` (G, 1 = inside;
 /// all 0 when fewer than 3 rows hold inliers), `ws.hull_points`. O(G) for the inlier test,
 /// then the hull of at most 2 grid.h points and a dilation over G; OpenCV allocates the
 /// hull's corners and the kernel.
@@ -482,8 +482,8 @@ struct SupportChoice {
 /// the same foot) + 0.1 x its extent. A candidate scores at most
 /// 1.1 x its extent, so once one scores more, smaller candidates are not counted (each
 /// count builds a hull and passes over the grid). Largest first; ties go to the lower
-/// index, as in index order. In: `candidates`, `ws.grid`, the frame's `edges`. Out: the choice; each counted
-/// candidate's `above`; `ws.by_extent`, `ws.sliver`, `ws.hull` of the last one counted.
+/// index, as in index order. In: `candidates`, `ws.grid`, the frame's `edges`. Out: the
+/// choice; each counted candidate's `above`; `ws.by_extent`, `ws.sliver`, `ws.hull` of the last one counted.
 /// O(C log C) to rank, mark_slivers, then O(G) (a hull, a pass and a parallel pass) per
 /// candidate counted, usually one or two.
 SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics& K, const Grid& grid,

@@ -30,6 +30,11 @@ inline bool row_has_label(const int* row, int from, int to) {
     return any != 0;
 }
 
+/// A pixel faces sideways (an upright surface: a wall, a box's or a can's side) when its
+/// normal lies within this of the support plane, and up when within this of its normal.
+/// Shared by the round test, the scope and the stack rule.
+constexpr float kUprightDeg = 25.0f;
+
 /// What every phase reads: the parameters, the frame and the normals of the crease tests
 /// (smoothed when normal_smooth_px > 0), the plane's classes per pixel.
 struct Ctx {
@@ -54,6 +59,18 @@ struct Ctx {
         return ((n.nx[p] - n.nx[q]) * dx + (n.ny[p] - n.ny[q]) * dy + (n.nz[p] - n.nz[q]) * dz) / len;
     }
 };
+
+/// Whether pixel p has a normal within the angle whose sine is `sin_max` of the support
+/// plane: it faces sideways.
+inline bool faces_sideways(const Ctx& x, const Plane& pl, std::size_t p, float sin_max) {
+    return x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_max;
+}
+
+/// Whether pixel p has a normal within the angle whose cosine is `cos_min` of the support's
+/// normal (both towards the camera): it faces up.
+inline bool faces_up(const Ctx& x, const Plane& pl, std::size_t p, float cos_min) {
+    return x.n.valid[p] && x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz >= cos_min;
+}
 
 // ---- union-find over segments (the merge and container rules join segments) -------------
 

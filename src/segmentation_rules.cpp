@@ -75,12 +75,6 @@ struct PlaneAxes {
     }
 };
 
-/// Whether pixel p has a normal within the angle whose sine is `sin_max` of the support
-/// plane: it faces sideways (a wall, a can's side). Shared by the round test and the scope.
-bool faces_sideways(const Ctx& x, const Plane& pl, std::size_t p, float sin_max) {
-    return x.n.valid[p] && std::fabs(x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz) <= sin_max;
-}
-
 /// A circle on the support plane through the points `for_points` visits (it calls its
 /// argument with each pixel), by algebraic least squares (Kasa), centred on their mean
 /// `mean` for conditioning: the centre relative to `mean` and the squared radius (not > 0,
@@ -772,10 +766,6 @@ int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n
 // ---- scope ---------------------------------------------------------------------------------
 
 namespace {
-
-/// A pixel faces sideways (is part of an upright surface: a wall, a cupboard's side) when
-/// its normal lies within this of the support plane.
-constexpr float kUprightDeg = 25.0f;
 
 /// The frame's edge: the image border and the rows and columns with no depth at all that
 /// reach it, when they are a narrow band (a sensor's registration border: 48 rows and 63

@@ -17,12 +17,6 @@ namespace {
 /// (1.5 cm): a horizontal face seen at 1-1.5 m by a structured-light sensor spreads its
 /// heights over a few millimetres (disparity steps of 3-6 mm, seen at an angle).
 constexpr float kLayerBinM = 0.005f;
-/// Heights are counted up to this over the support: the plane stage's max_object_height_m
-/// (PlaneParams), above which nothing stands on the support.
-constexpr float kMaxLayerHeightM = 0.5f;
-/// A pixel faces up when its normal lies within this of the support's (the scope's
-/// upright test, the other way round).
-constexpr float kUpDeg = 25.0f;
 /// Between two layers, at every height fewer than this share of the smaller layer's count
 /// face up: a stack leaves no upward face between its tops, a tilted or curved face spreads
 /// its heights evenly (generated tune seeds: 1/2 to 1/8 scored the same).
@@ -33,17 +27,15 @@ constexpr int kValleyDivisor = 4;
 /// layers lower; docs/ABLATION.md).
 constexpr float kCutOverLowerM = 0.01f;
 
-bool faces_up(const Ctx& x, const Plane& pl, std::size_t p, float cos_up) {
-    return x.n.valid[p] && x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz >= cos_up;
-}
-
-/// Per segment, how many of its pixels face up at each height over the support (bins of
-/// kLayerBinM from 0) into ws.layer_hist, segment after segment, and its size into
-/// ws.sizes. In: ws.label (0..n). Cost: one pass over the rows with objects.
+/// Per segment, how many of its pixels face up (within kUprightDeg of the support's normal)
+/// at each height over the support (bins of kLayerBinM from 0 up to the scope's height
+/// limit, above which nothing stands on the support) into ws.layer_hist, segment after
+/// segment, and its size into ws.sizes. In: ws.label (0..n). Cost: one pass over the rows
+/// with objects.
 void count_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n, int bins) {
     ws.layer_hist.assign(static_cast<std::size_t>(n + 1) * static_cast<std::size_t>(bins), 0);
     ws.sizes.assign(static_cast<std::size_t>(n) + 1, 0);
-    const float cos_up = std::cos(kUpDeg * kDegToRad);
+    const float cos_up = std::cos(kUprightDeg * kDegToRad);
     for (int v = 0; v < x.H; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
         if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
@@ -59,14 +51,14 @@ void count_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n, in
     }
 }
 
-/// The two layers of one segment's upward faces (hist: its bins, size: its pixels). A
-/// layer is a local peak of the counts over three bins that holds stack_min_share of the
-/// segment and min_points; the lower stands stack_min_step_m or more above the support (a
-/// box's top, not the table or a bowl's floor); the two lie stack_min_step_m or more
-/// apart, with a valley between them (kValleyDivisor). Of several pairs, the one whose
-/// smaller layer is largest; the cut lies kCutOverLowerM over the lower layer. Cost:
-/// O(bins^2), a hundred bins.
-StackLayers find_layers(const int* hist, int bins, int size, const SegmentParams& prm) {
+/// The height that cuts one segment between two layers of its upward faces (hist: its
+/// bins, size: its pixels), or a negative value when it has no two. A layer is a local peak
+/// of the counts over three bins that holds stack_min_share of the segment and min_points;
+/// the lower stands stack_min_step_m or more above the support (a box's top, not the table
+/// or a bowl's floor); the two lie stack_min_step_m or more apart, with a valley between
+/// them (kValleyDivisor). Of several pairs, the one whose smaller layer is largest; the cut
+/// lies kCutOverLowerM over its lower layer. Cost: O(bins^2), a hundred bins.
+float cut_height(const int* hist, int bins, int size, const SegmentParams& prm) {
     auto window = [&](int b) { return (b > 0 ? hist[b - 1] : 0) + hist[b] + (b + 1 < bins ? hist[b + 1] : 0); };
     auto peak = [&](int b) {
         const int c = window(b);
@@ -75,7 +67,7 @@ StackLayers find_layers(const int* hist, int bins, int size, const SegmentParams
     const int min_layer = std::max(prm.min_points, static_cast<int>(prm.stack_min_share * static_cast<float>(size)));
     const int step = static_cast<int>(std::ceil(prm.stack_min_step_m / kLayerBinM));
     auto middle = [](int b) { return (static_cast<float>(b) + 0.5f) * kLayerBinM; };
-    StackLayers best;
+    float cut = -1.0f;
     int best_count = 0;
     for (int lo = std::max(step, 1); lo < bins; ++lo) {
         const int a = window(lo);
@@ -86,25 +78,25 @@ StackLayers find_layers(const int* hist, int bins, int size, const SegmentParams
             if (hi - lo >= step && c >= min_layer && peak(hi) && kValleyDivisor * valley < smaller &&
                 smaller > best_count) {
                 best_count = smaller;
-                best = {middle(lo), middle(hi), middle(lo) + kCutOverLowerM};
+                cut = middle(lo) + kCutOverLowerM;
             }
             valley = std::min(valley, c);
         }
     }
-    return best;
+    return cut;
 }
 
-/// The layers of every segment of 2 x min_points or more into ws.stack_layers (cut < 0:
-/// none). Returns how many have two. Cost: O(n bins^2).
-int find_all_layers(const Ctx& x, SegmentWorkspace& ws, int n, int bins) {
-    ws.stack_layers.assign(static_cast<std::size_t>(n) + 1, StackLayers{});
+/// The cut of every segment of 2 x min_points or more into ws.stack_cut (< 0: none).
+/// Returns how many have one. Cost: O(n bins^2).
+int find_cuts(const Ctx& x, SegmentWorkspace& ws, int n, int bins) {
+    ws.stack_cut.assign(static_cast<std::size_t>(n) + 1, -1.0f);
     int found = 0;
     for (int l = 1; l <= n; ++l) {
         const int size = ws.sizes[static_cast<std::size_t>(l)];
         if (size < 2 * x.prm.min_points) continue;
         const int* hist = ws.layer_hist.data() + static_cast<std::size_t>(l) * static_cast<std::size_t>(bins);
-        ws.stack_layers[static_cast<std::size_t>(l)] = find_layers(hist, bins, size, x.prm);
-        found += ws.stack_layers[static_cast<std::size_t>(l)].cut >= 0;
+        ws.stack_cut[static_cast<std::size_t>(l)] = cut_height(hist, bins, size, x.prm);
+        found += ws.stack_cut[static_cast<std::size_t>(l)] >= 0;
     }
     return found;
 }
@@ -115,14 +107,14 @@ int cut_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     ws.remap.assign(static_cast<std::size_t>(n) + 1, 0);
     int next = n;
     for (int l = 1; l <= n; ++l)
-        if (ws.stack_layers[static_cast<std::size_t>(l)].cut >= 0) ws.remap[static_cast<std::size_t>(l)] = ++next;
+        if (ws.stack_cut[static_cast<std::size_t>(l)] >= 0) ws.remap[static_cast<std::size_t>(l)] = ++next;
     for (int v = 0; v < x.H; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
         if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
         for (std::size_t p = row; p < row + static_cast<std::size_t>(x.W); ++p) {
             const int l = ws.label[p];
             if (l <= 0 || ws.remap[static_cast<std::size_t>(l)] == 0) continue;
-            if (pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) > ws.stack_layers[static_cast<std::size_t>(l)].cut)
+            if (pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) > ws.stack_cut[static_cast<std::size_t>(l)])
                 ws.label[p] = ws.remap[static_cast<std::size_t>(l)];
         }
     }
@@ -133,9 +125,9 @@ int cut_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 
 int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     if (x.prm.stack_min_step_m <= 0) return 0;
-    const int bins = static_cast<int>(std::ceil(kMaxLayerHeightM / kLayerBinM));
+    const int bins = static_cast<int>(std::ceil(x.prm.scope_max_height_m / kLayerBinM));
     count_layers(x, pl, ws, n, bins);
-    if (find_all_layers(x, ws, n, bins) == 0) return 0;
+    if (find_cuts(x, ws, n, bins) == 0) return 0;
     return cut_layers(x, pl, ws, n);
 }
 

@@ -158,12 +158,6 @@ struct BoundaryStep {
     std::uint32_t near;  ///< the nearer pixel
 };
 
-/// The stack rule: the two layers of one segment's upward faces, heights over the support
-/// (m), and the height that parts them; cut < 0: none.
-struct StackLayers {
-    float lo = -1, hi = -1, cut = -1;
-};
-
 /// Scratch, sized once per resolution.
 struct SegmentWorkspace {
     NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
@@ -211,7 +205,7 @@ struct SegmentWorkspace {
     std::vector<std::uint8_t> scope_keep;
     // Stacks:
     std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
-    std::vector<StackLayers> stack_layers;   ///< per segment
+    std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)
 };
 
 /// What segmentation did, as data.
