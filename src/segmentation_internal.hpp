@@ -1,11 +1,15 @@
 #pragma once
-// Private to src/segmentation*.cpp: the context every phase of segment_objects reads, the
-// union-find over segments, and the rules (segmentation_rules.cpp) the driver calls.
+// Private to src/segmentation*.cpp: the context every phase of segment_objects reads,
+// coordinates on the support plane, the union-find over segments, and the rules the driver
+// calls (segmentation_rules.cpp, segmentation_stacks.cpp, segmentation_occlusion.cpp).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "wul3d/cloud.hpp"
 #include "wul3d/normals.hpp"
@@ -71,6 +75,24 @@ inline bool faces_sideways(const Ctx& x, const Plane& pl, std::size_t p, float s
 inline bool faces_up(const Ctx& x, const Plane& pl, std::size_t p, float cos_min) {
     return x.n.valid[p] && x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz >= cos_min;
 }
+
+/// Coordinates on the support plane: e1, e2 orthogonal to its normal (a foot's position is
+/// the point's).
+struct PlaneAxes {
+    Eigen::Vector3d e1, e2;
+
+    explicit PlaneAxes(const Plane& pl) {
+        const Eigen::Vector3d nrm(pl.nx, pl.ny, pl.nz);
+        int least = 0;  // the axis least aligned with the normal: a well-conditioned cross product
+        nrm.cwiseAbs().minCoeff(&least);
+        e1 = nrm.cross(Eigen::Vector3d::Unit(least)).normalized();
+        e2 = nrm.cross(e1);
+    }
+    Eigen::Vector2d operator()(const OrganizedCloud& c, std::size_t p) const {
+        const Eigen::Vector3d X(c.x[p], c.y[p], c.z[p]);
+        return Eigen::Vector2d(X.dot(e1), X.dot(e2));
+    }
+};
 
 // ---- union-find over segments (the merge and container rules join segments) -------------
 

@@ -57,23 +57,6 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
               [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
 }
 
-/// Coordinates on the support plane: e1, e2 orthogonal to its normal (a foot's position is
-/// the point's).
-struct PlaneAxes {
-    Eigen::Vector3d e1, e2;
-
-    explicit PlaneAxes(const Plane& pl) {
-        const Eigen::Vector3d nrm(pl.nx, pl.ny, pl.nz);
-        int least = 0;  // the axis least aligned with the normal: a well-conditioned cross product
-        nrm.cwiseAbs().minCoeff(&least);
-        e1 = nrm.cross(Eigen::Vector3d::Unit(least)).normalized();
-        e2 = nrm.cross(e1);
-    }
-    Eigen::Vector2d operator()(const OrganizedCloud& c, std::size_t p) const {
-        const Eigen::Vector3d X(c.x[p], c.y[p], c.z[p]);
-        return Eigen::Vector2d(X.dot(e1), X.dot(e2));
-    }
-};
 
 /// A circle on the support plane through the points `for_points` visits (it calls its
 /// argument with each pixel), by algebraic least squares (Kasa), centred on their mean

@@ -2,10 +2,15 @@
 // lie at two heights over the support, with nothing facing up between them, is two objects,
 // one resting on the other. Where they meet without a crease (a box too thin for its sides
 // to show a fold under the sensor's noise) and the colour cue cannot part them (one colour,
-// or a print that 2-means follows), the heights still tell them apart.
+// or a print that 2-means follows), the heights still tell them apart. Two boxes of two
+// heights standing side by side show the same two layers; there the taller one's walls run
+// on below the cut, and their colour sends them up with it (keep_walls_by_colour).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "segmentation_internal.hpp"
@@ -101,23 +106,170 @@ int find_cuts(const Ctx& x, SegmentWorkspace& ws, int n, int bins) {
     return found;
 }
 
-/// Cuts each layered segment: its pixels above the cut take a new label n + 1, n + 2, ... in
-/// segment order. Returns the cuts. Cost: one pass over the rows with objects.
-int cut_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
-    ws.remap.assign(static_cast<std::size_t>(n) + 1, 0);
-    int next = n;
-    for (int l = 1; l <= n; ++l)
-        if (ws.stack_cut[static_cast<std::size_t>(l)] >= 0) ws.remap[static_cast<std::size_t>(l)] = ++next;
+/// Calls visit(p, l, h) for each pixel p of a cut segment l, h its height over the support.
+/// Cost: one pass over the rows with objects.
+template <class Visit>
+void for_cut_pixels(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, Visit&& visit) {
     for (int v = 0; v < x.H; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
         if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
         for (std::size_t p = row; p < row + static_cast<std::size_t>(x.W); ++p) {
             const int l = ws.label[p];
-            if (l <= 0 || ws.remap[static_cast<std::size_t>(l)] == 0) continue;
-            if (pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) > ws.stack_cut[static_cast<std::size_t>(l)])
-                ws.label[p] = ws.remap[static_cast<std::size_t>(l)];
+            if (l <= 0 || ws.stack_cut[static_cast<std::size_t>(l)] < 0) continue;
+            visit(p, l, pl.height(x.c.x[p], x.c.y[p], x.c.z[p]));
         }
     }
+}
+
+/// Where the upper object's walls stand is mapped in cells of this size on the support
+/// plane, and a wall below the cut counts as under them within one cell: a wall's points
+/// scatter by the sensor's noise, 3-7 mm at 1-1.5 m.
+constexpr float kWallCellM = 0.01f;
+/// A grid that would exceed this many cells a side (2.56 m) is not drawn: no object is that
+/// large, and it bounds the memory.
+constexpr int kMaxWallCells = 256;
+
+/// The upper objects' walls: the pixels of each cut segment above its cut that face
+/// sideways, as (segment, u, v) on the support plane into ws.stack_walls. Cost: one pass over
+/// the rows with objects.
+void collect_upper_walls(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws) {
+    ws.stack_walls.clear();
+    for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
+        if (h <= ws.stack_cut[static_cast<std::size_t>(l)] || !faces_sideways(x, pl, p, sin_wall)) return;
+        const Eigen::Vector2d q = axes(x.c, p);
+        ws.stack_walls.insert(ws.stack_walls.end(),
+                              {static_cast<float>(l), static_cast<float>(q.x()), static_cast<float>(q.y())});
+    });
+}
+
+/// Per segment, a map of where its upper object's walls stand (ws.stack_walls): its box on
+/// the plane in ws.wall_box (u0, v0, columns, rows; columns 0: no map) and its cells, 1 where
+/// a wall stands, in ws.wall_cells from ws.wall_at. Cost: two passes over the walls.
+void draw_wall_maps(SegmentWorkspace& ws, int n) {
+    const std::size_t walls = ws.stack_walls.size() / 3;
+    const float big = std::numeric_limits<float>::max();
+    ws.wall_box.assign(4 * (static_cast<std::size_t>(n) + 1), 0.0f);
+    for (int l = 1; l <= n; ++l) {
+        float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(l);
+        b[0] = b[1] = big;
+        b[2] = b[3] = -big;
+    }
+    for (std::size_t i = 0; i < walls; ++i) {  // the boxes: min and max of u and v
+        const float* w = ws.stack_walls.data() + 3 * i;
+        float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(w[0]);
+        b[0] = std::min(b[0], w[1]);
+        b[1] = std::min(b[1], w[2]);
+        b[2] = std::max(b[2], w[1]);
+        b[3] = std::max(b[3], w[2]);
+    }
+    ws.wall_at.assign(static_cast<std::size_t>(n) + 1, 0);
+    std::size_t cells = 0;
+    for (int l = 1; l <= n; ++l) {  // then columns and rows in place of the max
+        float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(l);
+        const int cols = b[2] >= b[0] ? static_cast<int>((b[2] - b[0]) / kWallCellM) + 1 : 0;
+        const int rows = b[3] >= b[1] ? static_cast<int>((b[3] - b[1]) / kWallCellM) + 1 : 0;
+        const bool drawn = cols > 0 && rows > 0 && cols <= kMaxWallCells && rows <= kMaxWallCells;
+        b[2] = drawn ? static_cast<float>(cols) : 0.0f;
+        b[3] = drawn ? static_cast<float>(rows) : 0.0f;
+        ws.wall_at[static_cast<std::size_t>(l)] = cells;
+        if (drawn) cells += static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
+    }
+    ws.wall_cells.assign(cells, 0);
+    for (std::size_t i = 0; i < walls; ++i) {
+        const float* w = ws.stack_walls.data() + 3 * i;
+        const auto l = static_cast<std::size_t>(w[0]);
+        const float* b = ws.wall_box.data() + 4 * l;
+        if (b[2] == 0) continue;
+        const auto cu = static_cast<std::size_t>((w[1] - b[0]) / kWallCellM);
+        const auto cv = static_cast<std::size_t>((w[2] - b[1]) / kWallCellM);
+        ws.wall_cells[ws.wall_at[l] + cv * static_cast<std::size_t>(b[2]) + cu] = 1;
+    }
+}
+
+/// Whether point q of segment l (on the plane) stands where its upper object's walls stand:
+/// in a cell of its map or a neighbour. Cost: nine lookups.
+bool under_upper_walls(const SegmentWorkspace& ws, int l, const Eigen::Vector2d& q) {
+    const float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(l);
+    const int cols = static_cast<int>(b[2]), rows = static_cast<int>(b[3]);
+    if (cols == 0) return false;
+    const int cu = static_cast<int>(std::floor((static_cast<float>(q.x()) - b[0]) / kWallCellM));
+    const int cv = static_cast<int>(std::floor((static_cast<float>(q.y()) - b[1]) / kWallCellM));
+    const std::uint8_t* cells = ws.wall_cells.data() + ws.wall_at[static_cast<std::size_t>(l)];
+    for (int v = std::max(cv - 1, 0); v <= std::min(cv + 1, rows - 1); ++v)
+        for (int u = std::max(cu - 1, 0); u <= std::min(cu + 1, cols - 1); ++u)
+            if (cells[v * cols + u]) return true;
+    return false;
+}
+
+/// Where a pixel of a cut segment goes: above the cut, to the upper object (its walls,
+/// kUpperWall, or the rest, kUpper); below it, to the lower object, but for the walls that
+/// stand under the upper object's walls (kUnderUpperWalls), which go up when their colour
+/// says so (keep_walls_by_colour). The first three index ws.wall_colour.
+enum Piece : int { kUpperWall = 0, kUnderUpperWalls = 1, kLower = 2, kUpper = 3 };
+
+/// The piece of pixel p (height h) of cut segment l. Cost: O(1).
+Piece piece_of(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, const SegmentWorkspace& ws,
+               std::size_t p, int l, float h) {
+    const bool wall = faces_sideways(x, pl, p, sin_wall);
+    if (h > ws.stack_cut[static_cast<std::size_t>(l)]) return wall ? kUpperWall : kUpper;
+    return wall && under_upper_walls(ws, l, axes(x.c, p)) ? kUnderUpperWalls : kLower;
+}
+
+/// The distance between the mean chromaticities of two sums (r, g, b, count).
+double colour_distance(const std::array<double, 4>& a, const std::array<double, 4>& b) {
+    double d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        const double d = a[static_cast<std::size_t>(i)] / a[3] - b[static_cast<std::size_t>(i)] / b[3];
+        d2 += d * d;
+    }
+    return std::sqrt(d2);
+}
+
+/// Two boxes of two heights flush side by side are one segment with two layers too, and the
+/// cut halves the taller one: its walls run on below the cut, under its walls above it.
+/// Their colour decides, as geometry cannot tell them from a box resting flush on the edge
+/// of a larger one (whose walls below the cut are the lower box's): they go up only when
+/// their mean chromaticity lies color_min_distance or more from the rest of the lower piece
+/// (another material) and nearer the upper object's walls. Same-coloured pairs stay cut by
+/// height. Clears the map of every segment whose walls stay. Cost: one pass over the rows
+/// with objects.
+void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws,
+                          int n) {
+    ws.wall_colour.assign(static_cast<std::size_t>(n + 1) * 3, {0.0, 0.0, 0.0, 0.0});
+    for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
+        const Piece k = piece_of(x, pl, axes, sin_wall, ws, p, l, h);
+        if (k == kUpper) return;
+        // Chromaticity, as the colour cue's: light falling at other angles on two faces of
+        // one object scales their colour and leaves it.
+        const double r = x.c.r[p], g = x.c.g[p], b = x.c.b[p], scale = 255.0 / (r + g + b + 30.0);
+        std::array<double, 4>& sum = ws.wall_colour[3 * static_cast<std::size_t>(l) + static_cast<std::size_t>(k)];
+        sum[0] += r * scale;
+        sum[1] += g * scale;
+        sum[2] += b * scale;
+        sum[3] += 1;
+    });
+    for (int l = 1; l <= n; ++l) {
+        const std::array<double, 4>* sums = ws.wall_colour.data() + 3 * static_cast<std::size_t>(l);
+        bool up = sums[kUpperWall][3] > 0 && sums[kUnderUpperWalls][3] > 0 && sums[kLower][3] > 0;
+        if (up) {
+            const double to_lower = colour_distance(sums[kUnderUpperWalls], sums[kLower]);
+            up = to_lower >= x.prm.color_min_distance && colour_distance(sums[kUnderUpperWalls], sums[kUpperWall]) < to_lower;
+        }
+        if (!up) ws.wall_box[4 * static_cast<std::size_t>(l) + 2] = 0;  // no map: the walls stay
+    }
+}
+
+/// Cuts each layered segment: its upper object (above the cut, and the walls under its walls
+/// where a map is kept) takes a new label n + 1, n + 2, ... in segment order. Returns the
+/// cuts. Cost: one pass over the rows with objects.
+int cut_layers(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws, int n) {
+    ws.remap.assign(static_cast<std::size_t>(n) + 1, 0);
+    int next = n;
+    for (int l = 1; l <= n; ++l)
+        if (ws.stack_cut[static_cast<std::size_t>(l)] >= 0) ws.remap[static_cast<std::size_t>(l)] = ++next;
+    for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
+        if (piece_of(x, pl, axes, sin_wall, ws, p, l, h) != kLower) ws.label[p] = ws.remap[static_cast<std::size_t>(l)];
+    });
     return next - n;
 }
 
@@ -128,7 +280,18 @@ int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     const int bins = static_cast<int>(std::ceil(x.prm.scope_max_height_m / kLayerBinM));
     count_layers(x, pl, ws, n, bins);
     if (find_cuts(x, ws, n, bins) == 0) return 0;
-    return cut_layers(x, pl, ws, n);
+    // Which walls below the cut stand under the upper object's walls, and whether their
+    // colour sends them up (hybrid only: without colour, a cut by height).
+    const PlaneAxes axes(pl);
+    const float sin_wall = std::sin(kUprightDeg * kDegToRad);
+    if (x.prm.segmenter == Segmenter::Hybrid && x.c.has_color) {
+        collect_upper_walls(x, pl, axes, sin_wall, ws);
+        draw_wall_maps(ws, n);
+        keep_walls_by_colour(x, pl, axes, sin_wall, ws, n);
+    } else {
+        ws.wall_box.assign(4 * (static_cast<std::size_t>(n) + 1), 0.0f);  // no maps
+    }
+    return cut_layers(x, pl, axes, sin_wall, ws, n);
 }
 
 }  // namespace wul3d::detail

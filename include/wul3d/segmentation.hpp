@@ -206,6 +206,12 @@ struct SegmentWorkspace {
     // Stacks:
     std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
     std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)
+    std::vector<float> stack_walls;          ///< the upper objects' walls: segment, u, v on the plane
+    std::vector<float> wall_box;             ///< per segment, its walls' map: u0, v0, columns, rows
+    std::vector<std::size_t> wall_at;        ///< per segment, where its map starts in wall_cells
+    std::vector<std::uint8_t> wall_cells;    ///< 1 = an upper object's wall stands in that cell
+    std::vector<std::array<double, 4>> wall_colour;  ///< per segment and piece: chromaticity
+                                                     ///< sums (3) and count
 };
 
 /// What segmentation did, as data.
