@@ -57,7 +57,6 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
               [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
 }
 
-
 /// A circle on the support plane through the points `for_points` visits (it calls its
 /// argument with each pixel), by algebraic least squares (Kasa), centred on their mean
 /// `mean` for conditioning: the centre relative to `mean` and the squared radius (not > 0,

@@ -511,9 +511,10 @@ namespace {
 /// beside it (generated scenes; osd_mosd test56's book on a book): the renderer has no
 /// depth noise, so its creases are crisp and would split every pair here. With the stack
 /// rule off (the test's premise) `ta` and `tb` are one object; on, they are two, each
-/// holding `share` of its truth, with one stack cut.
+/// holding `share` of its truth, with one stack cut. `params`: the rest (the defaults).
 void expect_split_by_height(const PlaneStage& in, int ta, int tb, double share, const char* what,
-                            SegmentParams no_creases = {}) {
+                            const SegmentParams& params = {}) {
+    SegmentParams no_creases = params;
     no_creases.concavity = 100;  // above any (n_p - n_q) . direction: no pixel is a crease
     SegmentParams without = no_creases;
     without.stack_min_step_m = 0;
