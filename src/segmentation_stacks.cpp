@@ -32,6 +32,18 @@ constexpr int kValleyDivisor = 4;
 /// layers lower; docs/ABLATION.md).
 constexpr float kCutOverLowerM = 0.01f;
 
+/// Calls visit(p, l) for each pixel p of a segment l (labels 1..), skipping the rows without
+/// any (most rows above and below the objects). Cost: one pass over the rows with objects.
+template <class Visit>
+void for_segment_pixels(const Ctx& x, const SegmentWorkspace& ws, Visit&& visit) {
+    for (int v = 0; v < x.H; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
+        if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
+        for (std::size_t p = row; p < row + static_cast<std::size_t>(x.W); ++p)
+            if (const int l = ws.label[p]; l > 0) visit(p, l);
+    }
+}
+
 /// Per segment, how many of its pixels face up (within kUprightDeg of the support's normal)
 /// at each height over the support (bins of kLayerBinM from 0 up to the scope's height
 /// limit, above which nothing stands on the support) into ws.layer_hist, segment after
@@ -41,19 +53,13 @@ void count_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n, in
     ws.layer_hist.assign(static_cast<std::size_t>(n + 1) * static_cast<std::size_t>(bins), 0);
     ws.sizes.assign(static_cast<std::size_t>(n) + 1, 0);
     const float cos_up = std::cos(kUprightDeg * kDegToRad);
-    for (int v = 0; v < x.H; ++v) {
-        const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
-        if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
-        for (std::size_t p = row; p < row + static_cast<std::size_t>(x.W); ++p) {
-            const int l = ws.label[p];
-            if (l <= 0) continue;
-            ++ws.sizes[static_cast<std::size_t>(l)];
-            if (!faces_up(x, pl, p, cos_up)) continue;
-            const int b = static_cast<int>(std::floor(pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) / kLayerBinM));
-            if (b >= 0 && b < bins)
-                ++ws.layer_hist[static_cast<std::size_t>(l) * static_cast<std::size_t>(bins) + static_cast<std::size_t>(b)];
-        }
-    }
+    for_segment_pixels(x, ws, [&](std::size_t p, int l) {
+        ++ws.sizes[static_cast<std::size_t>(l)];
+        if (!faces_up(x, pl, p, cos_up)) return;
+        const int b = static_cast<int>(std::floor(pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) / kLayerBinM));
+        if (b >= 0 && b < bins)
+            ++ws.layer_hist[static_cast<std::size_t>(l) * static_cast<std::size_t>(bins) + static_cast<std::size_t>(b)];
+    });
 }
 
 /// The height that cuts one segment between two layers of its upward faces (hist: its
@@ -110,15 +116,9 @@ int find_cuts(const Ctx& x, SegmentWorkspace& ws, int n, int bins) {
 /// Cost: one pass over the rows with objects.
 template <class Visit>
 void for_cut_pixels(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, Visit&& visit) {
-    for (int v = 0; v < x.H; ++v) {
-        const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
-        if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
-        for (std::size_t p = row; p < row + static_cast<std::size_t>(x.W); ++p) {
-            const int l = ws.label[p];
-            if (l <= 0 || ws.stack_cut[static_cast<std::size_t>(l)] < 0) continue;
-            visit(p, l, pl.height(x.c.x[p], x.c.y[p], x.c.z[p]));
-        }
-    }
+    for_segment_pixels(x, ws, [&](std::size_t p, int l) {
+        if (ws.stack_cut[static_cast<std::size_t>(l)] >= 0) visit(p, l, pl.height(x.c.x[p], x.c.y[p], x.c.z[p]));
+    });
 }
 
 /// Where the upper object's walls stand is mapped in cells of this size on the support
@@ -130,74 +130,60 @@ constexpr float kWallCellM = 0.01f;
 constexpr int kMaxWallCells = 256;
 
 /// The upper objects' walls: the pixels of each cut segment above its cut that face
-/// sideways, as (segment, u, v) on the support plane into ws.stack_walls. Cost: one pass over
-/// the rows with objects.
+/// sideways, with where they stand on the support plane, into ws.stack_walls. Cost: one pass
+/// over the rows with objects.
 void collect_upper_walls(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws) {
     ws.stack_walls.clear();
     for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
         if (h <= ws.stack_cut[static_cast<std::size_t>(l)] || !faces_sideways(x, pl, p, sin_wall)) return;
         const Eigen::Vector2d q = axes(x.c, p);
-        ws.stack_walls.insert(ws.stack_walls.end(),
-                              {static_cast<float>(l), static_cast<float>(q.x()), static_cast<float>(q.y())});
+        ws.stack_walls.push_back({l, static_cast<float>(q.x()), static_cast<float>(q.y())});
     });
 }
 
-/// Per segment, a map of where its upper object's walls stand (ws.stack_walls): its box on
-/// the plane in ws.wall_box (u0, v0, columns, rows; columns 0: no map) and its cells, 1 where
-/// a wall stands, in ws.wall_cells from ws.wall_at. Cost: two passes over the walls.
+/// Per segment, a map of where its upper object's walls stand (ws.stack_walls) in
+/// ws.wall_maps, its cells in ws.wall_cells. Cost: two passes over the walls.
 void draw_wall_maps(SegmentWorkspace& ws, int n) {
-    const std::size_t walls = ws.stack_walls.size() / 3;
+    // The walls' box on the plane per segment, then its cells.
     const float big = std::numeric_limits<float>::max();
-    ws.wall_box.assign(4 * (static_cast<std::size_t>(n) + 1), 0.0f);
-    for (int l = 1; l <= n; ++l) {
-        float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(l);
-        b[0] = b[1] = big;
-        b[2] = b[3] = -big;
+    std::vector<std::array<float, 4>>& box = ws.wall_box;  // u0, v0, u1, v1
+    box.assign(static_cast<std::size_t>(n) + 1, {big, big, -big, -big});
+    for (const SegmentWorkspace::WallPoint& w : ws.stack_walls) {
+        std::array<float, 4>& b = box[static_cast<std::size_t>(w.segment)];
+        b = {std::min(b[0], w.u), std::min(b[1], w.v), std::max(b[2], w.u), std::max(b[3], w.v)};
     }
-    for (std::size_t i = 0; i < walls; ++i) {  // the boxes: min and max of u and v
-        const float* w = ws.stack_walls.data() + 3 * i;
-        float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(w[0]);
-        b[0] = std::min(b[0], w[1]);
-        b[1] = std::min(b[1], w[2]);
-        b[2] = std::max(b[2], w[1]);
-        b[3] = std::max(b[3], w[2]);
-    }
-    ws.wall_at.assign(static_cast<std::size_t>(n) + 1, 0);
+    ws.wall_maps.assign(static_cast<std::size_t>(n) + 1, {});
     std::size_t cells = 0;
-    for (int l = 1; l <= n; ++l) {  // then columns and rows in place of the max
-        float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(l);
-        const int cols = b[2] >= b[0] ? static_cast<int>((b[2] - b[0]) / kWallCellM) + 1 : 0;
-        const int rows = b[3] >= b[1] ? static_cast<int>((b[3] - b[1]) / kWallCellM) + 1 : 0;
-        const bool drawn = cols > 0 && rows > 0 && cols <= kMaxWallCells && rows <= kMaxWallCells;
-        b[2] = drawn ? static_cast<float>(cols) : 0.0f;
-        b[3] = drawn ? static_cast<float>(rows) : 0.0f;
-        ws.wall_at[static_cast<std::size_t>(l)] = cells;
-        if (drawn) cells += static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
+    for (int l = 1; l <= n; ++l) {
+        const std::array<float, 4>& b = box[static_cast<std::size_t>(l)];
+        if (b[2] < b[0]) continue;  // no walls
+        const int cols = static_cast<int>((b[2] - b[0]) / kWallCellM) + 1;
+        const int rows = static_cast<int>((b[3] - b[1]) / kWallCellM) + 1;
+        if (cols > kMaxWallCells || rows > kMaxWallCells) continue;
+        ws.wall_maps[static_cast<std::size_t>(l)] = {b[0], b[1], cols, rows, cells};
+        cells += static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
     }
     ws.wall_cells.assign(cells, 0);
-    for (std::size_t i = 0; i < walls; ++i) {
-        const float* w = ws.stack_walls.data() + 3 * i;
-        const auto l = static_cast<std::size_t>(w[0]);
-        const float* b = ws.wall_box.data() + 4 * l;
-        if (b[2] == 0) continue;
-        const auto cu = static_cast<std::size_t>((w[1] - b[0]) / kWallCellM);
-        const auto cv = static_cast<std::size_t>((w[2] - b[1]) / kWallCellM);
-        ws.wall_cells[ws.wall_at[l] + cv * static_cast<std::size_t>(b[2]) + cu] = 1;
+    for (const SegmentWorkspace::WallPoint& w : ws.stack_walls) {
+        const SegmentWorkspace::WallMap& m = ws.wall_maps[static_cast<std::size_t>(w.segment)];
+        if (m.cols == 0) continue;
+        const auto cu = static_cast<std::size_t>((w.u - m.u0) / kWallCellM);
+        const auto cv = static_cast<std::size_t>((w.v - m.v0) / kWallCellM);
+        ws.wall_cells[m.at + cv * static_cast<std::size_t>(m.cols) + cu] = 1;
     }
 }
 
 /// Whether point q of segment l (on the plane) stands where its upper object's walls stand:
 /// in a cell of its map or a neighbour. Cost: nine lookups.
 bool under_upper_walls(const SegmentWorkspace& ws, int l, const Eigen::Vector2d& q) {
-    const float* b = ws.wall_box.data() + 4 * static_cast<std::size_t>(l);
-    const int cols = static_cast<int>(b[2]), rows = static_cast<int>(b[3]);
-    if (cols == 0) return false;
-    const int cu = static_cast<int>(std::floor((static_cast<float>(q.x()) - b[0]) / kWallCellM));
-    const int cv = static_cast<int>(std::floor((static_cast<float>(q.y()) - b[1]) / kWallCellM));
-    const std::uint8_t* cells = ws.wall_cells.data() + ws.wall_at[static_cast<std::size_t>(l)];
-    for (int v = std::max(cv - 1, 0); v <= std::min(cv + 1, rows - 1); ++v)
-        for (int u = std::max(cu - 1, 0); u <= std::min(cu + 1, cols - 1); ++u)
-            if (cells[v * cols + u]) return true;
+    const SegmentWorkspace::WallMap& m = ws.wall_maps[static_cast<std::size_t>(l)];
+    if (m.cols == 0) return false;
+    const int cu = static_cast<int>(std::floor((static_cast<float>(q.x()) - m.u0) / kWallCellM));
+    const int cv = static_cast<int>(std::floor((static_cast<float>(q.y()) - m.v0) / kWallCellM));
+    const std::uint8_t* cells = ws.wall_cells.data() + m.at;
+    for (int v = std::max(cv - 1, 0); v <= std::min(cv + 1, m.rows - 1); ++v)
+        for (int u = std::max(cu - 1, 0); u <= std::min(cu + 1, m.cols - 1); ++u)
+            if (cells[v * m.cols + u]) return true;
     return false;
 }
 
@@ -239,8 +225,11 @@ void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, 
     for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
         const Piece k = piece_of(x, pl, axes, sin_wall, ws, p, l, h);
         if (k == kUpper) return;
-        // Chromaticity, as the colour cue's: light falling at other angles on two faces of
-        // one object scales their colour and leaves it.
+        // Chromaticity, 255 rgb / (r + g + b + 30): light falling at other angles on two faces
+        // of one object scales their colour and leaves it. The colour cue's adds 10 to each
+        // channel first, pulling dark pixels towards grey; this rule was measured without
+        // that (with it, report scene 01051's printed pair falls under color_min_distance:
+        // docs/ABLATION.md).
         const double r = x.c.r[p], g = x.c.g[p], b = x.c.b[p], scale = 255.0 / (r + g + b + 30.0);
         std::array<double, 4>& sum = ws.wall_colour[3 * static_cast<std::size_t>(l) + static_cast<std::size_t>(k)];
         sum[0] += r * scale;
@@ -255,7 +244,7 @@ void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, 
             const double to_lower = colour_distance(sums[kUnderUpperWalls], sums[kLower]);
             up = to_lower >= x.prm.color_min_distance && colour_distance(sums[kUnderUpperWalls], sums[kUpperWall]) < to_lower;
         }
-        if (!up) ws.wall_box[4 * static_cast<std::size_t>(l) + 2] = 0;  // no map: the walls stay
+        if (!up) ws.wall_maps[static_cast<std::size_t>(l)].cols = 0;  // no map: the walls stay
     }
 }
 
@@ -289,7 +278,7 @@ int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
         draw_wall_maps(ws, n);
         keep_walls_by_colour(x, pl, axes, sin_wall, ws, n);
     } else {
-        ws.wall_box.assign(4 * (static_cast<std::size_t>(n) + 1), 0.0f);  // no maps
+        ws.wall_maps.assign(static_cast<std::size_t>(n) + 1, {});  // no maps
     }
     return cut_layers(x, pl, axes, sin_wall, ws, n);
 }

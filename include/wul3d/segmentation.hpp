@@ -206,9 +206,21 @@ struct SegmentWorkspace {
     // Stacks:
     std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
     std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)
-    std::vector<float> stack_walls;          ///< the upper objects' walls: segment, u, v on the plane
-    std::vector<float> wall_box;             ///< per segment, its walls' map: u0, v0, columns, rows
-    std::vector<std::size_t> wall_at;        ///< per segment, where its map starts in wall_cells
+    /// A pixel of an upper object's wall: its segment and where it stands on the support plane.
+    struct WallPoint {
+        int segment;
+        float u, v;
+    };
+    /// Where one segment's upper object's walls stand: cells of wall_cells[at, at + cols *
+    /// rows), row by row from (u0, v0) on the plane; cols 0: no map.
+    struct WallMap {
+        float u0 = 0, v0 = 0;
+        int cols = 0, rows = 0;
+        std::size_t at = 0;
+    };
+    std::vector<WallPoint> stack_walls;      ///< the cut segments' upper walls
+    std::vector<WallMap> wall_maps;          ///< per segment
+    std::vector<std::array<float, 4>> wall_box;  ///< scratch: per segment its walls' u0, v0, u1, v1
     std::vector<std::uint8_t> wall_cells;    ///< 1 = an upper object's wall stands in that cell
     std::vector<std::array<double, 4>> wall_colour;  ///< per segment and piece: chromaticity
                                                      ///< sums (3) and count
