@@ -79,6 +79,7 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"occluded_joins", r.segment_stats.occluded},
             {"gaps_filled", r.segment_stats.gaps_filled},
             {"color_splits", r.segment_stats.color_splits},
+            {"texture_splits", r.segment_stats.texture_splits},
             {"stack_splits", r.segment_stats.stack_splits},
             {"scope", r.segment_stats.support_scope ? "support" : "scene"},
             {"out_of_scope", r.segment_stats.out_of_scope},

@@ -513,7 +513,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
         stats.ms.containers = ms_since();
     }
     if (params.segmenter == Segmenter::Hybrid) {
-        stats.color_splits = color_splits(x, support, ws, n);
+        stats.color_splits = color_splits(x, support, ws, n, stats.texture_splits);
         n += stats.color_splits;
         stats.ms.color = ms_since();
     }

@@ -142,8 +142,9 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
 int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
 
 /// The colour cue (hybrid): splits segments in two by colour; the new parts are numbered
-/// n + 1, n + 2, ... in segment order. Returns the splits.
-int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n);
+/// n + 1, n + 2, ... in segment order. Returns the splits; `by_material` gets those between
+/// a texture and another material (SegmentParams::color_textures).
+int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material);
 
 /// Occlusion (SegmentParams, "Occlusion"): joins the two parts of a surface that a nearer
 /// object divides in view. Returns the joins.

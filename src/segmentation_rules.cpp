@@ -619,31 +619,27 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
            4 * radial >= 3 * walls;
 }
 
-/// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
-/// "Colour cue"). Writes ws.part at the segment's pixels once 2-means ran. True when the
-/// split is kept. Cost: O(segment pixels) per 2-means iteration and for the boundary; no
-/// allocation (called in parallel, one segment per call).
-bool try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
-                      const ClusterParams& cp, float cos_crease, SegmentWorkspace& ws, int l) {
+/// What the colour cue's tests say of a split.
+enum class Verdict {
+    kKept,
+    kTexture,  ///< the boundary runs round many pieces: the parts follow a texture
+    kRejected,
+};
+
+/// The colour cue's tests (SegmentParams, "Colour cue") of a split of segment l: pixels
+/// px[0, m), parts in ws.part, part sizes `count` and means `cen` (feature units). Cost: one
+/// pass over the segment's pixels for the boundary; the round test's three more, on a
+/// support, when every other test passed.
+Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ClusterParams& cp,
+                    float cos_crease, const SegmentWorkspace& ws, int l, const int* px, int m, const int (&count)[2],
+                    const float (&cen)[2][6]) {
     const SegmentParams& prm = x.prm;
-    const int o = ws.offsets[static_cast<std::size_t>(l)];
-    const int* px = ws.order.data() + o;
-    const int m = segment_size(ws, l);
-    const float* f[6];  // the segment's features
-    for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
-    float cen[2][6];
-    double total[6];
-    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen, total)) return false;
-    std::uint8_t* const side = ws.part_in_order.data() + o;
-    int count[2] = {0, 0};
-    two_means(f, m, total, side, cen, count);
-    std::uint8_t* part = ws.part.data();
-    for (int i = 0; i < m; ++i) part[px[i]] = side[i];
     const int small = std::min(count[0], count[1]);
-    if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m)) return false;
+    if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m))
+        return Verdict::kRejected;
     const float dr = (cen[0][3] - cen[1][3]) / cp.alpha, dg = (cen[0][4] - cen[1][4]) / cp.alpha,
                 db = (cen[0][5] - cen[1][5]) / cp.alpha;
-    if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) return false;
+    if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) return Verdict::kRejected;
     // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
     // crease step away on either side tell a smooth surface from a fold.
     const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
@@ -655,7 +651,7 @@ bool try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane
     // pieces, far longer than either.
     const bool one_side = static_cast<float>(sb.boundary) <= prm.color_max_boundary * static_cast<float>(sb.small_outline);
     const bool compact = static_cast<double>(sb.boundary) <= prm.color_max_compact * std::sqrt(static_cast<double>(small));
-    if (!one_side && !compact) return false;
+    if (!one_side && !compact) return Verdict::kTexture;
     // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
     // straddle its edge), or the parts must differ in chromaticity: light falling on two
     // faces of one box at other angles scales their colour, it does not turn it, so
@@ -667,18 +663,249 @@ bool try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane
         const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
         const float dot = r0 * r1 + g0 * g1 + b0c * b1c;
         const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
-        if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) return false;
+        if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) return Verdict::kRejected;
     }
     // Last, as it is the rarest to fail: a round thing's colours are print.
-    return !(support && prm.color_round_deg > 0 && stands_round(x, *plane_xy, *support, px, m));
+    if (support && prm.color_round_deg > 0 && stands_round(x, *plane_xy, *support, px, m)) return Verdict::kRejected;
+    return Verdict::kKept;
+}
+
+// ---- the colour cue's materials ------------------------------------------------------------
+//
+// 2-means follows a texture when one object of the segment is textured: stripes of two
+// colours beside a plain box put the stripes in two parts and the box with one of them.
+// More colours then: the texture's two, the plain one's, and one for the rest. Two colours
+// whose contact is far longer than any two objects' (they interleave) are one material; the
+// split is between the materials.
+
+/// Colours per segment when 2-means followed a texture: a textured object's two, a plain
+/// one's beside it, and one more for what fits none (mixed pixels along edges, a third
+/// colour). Chosen on the generated tune seeds: 3, 4 and 5 colours scored 92.8, 93.1 and
+/// 92.9 Overlap F, learnt from every pixel (docs/ABLATION.md, "Textures").
+constexpr int kTextureColours = 4;
+
+/// k-means learns the colours from at most this many pixels per colour (every stride-th
+/// pixel), then gives every pixel its nearest once: FAISS's Clustering subsamples its
+/// training set the same way (max_points_per_centroid, 256 by default).
+constexpr int kSamplesPerColour = 256;
+
+/// The centre nearest pixel i's features (eq. 4 squared): |f - c_k|^2 less |f|^2, i.e.
+/// |c_k|^2 - 2 f . c_k, from `w` = 2 c_k and `bias` = |c_k|^2. Branch-free, so that a loop
+/// over pixels vectorizes.
+inline std::uint8_t nearest_colour(const float* const* f, int i, const float (&w)[kTextureColours][6],
+                                   const float (&bias)[kTextureColours]) {
+    std::uint8_t best = 0;
+    float best_d = 0;
+    for (int k = 0; k < kTextureColours; ++k) {
+        float d = bias[k];
+        for (int q = 0; q < 6; ++q) d -= w[k][q] * f[q][i];
+        const bool nearer = k == 0 || d < best_d;
+        best_d = nearer ? d : best_d;
+        best = nearer ? static_cast<std::uint8_t>(k) : best;
+    }
+    return best;
+}
+
+/// k-means (eq. 4 squared, on the 2-means features `f` of the m pixels) with
+/// kTextureColours centres, seeded at the two 2-means parts' means `two` and then, one by
+/// one, at the colour farthest from the centres so far; learnt from every stride-th pixel
+/// (at most kSamplesPerColour per colour, copied together). cluster[i] gets pixel i's
+/// colour, `cen` and `count` the colours' means (of the samples) and sizes (of all pixels).
+/// Cost: at most 8 passes over the samples (the nearest colours vectorized), then one over
+/// the m pixels; 28 KB of stack, no allocation.
+void texture_colours(const float* const* f, int m, const float (&two)[2][6], std::uint8_t* cluster,
+                     float (&cen)[kTextureColours][6], int (&count)[kTextureColours]) {
+    constexpr int K = kTextureColours, kMaxSamples = kSamplesPerColour * kTextureColours;
+    const int stride = (m + kMaxSamples - 1) / kMaxSamples;
+    float samples[6][kMaxSamples];
+    std::uint8_t nearest[kMaxSamples];
+    int n = 0;
+    for (int i = 0; i < m; i += stride, ++n)
+        for (int q = 0; q < 6; ++q) samples[q][n] = f[q][i];
+    const float* const s[6] = {samples[0], samples[1], samples[2], samples[3], samples[4], samples[5]};
+    auto colour_distance = [&](int j, const float* c) {
+        float d = 0;
+        for (int q = 3; q < 6; ++q) d += (s[q][j] - c[q]) * (s[q][j] - c[q]);
+        return d;
+    };
+    for (int q = 0; q < 6; ++q) cen[0][q] = two[0][q], cen[1][q] = two[1][q];
+    float nearest_d[kMaxSamples];  // each sample's colour distance to the nearest centre so far
+    for (int j = 0; j < n; ++j) nearest_d[j] = std::min(colour_distance(j, cen[0]), colour_distance(j, cen[1]));
+    for (int k = 2; k < K; ++k) {
+        const int farthest = static_cast<int>(std::max_element(nearest_d, nearest_d + n) - nearest_d);
+        for (int q = 0; q < 6; ++q) cen[k][q] = s[q][farthest];
+        for (int j = 0; j < n; ++j) nearest_d[j] = std::min(nearest_d[j], colour_distance(j, cen[k]));
+    }
+    float w[K][6], bias[K];
+    auto set_weights = [&] {
+        for (int k = 0; k < K; ++k) {
+            bias[k] = 0;
+            for (int q = 0; q < 6; ++q) w[k][q] = 2 * cen[k][q], bias[k] += cen[k][q] * cen[k][q];
+        }
+    };
+    for (int it = 0; it < 8; ++it) {
+        set_weights();
+        int changed = 0;
+        for (int j = 0; j < n; ++j) {
+            const std::uint8_t k = nearest_colour(s, j, w, bias);
+            changed += it == 0 || nearest[j] != k;
+            nearest[j] = k;
+        }
+        float sum[K][6] = {};
+        int n_k[K] = {};
+        for (int j = 0; j < n; ++j) {
+            const int k = nearest[j];
+            ++n_k[k];
+            for (int q = 0; q < 6; ++q) sum[k][q] += s[q][j];
+        }
+        for (int k = 0; k < K; ++k)
+            if (n_k[k] > 0)
+                for (int q = 0; q < 6; ++q) cen[k][q] = sum[k][q] / static_cast<float>(n_k[k]);
+        if (changed == 0) break;
+    }
+    set_weights();
+    // Local copies of the plane pointers: a byte store may alias anything, and the loop
+    // would load them again for every pixel instead of vectorizing.
+    const float* const planes[6] = {f[0], f[1], f[2], f[3], f[4], f[5]};
+    for (int i = 0; i < m; ++i) cluster[i] = nearest_colour(planes, i, w, bias);
+    for (int k = 0; k < K; ++k) count[k] = 0;
+    for (int i = 0; i < m; ++i) ++count[cluster[i]];
+}
+
+/// The materials of segment l's colours (ws.part at its pixels px[0, m), sizes `count`):
+/// per pair of colours their contact, the 4-neighbour pairs between them, over the square
+/// root of the smaller's size. Above color_max_compact (longer than the outline of any
+/// compact piece) they interleave: one material. At most color_max_boundary x that (one side
+/// of a compact piece) they lie apart. Between the two the pair is neither: no split. True,
+/// with `material` (0 or 1 per colour), when the colours make exactly two materials. Cost:
+/// one pass over the segment's pixels.
+bool texture_materials(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
+                       const int (&count)[kTextureColours], std::uint8_t (&material)[kTextureColours]) {
+    constexpr int K = kTextureColours;
+    const SegmentParams& prm = x.prm;
+    const int W = x.W;
+    const std::uint8_t* const part = ws.part.data();
+    int contact[K][K] = {};
+    for (int i = 0; i < m; ++i) {
+        const int p = px[i], u = p % W, v = p / W;
+        const std::size_t right = static_cast<std::size_t>(p) + 1, below = static_cast<std::size_t>(p + W);
+        if (u + 1 < W && ws.label[right] == l && part[right] != part[p]) ++contact[part[p]][part[right]];
+        if (v + 1 < x.H && ws.label[below] == l && part[below] != part[p]) ++contact[part[p]][part[below]];
+    }
+    int root[K];  // union-find over the colours
+    for (int k = 0; k < K; ++k) root[k] = k;
+    auto find = [&](int k) {
+        while (root[k] != k) k = root[k];
+        return k;
+    };
+    int materials = K;
+    auto join = [&](int a, int b) {
+        if (const int ra = find(a), rb = find(b); ra != rb) root[rb] = ra, --materials;
+    };
+    // A colour too small for an object (mixed pixels along an edge, a sticker) is part of
+    // the material it touches most.
+    auto tiny = [&](int k) { return count[k] < prm.min_points; };
+    for (int k = 0; k < K; ++k) {
+        if (!tiny(k)) continue;
+        int most = k == 0 ? 1 : 0;
+        for (int j = 0; j < K; ++j)
+            if (j != k && contact[k][j] + contact[j][k] > contact[k][most] + contact[most][k]) most = j;
+        join(most, k);
+    }
+    for (int a = 0; a < K; ++a)
+        for (int b = a + 1; b < K; ++b) {
+            if (tiny(a) || tiny(b)) continue;
+            const double c = contact[a][b] + contact[b][a];
+            const double unit = std::sqrt(static_cast<double>(std::min(count[a], count[b])));
+            if (c > prm.color_max_compact * unit) {
+                join(a, b);
+            } else if (c > prm.color_max_boundary * prm.color_max_compact * unit) {
+                return false;
+            }
+        }
+    if (materials != 2) return false;
+    const int first = find(0);
+    for (int k = 0; k < K; ++k) material[k] = find(k) == first ? 0 : 1;
+    return true;
+}
+
+/// Segment l's split into two materials, when 2-means followed a texture: texture_colours,
+/// texture_materials, then ws.part, side, `count` and `cen` say the materials (cen: their
+/// means). False, and ws.part not a split, when the colours are not two materials. Cost:
+/// texture_colours' passes and two more over the segment's pixels.
+bool split_by_materials(const Ctx& x, SegmentWorkspace& ws, int l, const int* px, const float* const* f, int m,
+                        std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+    float colour[kTextureColours][6];
+    int colour_count[kTextureColours];
+    texture_colours(f, m, cen, side, colour, colour_count);
+    for (const int c : colour_count)
+        if (c == 0) return false;
+    std::uint8_t* const part = ws.part.data();
+    for (int i = 0; i < m; ++i) part[px[i]] = side[i];
+    std::uint8_t material[kTextureColours];
+    if (!texture_materials(x, ws, l, px, m, colour_count, material)) return false;
+    double sum[2][6] = {};
+    count[0] = count[1] = 0;
+    for (int i = 0; i < m; ++i) {
+        const std::uint8_t j = material[side[i]];
+        side[i] = j;
+        part[px[i]] = j;
+        ++count[j];
+        for (int q = 0; q < 6; ++q) sum[j][q] += f[q][i];
+    }
+    // Each material large enough to be tried again (as order_by_size asks of a segment):
+    // grouping colours is weaker evidence than 2-means' own parts, and a print's block of
+    // min_points split off a box seen in two pieces on osd_mosd's learn18 (docs/ABLATION.md,
+    // "Textures").
+    if (std::min(count[0], count[1]) < 2 * x.prm.min_points) return false;
+    for (int j = 0; j < 2; ++j)
+        for (int q = 0; q < 6; ++q) cen[j][q] = static_cast<float>(sum[j][q] / count[j]);
+    return true;
+}
+
+/// How a segment was split by the colour cue (ws.split).
+enum Split : std::uint8_t { kNotSplit = 0, kSplitByColour = 1, kSplitByMaterial = 2 };
+
+/// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
+/// "Colour cue"); where 2-means followed a texture, the segment's materials
+/// (split_by_materials) and the same tests. Writes ws.part at the segment's pixels once
+/// 2-means ran. Cost: O(segment pixels) per 2-means iteration and for the boundary, the
+/// materials' passes when 2-means followed a texture; no allocation (called in parallel, one
+/// segment per call).
+Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
+                       const ClusterParams& cp, float cos_crease, SegmentWorkspace& ws, int l) {
+    const SegmentParams& prm = x.prm;
+    const int o = ws.offsets[static_cast<std::size_t>(l)];
+    const int* px = ws.order.data() + o;
+    const int m = segment_size(ws, l);
+    const float* f[6];  // the segment's features
+    for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
+    float cen[2][6];
+    double total[6];
+    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen, total)) return kNotSplit;
+    std::uint8_t* const side = ws.part_in_order.data() + o;
+    int count[2] = {0, 0};
+    two_means(f, m, total, side, cen, count);
+    std::uint8_t* part = ws.part.data();
+    for (int i = 0; i < m; ++i) part[px[i]] = side[i];
+    const Verdict verdict = judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen);
+    if (verdict == Verdict::kKept) return kSplitByColour;
+    if (verdict != Verdict::kTexture || !prm.color_textures || count[0] == 0 || count[1] == 0 ||
+        !split_by_materials(x, ws, l, px, f, m, side, cen, count))
+        return kNotSplit;
+    return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen) == Verdict::kKept
+               ? kSplitByMaterial
+               : kNotSplit;
 }
 
 /// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
-/// thread order). Returns the splits. Cost: one pass over the split segments' pixels.
-int number_splits(SegmentWorkspace& ws, int n) {
+/// thread order). Returns the splits, and adds those by material to `by_material`. Cost:
+/// one pass over the split segments' pixels.
+int number_splits(SegmentWorkspace& ws, int n, int& by_material) {
     int splits = 0, next = n;
     for (int l = 1; l <= n; ++l) {
-        if (!ws.split[static_cast<std::size_t>(l)]) continue;
+        if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
+        by_material += ws.split[static_cast<std::size_t>(l)] == kSplitByMaterial;
         const int id = ++next;
         const int o = ws.offsets[static_cast<std::size_t>(l)];
         const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
@@ -693,16 +920,16 @@ int number_splits(SegmentWorkspace& ws, int n) {
 
 /// One round of the colour cue over the segments marked in ws.to_try (1..n): tries to split
 /// each in two, then numbers part 1 of each split segment n + 1, n + 2, ... in segment order.
-/// Returns the splits. Cost: a counting sort and a gather of the object pixels (parallel
-/// passes), then O(segment pixels) per 2-means iteration per segment tried, segments in
-/// parallel.
-int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n) {
+/// Returns the splits, and adds those by material to `by_material`. Cost: a counting sort
+/// and a gather of the object pixels (parallel passes), then O(segment pixels) per 2-means
+/// iteration per segment tried, segments in parallel.
+int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
     const SegmentParams& prm = x.prm;
     sort_pixels_by_segment(x, ws, n);
     // part is written for a segment's pixels before anything reads them: no clearing.
     ws.part.resize(static_cast<std::size_t>(x.W) * x.H);
     ws.part_in_order.resize(static_cast<std::size_t>(ws.offsets[static_cast<std::size_t>(n) + 1]));
-    ws.split.assign(static_cast<std::size_t>(n) + 1, 0);
+    ws.split.assign(static_cast<std::size_t>(n) + 1, kNotSplit);
     ClusterParams cp;
     cp.alpha = prm.color_alpha;
     cp.delta = 1.0f - prm.color_alpha;
@@ -720,7 +947,7 @@ int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n)
         const PlaneAxes* axes = plane_xy ? &*plane_xy : nullptr;
         ws.split[static_cast<std::size_t>(l)] = try_colour_split(x, support, axes, features, cp, cos_crease, ws, l);
     }
-    return number_splits(ws, n);
+    return number_splits(ws, n, by_material);
 }
 
 }  // namespace
@@ -729,20 +956,23 @@ int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n)
 /// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
 /// are large, and meet along one side of the smaller part or round a compact piece, across
 /// a smooth surface or with a turn of colour, and the segment does not stand round on the
-/// support (stands_round: a can's label is print). A second round tries the two parts of each
-/// split segment again: three flush boxes of three colours need two cuts. In: ws.label
-/// (1..n with gaps). Out: ws.label with the new parts numbered n + 1, n + 2, ... (round 1's
-/// in segment order, then round 2's). Cost: split_round once, twice when it split anything.
-int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n) {
+/// support (stands_round: a can's label is print). Where 2-means followed a texture, the
+/// same tests judge a split between the segment's materials (split_by_materials). A second
+/// round tries the two parts of each split segment again: three flush boxes of three colours
+/// need two cuts. In: ws.label (1..n with gaps). Out: ws.label with the new parts numbered
+/// n + 1, n + 2, ... (round 1's in segment order, then round 2's); `by_material` counts the
+/// splits between materials. Cost: split_round once, twice when it split anything.
+int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
+    by_material = 0;
     ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
-    const int first = split_round(x, support, ws, n);
+    const int first = split_round(x, support, ws, n, by_material);
     if (first == 0) return 0;
     // Round 2: the segments split in round 1 (part 0 kept their label) and their new parts.
     // A third round split nothing more on the tune seeds (docs/ABLATION.md).
     ws.to_try.assign(static_cast<std::size_t>(n + first) + 1, 0);
-    for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)];
+    for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)] != kNotSplit;
     for (int l = n + 1; l <= n + first; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
-    return first + split_round(x, support, ws, n + first);
+    return first + split_round(x, support, ws, n + first, by_material);
 }
 
 // ---- scope ---------------------------------------------------------------------------------

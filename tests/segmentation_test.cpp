@@ -676,6 +676,65 @@ TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
 }
 
 namespace {
+/// Paints truth object `id`'s pixels with stripes of two colours, `period_m` wide, fixed on
+/// its surfaces (the stripes follow x + y + z of the points, as the generator's do).
+void paint_stripes(PlaneStage& in, int id, const std::uint8_t (&a)[3], const std::uint8_t (&b)[3], float period_m) {
+    for (std::size_t p = 0; p < in.truth.size(); ++p) {
+        if (in.truth[p] != id) continue;
+        const float t = (in.cloud.x[p] + in.cloud.y[p] + in.cloud.z[p]) / period_m;
+        const auto& c = static_cast<long>(std::floor(t)) % 2 == 0 ? a : b;
+        in.cloud.r[p] = c[0], in.cloud.g[p] = c[1], in.cloud.b[p] = c[2];
+    }
+}
+
+/// Two flush boxes, the left plain red, the right striped (blue and yellow, 2 cm).
+PlaneStage plain_and_striped_boxes() {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    s.boxes = {SceneBox{.x = -0.075f, .z = 1.0f}, SceneBox{.x = 0.075f, .z = 1.0f}};
+    PlaneStage in = up_to_the_plane(s);
+    paint_stripes(in, kTruthBox0 + 1, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    return in;
+}
+}  // namespace
+
+// A plain box flush beside a striped one: 2-means follows the stripes (its boundary runs
+// round every stripe) and the split is rejected; the segment's three colours make two
+// materials (the stripes' two interleave), and the split between them is kept.
+TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
+    const PlaneStage in = plain_and_striped_boxes();
+    SegmentParams without;
+    without.color_textures = false;
+    SegmentStats stats;
+    const LabelImage one = segment(in, without, &stats);
+    int a = 0, b = 0;
+    dominant_share(one.labels, in.truth, kTruthBox0, &a);
+    dominant_share(one.labels, in.truth, kTruthBox0 + 1, &b);
+    ASSERT_EQ(a, b) << "2-means alone should not part the boxes (test premise)";
+    EXPECT_EQ(stats.color_splits, 0);
+
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the materials were not parted");
+    EXPECT_EQ(stats.color_splits, 1);
+    EXPECT_EQ(stats.texture_splits, 1);
+}
+
+// One striped box on its own: its stripes are one material, whatever the three colours
+// 2-means' texture leads to; nothing is split.
+TEST(SegmentObjects, StripedBox_StaysOneObject) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    s.boxes = {SceneBox{.z = 1.0f, .w = 0.25f}};
+    PlaneStage in = up_to_the_plane(s);
+    paint_stripes(in, kTruthBox0, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0), 0.95);
+    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.segments, 1);
+}
+
+namespace {
 /// A long box lying across the table, and a narrow tall box standing before its middle: the
 /// lying box shows one part each side of the standing one. With `two_boxes`, two short
 /// boxes stand there instead, the right one 2.5 cm farther back and 2.5 cm taller: two

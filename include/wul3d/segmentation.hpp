@@ -88,6 +88,11 @@ struct SegmentParams {
                                       ///< rim_ fit's residual and arc) and face within this
                                       ///< of its radii; [0, 90), 0 = off
     float color_round_max_radius_m = 0.15f;  ///< ... a circle of at most this radius; > 0
+    bool color_textures = true;  ///< where 2-means follows a texture (its boundary runs round
+                                 ///< many pieces), four colours, and two whose contact is
+                                 ///< longer than color_max_compact allows are one material
+                                 ///< (they interleave); the same tests judge the split
+                                 ///< between two materials: stripes beside a plain box
     // Stacks (needs the support plane; not kmeans): a segment whose upward faces lie at two
     // heights over the support, nothing facing up between them, is two objects, one resting
     // on the other; it is cut just over the lower one's top.
@@ -230,6 +235,8 @@ struct SegmentWorkspace {
 struct SegmentStats {
     int segments = 0;      ///< objects written to `out`
     int color_splits = 0;  ///< splits the colour cue made, both rounds (each adds a segment)
+    int texture_splits = 0;  ///< of color_splits, those between a texture and another
+                             ///< material (color_textures)
     int stack_splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
     int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim

@@ -92,6 +92,7 @@ Result make_result(const FrameResult& r) {
     out.stats["occluded_joins"] = r.segment_stats.occluded;
     out.stats["gaps_filled"] = r.segment_stats.gaps_filled;
     out.stats["color_splits"] = r.segment_stats.color_splits;
+    out.stats["texture_splits"] = r.segment_stats.texture_splits;
     out.stats["stack_splits"] = r.segment_stats.stack_splits;
     return out;
 }
