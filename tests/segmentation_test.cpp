@@ -699,8 +699,9 @@ PlaneStage plain_and_striped_boxes() {
 }  // namespace
 
 // A plain box flush beside a striped one: 2-means follows the stripes (its boundary runs
-// round every stripe) and the split is rejected; the segment's three colours make two
-// materials (the stripes' two interleave), and the split between them is kept.
+// round every stripe) and the split is rejected; the segment's four colours make two
+// materials (the stripes' two interleave, the rest is the plain box's), and the split
+// between them is kept.
 TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
     const PlaneStage in = plain_and_striped_boxes();
     SegmentParams without;
@@ -719,8 +720,8 @@ TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
     EXPECT_EQ(stats.texture_splits, 1);
 }
 
-// One striped box on its own: its stripes are one material, whatever the three colours
-// 2-means' texture leads to; nothing is split.
+// One striped box on its own: its stripes are one material, whatever four colours k-means
+// finds in them; nothing is split.
 TEST(SegmentObjects, StripedBox_StaysOneObject) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 13;
