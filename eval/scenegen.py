@@ -219,9 +219,12 @@ def yaw_matrix(yaw, tilt_axis=None, tilt=0.0):
 # ---------------------------------------------------------------------------------------
 # The scene: a list of (primitive, label, material).
 # ---------------------------------------------------------------------------------------
-def build_scene(rng, prints):
+def build_scene(rng, prints, kind_of=None):
     """`prints`: the random stream of the cylinders' labels, apart from `rng` so that adding
-    them left every layout as it was."""
+    them left every layout as it was. `kind_of`, a dict, gets each object's label -> the kind
+    of group it was drawn in (box, stack, flat, lean, flush, cylinder, cup, bowl); it draws
+    nothing, so the layout is the same with or without it."""
+    kind_of = {} if kind_of is None else kind_of
     parts = []
     table_h = rng.uniform(0.70, 0.78)
     L, D = rng.uniform(1.2, 1.8), rng.uniform(0.7, 1.0)
@@ -306,6 +309,7 @@ def build_scene(rng, prints):
             yaw = rng.uniform(0, np.pi)
             R = yaw_matrix(yaw)
             label += 1
+            kind_of[label] = str(kind)
             parts.append((Box([at[0], at[1], hz], R, [hx, hy, hz]), label, material(rng)))
             footprints.append((at[0], at[1], r))
             top = 2 * hz
@@ -319,6 +323,7 @@ def build_scene(rng, prints):
                     off = R @ np.array([rng.uniform(-1, 1) * (hx - ux), rng.uniform(-1, 1) * (hy - uy), 0])
                     Ru = yaw_matrix(yaw + rng.uniform(-0.3, 0.3))
                     label += 1
+                    kind_of[label] = str(kind)
                     parts.append((Box([at[0] + off[0], at[1] + off[1], top + uz], Ru, [ux, uy, uz]), label,
                                   material(rng)))
                     top += 2 * uz
@@ -333,6 +338,7 @@ def build_scene(rng, prints):
                 centre = base - Rl[:, 2] * 0 + Rl[:, 2] * lh
                 centre[2] = max(centre[2], lh * np.cos(tilt))
                 label += 1
+                kind_of[label] = str(kind)
                 parts.append((Box(centre, Rl, [lt, lw, lh]), label, material(rng)))
         elif kind == "flush":
             count = 2 if rng.random() < 0.6 else 3
@@ -356,6 +362,7 @@ def build_scene(rng, prints):
                 c = np.array([at[0], at[1], 0]) + R @ np.array([x, 0, 0])
                 c[2] = hzs[i]
                 label += 1
+                kind_of[label] = str(kind)
                 parts.append((Box(c, R, [hxs[i], hy, hzs[i]]), label, m0 if same else material(rng)))
                 x += hxs[i]
             footprints.append((at[0], at[1], r))
@@ -375,6 +382,7 @@ def build_scene(rng, prints):
             if at is None:
                 continue
             label += 1
+            kind_of[label] = str(kind)
             mat = material(rng)
             if kind == "cylinder" and prints.random() < LABELLED:
                 mat = with_label(prints, mat, h)
@@ -453,10 +461,12 @@ def occluded(parts, o, d, t_max):
 
 def render(seed, width=640, height=480, truth=None):
     """The frame of `seed`: colour, depth (mm), labels, intrinsics. `truth`, a dict, gets the
-    exact depth (`z`, metres), each pixel's world point (`world`) and its part's label before
-    the visibility rule (`raw_labels`), for the tests."""
+    exact depth (`z`, metres), each pixel's world point (`world`), its part's label before
+    the visibility rule (`raw_labels`) and each label's kind of group (`kinds`, label ->
+    build_scene's kind), for the tests and eval/kinds.py."""
     rng = np.random.default_rng(seed)
-    parts, (L, D, _) = build_scene(rng, np.random.default_rng([seed, 1]))
+    kind_of = {}
+    parts, (L, D, _) = build_scene(rng, np.random.default_rng([seed, 1]), kind_of)
     pos, Rc = camera(rng, L, D)
     s = width / 640.0
     f, cx, cy = FOCAL * s, (width - 1) / 2.0, (height - 1) / 2.0
@@ -523,15 +533,18 @@ def render(seed, width=640, height=480, truth=None):
     labels = labels.reshape(height, width)
     out = np.zeros_like(labels, dtype=np.uint16)
     next_id = 0
+    out_kinds = {}
     for lab in range(1, labels.max() + 1):
         m = (labels == lab) & valid
         if m.sum() * (640.0 / width) ** 2 >= MIN_VISIBLE:
             next_id += 1
             out[labels == lab] = next_id
+            out_kinds[next_id] = kind_of[lab]
     if truth is not None:
         truth["z"] = np.where(hit, z, 0).reshape(height, width)
         truth["world"] = P.reshape(height, width, 3)
         truth["raw_labels"] = labels
+        truth["kinds"] = out_kinds
         truth["sigma_px"] = DISPARITY_SIGMA * s
         truth["fb"] = f * BASELINE
     intr = {"fx": f, "fy": f, "cx": cx, "cy": cy, "width": width, "height": height,

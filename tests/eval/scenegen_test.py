@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
-"""eval/scenegen.py: small scenes whose labels and depth are checked against the ray cast.
+"""eval/scenegen.py: small scenes whose labels and depth are checked against the ray cast;
+eval/kinds.py on one of them.
 
 Run by ctest (tests/CMakeLists.txt); needs Debian's python3-numpy and python3-pil."""
+import contextlib
+import io
 import json
 import pathlib
 import sys
@@ -13,6 +16,7 @@ from PIL import Image
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "eval"))
 import scenegen  # noqa: E402
+import kinds as kinds_module  # noqa: E402
 
 W, H = 320, 240
 
@@ -99,6 +103,43 @@ class Scenegen(unittest.TestCase):
             mid, below = np.array([[0.0, 0.0, (mat["z0"] + mat["z1"]) / 2]]), np.array([[0.0, 0.0, mat["z0"] / 2]])
             np.testing.assert_array_equal(scenegen.shade(mat, mid)[0], mat["b"])
             self.assertGreaterEqual(np.linalg.norm(scenegen.shade(mat, below)[0] - mat["b"]), 1)
+
+    def test_each_object_has_the_kind_it_was_drawn_as(self):
+        label = self.frame[2]
+        kinds = self.truth["kinds"]
+        self.assertEqual(sorted(kinds), list(range(1, int(label.max()) + 1)))
+        self.assertLessEqual(set(kinds.values()), set(kinds_module.KINDS))
+        # Over many scenes, the round kinds are cones and the others boxes.
+        for seed in range(10):
+            kind_of = {}
+            parts, _ = scenegen.build_scene(np.random.default_rng(seed), np.random.default_rng([seed, 1]), kind_of)
+            for prim, lab, _ in parts:
+                if lab > 0:
+                    round_kind = kind_of[lab] in ("cylinder", "cup", "bowl")
+                    self.assertEqual(isinstance(prim, scenegen.Cone), round_kind, kind_of[lab])
+
+    def test_kinds_scores_a_perfect_run_good_and_an_empty_one_missed(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            gen, perfect, empty = (pathlib.Path(tmp) / d for d in ("gen", "perfect", "empty"))
+            scenegen.main(["--out", str(gen), "--seeds", "7", "--width", str(W), "--height", str(H)])
+            label = np.array(Image.open(gen / "scene_00007" / "label.png"))
+            for out, image in ((perfect, label), (empty, np.zeros_like(label))):
+                (out / "scene_00007").mkdir(parents=True)
+                Image.fromarray(image).save(out / "scene_00007" / "objects.png")
+            n = int(label.max())
+            for out, fate in ((perfect, "good"), (empty, "missed")):
+                lines = io.StringIO()
+                with contextlib.redirect_stdout(lines):
+                    kinds_module.main([str(gen), str(out)])
+                rows = [r.split() for r in lines.getvalue().splitlines()]
+                header, body, total = rows[0], rows[1:-1], rows[-1]
+                column = header.index(fate)
+                self.assertEqual(sum(int(r[column]) for r in body), n)
+                self.assertEqual(total[1], str(n))
+                self.assertEqual(float(total[2]), 1.0 if fate == "good" else 0.0)
+            with self.assertRaises(SystemExit) as e:
+                kinds_module.main([str(gen), str(pathlib.Path(tmp) / "none")])
+            self.assertIn("missing", str(e.exception.code))
 
     def test_bad_seed_range_is_one_line(self):
         with self.assertRaises(SystemExit) as e:
