@@ -537,6 +537,17 @@ struct SplitBoundary {
     int small_outline = 0;  ///< 4-neighbour pairs from the smaller part to anything else
 };
 
+/// Calls visit(q, du, dv) for each 4-neighbour q of pixel p to its right (du = 1) or below
+/// (dv = 1) that lies in segment l in another part (ws.part): each boundary pair inside the
+/// segment once. Cost: two lookups.
+template <class Visit>
+void for_part_boundary_pairs(const Ctx& x, const SegmentWorkspace& ws, int l, int p, Visit&& visit) {
+    const int W = x.W, u = p % W, v = p / W;
+    const std::uint8_t* const part = ws.part.data();
+    if (u + 1 < W && ws.label[static_cast<std::size_t>(p) + 1] == l && part[p + 1] != part[p]) visit(p + 1, 1, 0);
+    if (v + 1 < x.H && ws.label[static_cast<std::size_t>(p + W)] == l && part[p + W] != part[p]) visit(p + W, 0, 1);
+}
+
 /// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part) and the
 /// smaller part's outline. Cost: one pass over the segment's pixels and their neighbours.
 SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
@@ -553,20 +564,16 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
             for (const int q : nb)
                 sb.small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
         }
-        const int dirs[2][2] = {{1, 0}, {0, 1}};
-        for (const auto& dd : dirs) {
-            if (u + dd[0] >= W || v + dd[1] >= x.H) continue;
-            const int q = p + dd[0] + dd[1] * W;
-            if (ws.label[q] != l || part[q] == part[p]) continue;
+        for_part_boundary_pairs(x, ws, l, p, [&](int, int du, int dv) {
             ++sb.boundary;
-            const int pu = u - s * dd[0], pv = v - s * dd[1];
-            const int qu = u + dd[0] + s * dd[0], qv = v + dd[1] + s * dd[1];
-            if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) continue;
+            const int pu = u - s * du, pv = v - s * dv;
+            const int qu = u + du + s * du, qv = v + dv + s * dv;
+            if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) return;
             const int a = pv * W + pu, b = qv * W + qu;
-            if (!x.n.valid[a] || !x.n.valid[b]) continue;
+            if (!x.n.valid[a] || !x.n.valid[b]) return;
             sb.smooth += x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b] >= cos_crease;
             ++sb.with_normals;
-        }
+        });
     }
     return sb;
 }
@@ -783,15 +790,13 @@ bool texture_materials(const Ctx& x, const SegmentWorkspace& ws, int l, const in
                        const int (&count)[kTextureColours], std::uint8_t (&material)[kTextureColours]) {
     constexpr int K = kTextureColours;
     const SegmentParams& prm = x.prm;
-    const int W = x.W;
     const std::uint8_t* const part = ws.part.data();
-    int contact[K][K] = {};
-    for (int i = 0; i < m; ++i) {
-        const int p = px[i], u = p % W, v = p / W;
-        const std::size_t right = static_cast<std::size_t>(p) + 1, below = static_cast<std::size_t>(p + W);
-        if (u + 1 < W && ws.label[right] == l && part[right] != part[p]) ++contact[part[p]][part[right]];
-        if (v + 1 < x.H && ws.label[below] == l && part[below] != part[p]) ++contact[part[p]][part[below]];
-    }
+    int contact[K][K] = {};  // symmetric
+    for (int i = 0; i < m; ++i)
+        for_part_boundary_pairs(x, ws, l, px[i], [&](int q, int, int) {
+            ++contact[part[px[i]]][part[q]];
+            ++contact[part[q]][part[px[i]]];
+        });
     int root[K];  // union-find over the colours
     for (int k = 0; k < K; ++k) root[k] = k;
     auto find = [&](int k) {
@@ -809,13 +814,13 @@ bool texture_materials(const Ctx& x, const SegmentWorkspace& ws, int l, const in
         if (!tiny(k)) continue;
         int most = k == 0 ? 1 : 0;
         for (int j = 0; j < K; ++j)
-            if (j != k && contact[k][j] + contact[j][k] > contact[k][most] + contact[most][k]) most = j;
+            if (j != k && contact[k][j] > contact[k][most]) most = j;
         join(most, k);
     }
     for (int a = 0; a < K; ++a)
         for (int b = a + 1; b < K; ++b) {
             if (tiny(a) || tiny(b)) continue;
-            const double c = contact[a][b] + contact[b][a];
+            const double c = contact[a][b];
             const double unit = std::sqrt(static_cast<double>(std::min(count[a], count[b])));
             if (c > prm.color_max_compact * unit) {
                 join(a, b);
@@ -890,8 +895,8 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
     for (int i = 0; i < m; ++i) part[px[i]] = side[i];
     const Verdict verdict = judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen);
     if (verdict == Verdict::kKept) return kSplitByColour;
-    if (verdict != Verdict::kTexture || !prm.color_textures || count[0] == 0 || count[1] == 0 ||
-        !split_by_materials(x, ws, l, px, f, m, side, cen, count))
+    // kTexture: both parts passed the share test, so both hold pixels.
+    if (verdict != Verdict::kTexture || !prm.color_textures || !split_by_materials(x, ws, l, px, f, m, side, cen, count))
         return kNotSplit;
     return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen) == Verdict::kKept
                ? kSplitByMaterial
