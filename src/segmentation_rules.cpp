@@ -10,6 +10,7 @@
 #include <optional>
 #include <utility>
 
+#include "circle_fit.hpp"
 #include "segmentation_internal.hpp"
 #include "wul3d/clustering.hpp"  // ClusterParams: the colour cue's alpha and delta
 
@@ -57,31 +58,31 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
               [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
 }
 
-/// A circle on the support plane through the points `for_points` visits (it calls its
-/// argument with each pixel), by algebraic least squares (Kasa), centred on their mean
-/// `mean` for conditioning: the centre relative to `mean` and the squared radius (not > 0,
-/// or not finite, when the points fit no circle). Cost: one pass over the points.
-template <class ForPoints>
-std::pair<Eigen::Vector2d, double> fit_circle(const Ctx& x, const PlaneAxes& plane_xy, const Eigen::Vector2d& mean,
-                                              ForPoints&& for_points) {
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    for_points([&](std::size_t p) {
-        const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
-        const Eigen::Vector3d row(d.x(), d.y(), 1.0);
-        A += row * row.transpose();
-        rhs -= row * d.squaredNorm();
-    });
-    const Eigen::Vector3d sol = A.ldlt().solve(rhs);
-    const Eigen::Vector2d centre(-sol.x() / 2, -sol.y() / 2);
-    return {centre, centre.squaredNorm() - sol.z()};
+/// The points `for_pixels` visits (it calls its argument with each pixel) on the support
+/// plane, less `mean` (for the circle fit's conditioning): what fit_circle takes.
+template <class ForPixels>
+auto on_plane(const Ctx& x, const PlaneAxes& plane_xy, const Eigen::Vector2d& mean, ForPixels& for_pixels) {
+    return [&x, &plane_xy, &mean, &for_pixels](auto&& visit) {
+        for_pixels([&](std::size_t p) { visit(Eigen::Vector2d(plane_xy(x.c, p) - mean)); });
+    };
+}
+
+/// The RMS distance from a fitted circle that still counts as on it, for points at mean
+/// depth z: rim_max_residual_m to 1 m (it was set on `osd_mosd`, whose objects lie 0.57-0.82
+/// m away), then growing as z^2, as the sensor's depth noise does (a structured-light
+/// sensor's depth step is z^2 / (f b)), which scatters the points along the rays. Only the
+/// rims use it: the round test keeps rim_max_residual_m, since a
+/// looser fit there calls two flush boxes round and keeps them from the colour split
+/// (docs/ABLATION.md, "Circles").
+double circle_tolerance(const SegmentParams& prm, double z) {
+    return prm.rim_max_residual_m * std::max(1.0, z * z);
 }
 
 /// A circle fitted to the front segment's edge along the steps ws.steps[i0, i1) (the nearer
-/// pixels of the depth steps that lie in `front`), on the plane: algebraic least squares
-/// (Kasa), centred on the edge's mean for conditioning. Appends {front, back, centre (2),
-/// radius, rim height} to ws.rim_fits when the edge lies on the circle and spans enough of
-/// it. Cost: four passes over the pair's boundary pairs; no allocation but the append.
+/// pixels of the depth steps that lie in `front`), on the plane (fit_circle). Appends {front,
+/// back, centre (2), radius, rim height} to ws.rim_fits when the edge lies on the circle
+/// (circle_tolerance at the edge's depth) and spans enough of it. Cost: three passes and
+/// fit_circle's six over the pair's boundary pairs; no allocation but the append.
 void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
              std::size_t i0, std::size_t i1, int front, int back) {
     const SegmentParams& prm = x.prm;
@@ -90,21 +91,22 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
         for (std::size_t j = i0; j < i1; ++j)
             if (((ws.steps[j].key >> 1) & 1) && label[ws.steps[j].near] == front) visit(ws.steps[j].near);
     };
-    double m = 0, height = 0;
+    double m = 0, height = 0, z = 0;
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for_edge([&](std::size_t p) {
         ++m;
         mean += plane_xy(x.c, p);
         height += pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+        z += x.c.z[p];
     });
     if (m < 3) return;
     mean /= m;
     height /= m;
-    const std::pair<Eigen::Vector2d, double> fit = fit_circle(x, plane_xy, mean, for_edge);
-    const Eigen::Vector2d centre = fit.first;  // not a structured binding: lambdas capture it
-    const double R2 = fit.second;
-    if (!(R2 > 0) || !std::isfinite(R2)) return;
-    const double R = std::sqrt(R2);
+    z /= m;
+    const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_edge));
+    const Eigen::Vector2d centre = fit.centre;
+    const double R = fit.radius;
+    if (!std::isfinite(R)) return;
     // Geometric residual, and the widest chord: the farthest edge pixel from the mean,
     // then the farthest from that one.
     double res = 0, far_d = -1, chord = 0;
@@ -119,7 +121,7 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
         }
     });
     for_edge([&](std::size_t p) { chord = std::max(chord, (plane_xy(x.c, p) - mean - far).norm()); });
-    if (std::sqrt(res / m) > prm.rim_max_residual_m || chord < prm.rim_min_arc * 2 * R) return;
+    if (std::sqrt(res / m) > circle_tolerance(prm, z) || chord < prm.rim_min_arc * 2 * R) return;
     ws.rim_fits.push_back({static_cast<double>(front), static_cast<double>(back), centre.x() + mean.x(),
                            centre.y() + mean.y(), R, height});
 }
@@ -580,11 +582,11 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
 
 /// Whether the pixels px[0, m) of one segment stand round on the support pl: a quarter of
 /// them or more are walls (normals within color_round_deg of the plane), the walls lie on
-/// one upright circle (a Kasa fit on the plane, as the containers' rims: RMS within
-/// rim_max_residual_m, spanning rim_min_arc of the diameter, radius up to
+/// one upright circle (fit_circle on the plane, as the containers' rims: RMS within
+/// rim_max_residual_m at any depth, spanning rim_min_arc of the diameter, radius up to
 /// color_round_max_radius_m) and three quarters of them face within color_round_deg of its
 /// radii. A can, a bottle or a cup is one solid of revolution; two objects flush in view
-/// show flat faces. Cost: three passes over the m pixels.
+/// show flat faces. Cost: two passes and fit_circle's six over the m pixels.
 bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, const int* px, int m) {
     const SegmentParams& prm = x.prm;
     const float sin_wall = std::sin(prm.color_round_deg * kDegToRad);
@@ -602,12 +604,11 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     });
     if (walls < 3 || 4 * walls < m) return false;
     mean /= walls;
-    const std::pair<Eigen::Vector2d, double> fit = fit_circle(x, plane_xy, mean, for_walls);
-    const Eigen::Vector2d centre = fit.first;  // not a structured binding: lambdas capture it
-    const double R2 = fit.second;
-    const double max_r = prm.color_round_max_radius_m;
-    if (!(R2 > 0) || !std::isfinite(R2) || R2 > max_r * max_r) return false;
-    const double R = std::sqrt(R2), cos_radial = std::cos(prm.color_round_deg * kDegToRad);
+    const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_walls));
+    const Eigen::Vector2d centre = fit.centre;
+    const double R = fit.radius;
+    if (!std::isfinite(R) || R > prm.color_round_max_radius_m) return false;
+    const double cos_radial = std::cos(prm.color_round_deg * kDegToRad);
     // Residual, the walls' extent (the diagonal of their box on the plane) and how many
     // face along a radius (either way: a cup's inside faces in).
     double res = 0, radial = 0;

@@ -108,9 +108,11 @@ struct SegmentParams {
     // arc, and the farther segment lies inside the circle and reaches up to the rim (its far
     // side). Such a pair is joined.
     int rim_min_boundary = 10;          ///< depth-step boundary pairs at least; >= 3, or 0 = off
-    float rim_max_residual_m = 0.0035f; ///< RMS distance of the edge from its fitted circle; > 0
-    float rim_min_arc = 0.45f;          ///< widest chord of the edge / the circle's diameter at
-                                        ///< least (0.45: an arc of 54 degrees); (0, 1]
+    float rim_max_residual_m = 0.0035f; ///< RMS distance of the edge from its fitted circle
+                                        ///< to 1 m, growing as z^2 beyond (the sensor's
+                                        ///< noise); the round test's at any depth; > 0
+    float rim_min_arc = 0.4f;           ///< widest chord of the edge / the circle's diameter at
+                                        ///< least (0.4: an arc of 47 degrees); (0, 1]
     float rim_inside_share = 0.95f;     ///< share of the inside's feet within the circle
                                         ///< (radius + 10 % + 1 cm); (0, 1]
     float rim_height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
