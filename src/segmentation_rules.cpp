@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -204,22 +205,77 @@ int join_insides(const Ctx& x, SegmentWorkspace& ws, int n) {
     return joins;
 }
 
+/// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
+/// segment reached, of min_seed_points or more, become segments n + 1, ... for the rim
+/// test. At `--decimate 2` every pixel of a small cup's inside, or of a bowl's outer wall
+/// seen at a steep angle, can lie within a crease step of a crease, so the region seeds no
+/// segment, and the rim's depth step keeps reattachment out of it. ws.cut (the seeds, spent
+/// by now) holds the pixels still open. Returns the islands added. Cost: one pass over the
+/// pixels that vectorizes, a memchr for each island's first pixel, and a search over the
+/// unreached object pixels.
+int add_islands(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const int W = x.W, H = x.H;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    std::uint8_t* const open = ws.cut.data();
+    const int* const label = ws.label.data();
+    const std::uint8_t* const cls = x.cls.data();
+    for (std::size_t p = 0; p < N; ++p)
+        open[p] = static_cast<std::uint8_t>((label[p] == 0) & (cls[p] == kPlaneObject));
+    int added = 0;
+    for (std::size_t seed = 0; seed < N; ++seed) {
+        const void* const next = std::memchr(open + seed, 1, N - seed);
+        if (!next) break;
+        seed = static_cast<std::size_t>(static_cast<const std::uint8_t*>(next) - open);
+        int head = 0, tail = 0;
+        ws.queue[tail++] = static_cast<int>(seed);
+        open[seed] = 0;
+        while (head < tail) {
+            const int p = ws.queue[head++];
+            const int u = p % W, v = p / W;
+            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
+                               v + 1 < H ? p + W : -1};
+            for (int q : nb) {
+                if (q < 0 || !open[q]) continue;
+                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
+                open[q] = 0;
+                ws.queue[tail++] = q;
+            }
+        }
+        if (tail < x.prm.min_seed_points) continue;
+        const int id = n + (++added);
+        for (int i = 0; i < tail; ++i) ws.label[static_cast<std::size_t>(ws.queue[i])] = id;
+    }
+    return added;
+}
+
 }  // namespace
 
 /// The container rule (SegmentParams, "Containers"): a segment seen over another's circular,
 /// level edge across a depth step, lying inside that circle and reaching up to it, is the
-/// other's inside (a bowl's or a cup's) and joins it. In: ws.label (1..n with gaps). Out:
-/// ws.label with the insides joined. Cost: one pass over the pixels and a sort of the
-/// boundary pairs; then per candidate a few passes over its boundary, and one over the rows
-/// of the candidates' insides.
+/// other's inside (a bowl's or a cup's) and joins it. With rim_islands the regions no
+/// segment reached take part as segments n + 1, ... (add_islands), and after the joins those
+/// that joined no segment are unlabelled again: the root of a joined set is its smallest
+/// label, so what is left above n joined only islands. In: ws.label (1..n with gaps). Out:
+/// ws.label with the insides joined, still within 1..n. Cost: one pass over the pixels and a
+/// sort of the boundary pairs; then per candidate a few passes over its boundary, and one
+/// over the rows of the candidates' insides; with islands, add_islands and one more pass.
 int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
-    if (x.prm.rim_min_boundary <= 0 || n < 2) return 0;
-    collect_boundary_steps(x, ws, n);
-    const PlaneAxes plane_xy(pl);
-    find_rims(x, pl, plane_xy, ws);
-    if (ws.rim_fits.empty()) return 0;
-    measure_insides(x, pl, plane_xy, ws, n);
-    return join_insides(x, ws, n);
+    if (x.prm.rim_min_boundary <= 0 || n < 1) return 0;
+    const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
+    const int all = n + islands;
+    int joins = 0;
+    if (all >= 2) {
+        collect_boundary_steps(x, ws, all);
+        const PlaneAxes plane_xy(pl);
+        find_rims(x, pl, plane_xy, ws);
+        if (!ws.rim_fits.empty()) {
+            measure_insides(x, pl, plane_xy, ws, all);
+            joins = join_insides(x, ws, all);
+        }
+    }
+    if (islands > 0)
+        for (int& l : ws.label) l = l > n ? 0 : l;  // a branch-free pass that vectorizes
+    return joins;
 }
 
 // ---- floor gaps ----------------------------------------------------------------------------

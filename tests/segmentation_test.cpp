@@ -285,6 +285,48 @@ TEST(CircleFit, ExactCircleAndALine) {
     EXPECT_FALSE(extent >= SegmentParams{}.rim_min_arc * 2 * l.radius) << "a line fitted a circle of radius " << l.radius;
 }
 
+// A small cup with a thin wall (0.5 mm: no rim ring joins inside and outside) seen from
+// above: every pixel of its inside, or of its outer wall, lies within a crease step of the
+// rim's or the floor's crease, so that region seeds no segment, and the rim's depth step
+// keeps reattachment out of it. As an island (rim_islands) it meets the other part across
+// the rim and the container rule joins them; without islands the cup is cut short (3.5 cm
+// across) or lost (2.5 cm).
+TEST(SegmentObjects, SmallThinCup_RegionNoSeedReachedJoinedAcrossTheRim) {
+    for (const float radius : {0.035f, 0.025f}) {
+        Scene s = pitched_tabletop_scene();
+        SceneCup cup;
+        cup.z = 1.0f;
+        cup.radius = radius;
+        cup.h = 0.09f;
+        cup.wall = 0.0005f;
+        s.cups = {cup};
+        std::vector<int> truth;
+        SegmentParams no_islands;
+        no_islands.rim_islands = false;
+        int label = 0;
+        const LabelImage cut = segment(s, no_islands, truth);
+        const double share = dominant_share(cut.labels, truth, kTruthCup0, &label);
+        EXPECT_TRUE(label == 0 || share < 0.85)
+            << radius << ": the cup was whole without islands (test premise), share " << share;
+
+        SegmentStats stats;
+        const LabelImage out = segment(s, SegmentParams{}, truth, &stats);
+        EXPECT_GT(dominant_share(out.labels, truth, kTruthCup0, &label), 0.95) << radius;
+        EXPECT_NE(label, 0) << radius;
+        EXPECT_GE(stats.containers, 1) << radius;
+        EXPECT_EQ(stats.segments, 1) << radius;
+
+        // Islands that join nothing change nothing: with no rim fitting a circle, the labels
+        // are those of the run without islands.
+        SegmentParams no_rims;
+        no_rims.rim_max_residual_m = 1e-7f;
+        SegmentParams no_rims_no_islands = no_rims;
+        no_rims_no_islands.rim_islands = false;
+        EXPECT_EQ(segment(s, no_rims, truth).labels, segment(s, no_rims_no_islands, truth).labels)
+            << radius << ": an island no rule joined was kept";
+    }
+}
+
 // Gaps in a container's floor: floor points the plane step left out (here a 3 x 3 block of
 // the cup's inside, taken back out of it) are filled into the cup; a hole in its wall, which
 // touches no inside, stays a hole (a mug's handle shows the table the same way).

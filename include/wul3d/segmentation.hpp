@@ -116,6 +116,9 @@ struct SegmentParams {
     float rim_inside_share = 0.95f;     ///< share of the inside's feet within the circle
                                         ///< (radius + 10 % + 1 cm); (0, 1]
     float rim_height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
+    bool rim_islands = true;            ///< object regions no segment reached (a small cup's
+                                        ///< inside at --decimate 2, every pixel on a crease)
+                                        ///< are candidates too, kept only where joined
     /// Gaps in a container's floor: a patch of unlabelled points enclosed by one segment and
     /// touching its inside (kPlaneInside: floor points whose patch was too noisy to pass the
     /// plane's island test) joins that segment. A true hole (a mug's handle, the table seen
