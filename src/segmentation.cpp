@@ -113,22 +113,10 @@ int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentW
         }
         if (ws.label[seed]) continue;
         const int id = ++n;
-        int head = 0, tail = 0;
-        ws.queue[tail++] = static_cast<int>(seed);
         ws.label[seed] = id;
-        while (head < tail) {
-            const int p = ws.queue[head++];
-            const int u = p % W, v = p / W;
-            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
-                               v + 1 < H ? p + W : -1};
-            for (int q : nb) {
-                if (q < 0 || !seedable[q] || ws.label[q]) continue;
-                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
-                ws.label[q] = id;
-                ws.queue[tail++] = q;
-            }
-        }
-        ws.sizes.push_back(tail);
+        ws.sizes.push_back(flood_region(
+            x, ws.queue, static_cast<int>(seed), [&](std::size_t q) { return seedable[q] && !ws.label[q]; },
+            [&](std::size_t q) { ws.label[q] = id; }));
     }
     return n;
 }

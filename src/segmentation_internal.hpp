@@ -94,6 +94,29 @@ struct PlaneAxes {
     }
 };
 
+/// One region by breadth-first search from `seed` (the caller has marked it): every
+/// 4-neighbour q of a region pixel with is_open(q) and continuous depth is marked (mark(q))
+/// and joins. The region's pixels land in queue[0, size); returns the size. Shared by the
+/// components that seed segments and the container rule's islands. Cost: O(region).
+template <class IsOpen, class Mark>
+int flood_region(const Ctx& x, std::vector<int>& queue, int seed, IsOpen&& is_open, Mark&& mark) {
+    const int W = x.W, H = x.H;
+    int head = 0, tail = 0;
+    queue[static_cast<std::size_t>(tail++)] = seed;
+    while (head < tail) {
+        const int p = queue[static_cast<std::size_t>(head++)];
+        const int u = p % W, v = p / W;
+        const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1, v + 1 < H ? p + W : -1};
+        for (int q : nb) {
+            if (q < 0 || !is_open(static_cast<std::size_t>(q))) continue;
+            if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
+            mark(static_cast<std::size_t>(q));
+            queue[static_cast<std::size_t>(tail++)] = q;
+        }
+    }
+    return tail;
+}
+
 // ---- union-find over segments (the merge and container rules join segments) -------------
 
 inline int find_root(std::vector<int>& parent, int a) {

@@ -226,24 +226,13 @@ int add_islands(const Ctx& x, SegmentWorkspace& ws, int n) {
         const void* const next = std::memchr(open + seed, 1, N - seed);
         if (!next) break;
         seed = static_cast<std::size_t>(static_cast<const std::uint8_t*>(next) - open);
-        int head = 0, tail = 0;
-        ws.queue[tail++] = static_cast<int>(seed);
         open[seed] = 0;
-        while (head < tail) {
-            const int p = ws.queue[head++];
-            const int u = p % W, v = p / W;
-            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
-                               v + 1 < H ? p + W : -1};
-            for (int q : nb) {
-                if (q < 0 || !open[q]) continue;
-                if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
-                open[q] = 0;
-                ws.queue[tail++] = q;
-            }
-        }
-        if (tail < x.prm.min_seed_points) continue;
+        const int size = flood_region(
+            x, ws.queue, static_cast<int>(seed), [&](std::size_t q) { return open[q] != 0; },
+            [&](std::size_t q) { open[q] = 0; });
+        if (size < x.prm.min_seed_points) continue;
         const int id = n + (++added);
-        for (int i = 0; i < tail; ++i) ws.label[static_cast<std::size_t>(ws.queue[i])] = id;
+        for (int i = 0; i < size; ++i) ws.label[static_cast<std::size_t>(ws.queue[i])] = id;
     }
     return added;
 }
