@@ -72,9 +72,9 @@ auto on_plane(const Ctx& x, const PlaneAxes& plane_xy, const Eigen::Vector2d& me
 /// depth z: rim_max_residual_m to 1 m (it was set on `osd_mosd`, whose objects lie 0.57-0.82
 /// m away), then growing as z^2, as the sensor's depth noise does (a structured-light
 /// sensor's depth step is z^2 / (f b)), which scatters the points along the rays. Only the
-/// rims use it: the round test keeps rim_max_residual_m, since a
-/// looser fit there calls two flush boxes round and keeps them from the colour split
-/// (docs/ABLATION.md, "Circles").
+/// rims use it: the round test keeps rim_max_residual_m, since a looser bound there let more
+/// segments pass as round, which the colour cue then leaves unsplit (docs/ABLATION.md,
+/// "Circles").
 double circle_tolerance(const SegmentParams& prm, double z) {
     return prm.rim_max_residual_m * std::max(1.0, z * z);
 }
