@@ -237,6 +237,18 @@ int add_islands(const Ctx& x, SegmentWorkspace& ws, int n) {
     return added;
 }
 
+/// The rim test over segments 1..n (with gaps): candidates, their circles, their insides,
+/// the joins. Returns the joins. Cost: as join_containers', less the islands.
+int join_rims(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    if (n < 2) return 0;
+    collect_boundary_steps(x, ws, n);
+    const PlaneAxes plane_xy(pl);
+    find_rims(x, pl, plane_xy, ws);
+    if (ws.rim_fits.empty()) return 0;
+    measure_insides(x, pl, plane_xy, ws, n);
+    return join_insides(x, ws, n);
+}
+
 }  // namespace
 
 /// The container rule (SegmentParams, "Containers"): a segment seen over another's circular,
@@ -251,17 +263,7 @@ int add_islands(const Ctx& x, SegmentWorkspace& ws, int n) {
 int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     if (x.prm.rim_min_boundary <= 0 || n < 1) return 0;
     const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
-    const int all = n + islands;
-    int joins = 0;
-    if (all >= 2) {
-        collect_boundary_steps(x, ws, all);
-        const PlaneAxes plane_xy(pl);
-        find_rims(x, pl, plane_xy, ws);
-        if (!ws.rim_fits.empty()) {
-            measure_insides(x, pl, plane_xy, ws, all);
-            joins = join_insides(x, ws, all);
-        }
-    }
+    const int joins = join_rims(x, pl, ws, n + islands);
     if (islands > 0)
         for (int& l : ws.label) l = l > n ? 0 : l;  // a branch-free pass that vectorizes
     return joins;

@@ -172,7 +172,8 @@ struct BoundaryStep {
 struct SegmentWorkspace {
     NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
     std::vector<float> smooth_scratch;
-    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component
+    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component; once the seeds are
+                                       ///< spent, the container rule's open pixels (islands)
     std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
     std::vector<int> label;    ///< 0 none, 1..n
     std::vector<int> queue;
