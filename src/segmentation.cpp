@@ -69,6 +69,7 @@ void SegmentParams::validate() const {
     require(color_max_compact >= 0, "color_max_compact", color_max_compact, ">= 0");
     require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
     require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
+    require(color_min_step >= 0 && color_min_step < 100, "color_min_step", color_min_step, "in [0, 100), <= 1 = off");
     require(color_round_deg >= 0 && color_round_deg < 90, "color_round_deg", color_round_deg, "in [0, 90)");
     require(color_round_max_radius_m > 0, "color_round_max_radius_m", color_round_max_radius_m, "> 0");
     require(stack_min_step_m >= 0 && stack_min_step_m <= 0.5f, "stack_min_step_m", stack_min_step_m,

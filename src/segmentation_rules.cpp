@@ -394,6 +394,16 @@ int segment_size(const SegmentWorkspace& ws, int l) {
     return ws.offsets[static_cast<std::size_t>(l) + 1] - ws.offsets[static_cast<std::size_t>(l)];
 }
 
+/// One plane, for the brightness step (judge_split): the normals a crease step either side
+/// of the boundary within this angle, the scatter of the smoothed normals on a flat face
+/// (3 degrees left out most of the generated boxes' faces; 15, the smooth test's, took in
+/// a white bowl's lit and shaded sides on the RealSense frames).
+constexpr float kStepPlaneDeg = 5.0f;
+
+/// Added to a pixel's r + g + b before a ratio of colours: keeps the chromaticity of dark,
+/// noisy pixels near grey, and their brightness ratios small.
+constexpr float kDark = 30.0f;
+
 /// The 2-means features of the segments' pixels, one plane each in segment order so that
 /// every pass over a segment reads contiguous memory.
 struct ColourFeatures {
@@ -414,9 +424,7 @@ ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWor
     // The colour term is the chromaticity, rgb / (r + g + b), at the scale of 8-bit colour
     // (a grey pixel of any brightness: 85, 85, 85): light falling on two faces of one box at
     // other angles scales their colour and leaves it, so the two parts are two materials,
-    // not a lit face and a shaded one. kDark keeps the chromaticity of dark, noisy pixels
-    // near grey.
-    constexpr float kDark = 30.0f;
+    // not a lit face and a shaded one.
     auto chroma = [&](std::size_t p, float* out) {
         const float r = x.c.r[p], g = x.c.g[p], b = x.c.b[p];
         const float k = 255.0f / (r + g + b + kDark);
@@ -583,6 +591,9 @@ struct SplitBoundary {
     int boundary = 0;       ///< 4-neighbour pairs inside the segment with different parts
     int with_normals = 0;   ///< ... with normals a crease step away on either side
     int smooth = 0;         ///< ... whose normals lie within color_max_crease_deg
+    int steps[2] = {0, 0};  ///< ... of those, on one plane (kStepPlaneDeg), where part 0's
+                            ///< side (steps[0]) or part 1's is color_min_step times
+                            ///< brighter a crease step away
     int small_outline = 0;  ///< 4-neighbour pairs from the smaller part to anything else
 };
 
@@ -603,6 +614,8 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
                              std::uint8_t small_part, float cos_crease) {
     const int W = x.W, s = x.prm.crease_step_px;
     const std::uint8_t* const part = ws.part.data();
+    const float cos_plane = std::cos(kStepPlaneDeg * kDegToRad);
+    auto brightness = [&](int p) { return static_cast<float>(x.c.r[p] + x.c.g[p] + x.c.b[p]) + kDark; };
     SplitBoundary sb;
     for (int i = 0; i < m; ++i) {
         const int p = px[i];
@@ -613,15 +626,23 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
             for (const int q : nb)
                 sb.small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
         }
-        for_part_boundary_pairs(x, ws, l, p, [&](int, int du, int dv) {
+        for_part_boundary_pairs(x, ws, l, p, [&](int q, int du, int dv) {
             ++sb.boundary;
             const int pu = u - s * du, pv = v - s * dv;
             const int qu = u + du + s * du, qv = v + dv + s * dv;
             if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) return;
             const int a = pv * W + pu, b = qv * W + qu;
             if (!x.n.valid[a] || !x.n.valid[b]) return;
-            sb.smooth += x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b] >= cos_crease;
+            const float cos_ab = x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b];
+            sb.smooth += cos_ab >= cos_crease;
             ++sb.with_normals;
+            // A step in brightness counts on one plane only (a lies on p's side, b on q's):
+            // light falls alike there, while a curved surface turns from it (a bowl's lit
+            // and shaded sides).
+            if (cos_ab < cos_plane || cos_ab < cos_crease) return;
+            const float ia = brightness(a), ib = brightness(b);
+            sb.steps[part[p]] += ia >= x.prm.color_min_step * ib;
+            sb.steps[part[q]] += ib >= x.prm.color_min_step * ia;
         });
     }
     return sb;
@@ -674,6 +695,10 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
            4 * radial >= 3 * walls;
 }
 
+/// Boundary pairs on one plane that a brightness step needs: as many as the convexity merge
+/// tests.
+constexpr int kMinStepPairs = 6;
+
 /// What the colour cue's tests say of a split.
 enum class Verdict {
     kKept,
@@ -694,7 +719,8 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
         return Verdict::kRejected;
     const float dr = (cen[0][3] - cen[1][3]) / cp.alpha, dg = (cen[0][4] - cen[1][4]) / cp.alpha,
                 db = (cen[0][5] - cen[1][5]) / cp.alpha;
-    if (std::sqrt(dr * dr + dg * dg + db * db) < prm.color_min_distance) return Verdict::kRejected;
+    const bool far_in_colour = std::sqrt(dr * dr + dg * dg + db * db) >= prm.color_min_distance;
+    if (!far_in_colour && !(prm.color_min_step > 1)) return Verdict::kRejected;
     // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
     // crease step away on either side tell a smooth surface from a fold.
     const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
@@ -711,9 +737,16 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
     // straddle its edge), or the parts must differ in chromaticity: light falling on two
     // faces of one box at other angles scales their colour, it does not turn it, so
     // across a fold (a flat box on another, flush boxes of two heights) only a change of
-    // material turns the mean colour by color_min_hue_deg.
+    // material turns the mean colour by color_min_hue_deg. Or, either way, a step in
+    // brightness along the boundary where it crosses one plane: light falls alike on both
+    // sides there, so only a change of material (two flush boxes of one hue, a light and a
+    // dark one, which the chromaticity cannot tell apart) makes one side brighter, along
+    // most of the crossing, in one direction.
+    const bool brightness_step = prm.color_min_step > 1 && sb.smooth >= kMinStepPairs &&
+                                 10 * std::max(sb.steps[0], sb.steps[1]) >= 7 * sb.smooth;
+    if (!far_in_colour && !brightness_step) return Verdict::kRejected;
     const bool across_smooth = sb.with_normals > 0 && 10 * sb.smooth >= 7 * sb.with_normals;
-    if (!across_smooth) {
+    if (!across_smooth && !brightness_step) {
         const float r0 = cen[0][3], g0 = cen[0][4], b0c = cen[0][5];
         const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
         const float dot = r0 * r1 + g0 * g1 + b0c * b1c;

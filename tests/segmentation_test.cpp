@@ -157,6 +157,42 @@ TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
     EXPECT_EQ(stats.color_splits, 1);
 }
 
+// Two flush boxes of one hue, a light one and a dark one: their chromaticities lie closer
+// than the colour cue's distance, so only the step in brightness where their contact
+// crosses the shared front and top planes tells the two materials apart.
+TEST(SegmentObjects, FlushBoxesOfOneHue_SeparatedByTheBrightnessStep) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 7;
+    SceneBox light;
+    light.x = -0.075f;
+    light.z = 1.0f;
+    light.r = 200;
+    light.g = 120;
+    light.b = 60;
+    SceneBox dark = light;
+    dark.x = 0.075f;
+    dark.r = 80;
+    dark.g = 65;
+    dark.b = 20;
+    s.boxes = {light, dark};
+    std::vector<int> truth;
+    int a = 0, b = 0;
+    SegmentParams no_step;
+    no_step.color_min_step = 0;
+    const LabelImage without = segment(s, no_step, truth);
+    dominant_share(without.labels, truth, kTruthBox0, &a);
+    dominant_share(without.labels, truth, kTruthBox0 + 1, &b);
+    EXPECT_EQ(a, b) << "the chromaticity alone should not separate the boxes (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(s, SegmentParams{}, truth, &stats);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(a, b) << "the brightness step did not split the flush boxes";
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
 // The colour cue leaves a box alone whose faces differ in shade: the colour boundary runs
 // along a convex edge, not across a flat surface.
 TEST(SegmentObjects, ColourCue_DoesNotSplitOneBox) {
