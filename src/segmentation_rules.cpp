@@ -608,8 +608,8 @@ void for_part_boundary_pairs(const Ctx& x, const SegmentWorkspace& ws, int l, in
     if (v + 1 < x.H && ws.label[static_cast<std::size_t>(p + W)] == l && part[p + W] != part[p]) visit(p + W, 0, 1);
 }
 
-/// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part) and the
-/// smaller part's outline. Cost: one pass over the segment's pixels and their neighbours.
+/// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part), its
+/// brightness steps on one plane, and the smaller part's outline. Cost: one pass over the segment's pixels and their neighbours.
 SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
                              std::uint8_t small_part, float cos_crease) {
     const int W = x.W, s = x.prm.crease_step_px;
@@ -695,8 +695,8 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
            4 * radial >= 3 * walls;
 }
 
-/// Boundary pairs on one plane that a brightness step needs: as many as the convexity merge
-/// tests.
+/// Boundary pairs across a smooth surface that a brightness step needs: as many as the
+/// convexity merge tests.
 constexpr int kMinStepPairs = 6;
 
 /// What the colour cue's tests say of a split.
