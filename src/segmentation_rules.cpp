@@ -395,9 +395,9 @@ int segment_size(const SegmentWorkspace& ws, int l) {
 }
 
 /// One plane, for the brightness step (judge_split): the normals a crease step either side
-/// of the boundary within this angle, the scatter of the smoothed normals on a flat face
-/// (3 degrees left out most of the generated boxes' faces; 15, the smooth test's, took in
-/// a white bowl's lit and shaded sides on the RealSense frames).
+/// of the boundary within this angle. The smallest that gains on the generated tune seeds
+/// (3 degrees left out their boxes' faces), well under the smooth test's 15, which took in
+/// a white bowl's lit and shaded sides on the RealSense frames (docs/ABLATION.md).
 constexpr float kStepPlaneDeg = 5.0f;
 
 /// Added to a pixel's r + g + b before a ratio of colours: keeps the chromaticity of dark,
@@ -609,12 +609,14 @@ void for_part_boundary_pairs(const Ctx& x, const SegmentWorkspace& ws, int l, in
 }
 
 /// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part), its
-/// brightness steps on one plane, and the smaller part's outline. Cost: one pass over the segment's pixels and their neighbours.
+/// brightness steps on one plane, and the smaller part's outline. Cost: one pass over the
+/// segment's pixels and their neighbours.
 SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
                              std::uint8_t small_part, float cos_crease) {
     const int W = x.W, s = x.prm.crease_step_px;
     const std::uint8_t* const part = ws.part.data();
-    const float cos_plane = std::cos(kStepPlaneDeg * kDegToRad);
+    // One plane: within kStepPlaneDeg, and smooth whatever color_max_crease_deg says.
+    const float cos_plane = std::max(std::cos(kStepPlaneDeg * kDegToRad), cos_crease);
     auto brightness = [&](int p) { return static_cast<float>(x.c.r[p] + x.c.g[p] + x.c.b[p]) + kDark; };
     SplitBoundary sb;
     for (int i = 0; i < m; ++i) {
@@ -639,7 +641,7 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
             // A step in brightness counts on one plane only (a lies on p's side, b on q's):
             // light falls alike there, while a curved surface turns from it (a bowl's lit
             // and shaded sides).
-            if (cos_ab < cos_plane || cos_ab < cos_crease) return;
+            if (cos_ab < cos_plane) return;
             const float ia = brightness(a), ib = brightness(b);
             sb.steps[part[p]] += ia >= x.prm.color_min_step * ib;
             sb.steps[part[q]] += ib >= x.prm.color_min_step * ia;

@@ -163,17 +163,8 @@ TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
 TEST(SegmentObjects, FlushBoxesOfOneHue_SeparatedByTheBrightnessStep) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 7;
-    SceneBox light;
-    light.x = -0.075f;
-    light.z = 1.0f;
-    light.r = 200;
-    light.g = 120;
-    light.b = 60;
-    SceneBox dark = light;
-    dark.x = 0.075f;
-    dark.r = 80;
-    dark.g = 65;
-    dark.b = 20;
+    const SceneBox light{.x = -0.075f, .z = 1.0f, .r = 200, .g = 120, .b = 60};
+    const SceneBox dark{.x = 0.075f, .z = 1.0f, .r = 80, .g = 65, .b = 20};
     s.boxes = {light, dark};
     std::vector<int> truth;
     int a = 0, b = 0;
