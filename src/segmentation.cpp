@@ -245,10 +245,11 @@ int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
 /// Joins segments that touch along a boundary that is mostly not concave. Each 4-neighbour
 /// pair (p, q) of two segments with continuous depth is tested for a crease between the
 /// pixels a crease step away on either side, inside their own segments; the pair of
-/// segments merges when enough pairs were tested and few were concave. Returns the merges.
-/// Cost: one pass over the pixels, a sort of the boundary pairs, one more pass to relabel
-/// when anything merged.
-int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
+/// segments (a, b) merges when enough pairs were tested, few were concave and may_join(a,
+/// b). Returns the merges. Cost: one pass over the pixels, a sort of the boundary pairs, one
+/// more pass to relabel when anything merged.
+template <class MayJoin>
+int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) {
     const SegmentParams& prm = x.prm;
     if (prm.merge_max_concave <= 0 || n < 2) return 0;
     const int W = x.W, H = x.H, s = prm.crease_step_px;
@@ -295,13 +296,58 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n) {
             tested += static_cast<int>((ws.edges[i] >> 1) & 1);
             concave += static_cast<int>(ws.edges[i] & 1);
         }
+        const int a = static_cast<int>(key >> 30), b = static_cast<int>(key & ((1u << 30) - 1));
         if (tested < prm.merge_min_boundary ||
-            static_cast<float>(concave) > prm.merge_max_concave * static_cast<float>(tested))
+            static_cast<float>(concave) > prm.merge_max_concave * static_cast<float>(tested) || !may_join(a, b))
             continue;
-        merges += join_sets(ws.parent, static_cast<int>(key >> 30), static_cast<int>(key & ((1u << 30) - 1)));
+        merges += join_sets(ws.parent, a, b);
     }
     if (merges > 0) relabel_to_roots(ws);
     return merges;
+}
+
+/// The convexity merge again after the colour cue (color_rejoin), between segments that
+/// came from different segments before it (ws.origin: what the cue parted stays parted)
+/// and are one material by the cue's measures: the chromaticities of their mean colours
+/// within color_min_distance and, with the brightness step on, their mean brightness within
+/// color_min_step. A box with another lying on it can come out of the crease cuts in two
+/// pieces, and the first merge kept them apart because the upper box's wall, a concave
+/// crease, ran along their boundary too; once the cue has made the upper box a segment of
+/// its own, the pieces' boundary is their own convex edge. Returns the merges. Cost: one
+/// pass over the rows with labels for the segments' mean colours, then merge_convex's.
+int rejoin_materials(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    ws.material.assign(static_cast<std::size_t>(n) + 1, {0, 0, 0, 0});
+    for (int v = 0; v < x.H; ++v) {
+        const int* const row = ws.label.data() + static_cast<std::ptrdiff_t>(v) * x.W;
+        if (!row_has_label(row, 0, x.W)) continue;
+        for (int u = 0; u < x.W; ++u) {
+            if (row[u] == 0) continue;
+            const std::size_t p = static_cast<std::size_t>(v) * x.W + u;
+            std::array<double, 4>& m = ws.material[static_cast<std::size_t>(row[u])];
+            m[0] += x.c.r[p], m[1] += x.c.g[p], m[2] += x.c.b[p], m[3] += 1;
+        }
+    }
+    // The mean colour's chromaticity (chromaticity()'s formula) and brightness.
+    auto material = [&](int l, double (&c)[3]) {
+        const std::array<double, 4>& m = ws.material[static_cast<std::size_t>(l)];
+        const double r = m[0] / m[3], g = m[1] / m[3], b = m[2] / m[3], bright = r + g + b + kDark;
+        c[0] = 255 * (r + kDark / 3) / bright;
+        c[1] = 255 * (g + kDark / 3) / bright;
+        c[2] = 255 * (b + kDark / 3) / bright;
+        return bright;
+    };
+    return merge_convex(x, ws, n, [&](int a, int b) {
+        if (ws.origin[static_cast<std::size_t>(a)] == ws.origin[static_cast<std::size_t>(b)]) return false;
+        double ca[3], cb[3];
+        const double ba = material(a, ca), bb = material(b, cb);
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) d2 += (ca[k] - cb[k]) * (ca[k] - cb[k]);
+        if (d2 >= static_cast<double>(prm.color_min_distance) * prm.color_min_distance) return false;
+        const bool brightness_step = prm.color_min_step > 1 &&
+                                     std::max(ba, bb) >= static_cast<double>(prm.color_min_step) * std::min(ba, bb);
+        return !brightness_step;
+    });
 }
 
 // ---- the basic phases of segment_objects -------------------------------------------------
@@ -496,7 +542,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     stats.ms.reattach = ms_since();
     // The rules on segments (docs/DESIGN.md, "Objects", 2), in this order.
     if (!kmeans) {
-        stats.merges = merge_convex(x, ws, n);
+        stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
         stats.ms.merge = ms_since();
         if (support) stats.containers = join_containers(x, *support, ws, n);
         stats.ms.containers = ms_since();
@@ -504,6 +550,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     if (params.segmenter == Segmenter::Hybrid) {
         stats.color_splits = color_splits(x, support, ws, n, stats.texture_splits);
         n += stats.color_splits;
+        if (stats.color_splits > 0 && params.color_rejoin) stats.merges += rejoin_materials(x, ws, n);
         stats.ms.color = ms_since();
     }
     if (!kmeans && support) {

@@ -34,6 +34,20 @@ inline bool row_has_label(const int* row, int from, int to) {
     return any != 0;
 }
 
+/// Added to a pixel's r + g + b before a ratio of colours: keeps the chromaticity of dark,
+/// noisy pixels near grey, and their brightness ratios small.
+constexpr float kDark = 30.0f;
+
+/// Pixel p's chromaticity, rgb / (r + g + b), at the scale of 8-bit colour (a grey pixel of
+/// any brightness: 85, 85, 85; kDark pulls dark pixels towards grey): what the colour cue
+/// calls a material's colour, as light falling at other angles scales a colour and leaves
+/// its chromaticity.
+inline void chromaticity(const OrganizedCloud& c, std::size_t p, float (&out)[3]) {
+    const float r = c.r[p], g = c.g[p], b = c.b[p];
+    const float k = 255.0f / (r + g + b + kDark);
+    out[0] = k * (r + kDark / 3), out[1] = k * (g + kDark / 3), out[2] = k * (b + kDark / 3);
+}
+
 /// A pixel faces sideways (an upright surface: a wall, a box's or a can's side) when its
 /// normal lies within this of the support plane, and up when within this of its normal.
 /// Shared by the round test, the scope and the stack rule.
@@ -165,8 +179,9 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
 int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
 
 /// The colour cue (hybrid): splits segments in two by colour; the new parts are numbered
-/// n + 1, n + 2, ... in segment order. Returns the splits; `by_material` gets those between
-/// a texture and another material (SegmentParams::color_textures).
+/// n + 1, n + 2, ... in segment order; ws.origin holds each label's segment before the cue.
+/// Returns the splits; `by_material` gets those between a texture and another material
+/// (SegmentParams::color_textures).
 int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material);
 
 /// Occlusion (SegmentParams, "Occlusion"): joins the two parts of a surface that a nearer

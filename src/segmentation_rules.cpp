@@ -400,10 +400,6 @@ int segment_size(const SegmentWorkspace& ws, int l) {
 /// a white bowl's lit and shaded sides on the RealSense frames (docs/ABLATION.md).
 constexpr float kStepPlaneDeg = 5.0f;
 
-/// Added to a pixel's r + g + b before a ratio of colours: keeps the chromaticity of dark,
-/// noisy pixels near grey, and their brightness ratios small.
-constexpr float kDark = 30.0f;
-
 /// The 2-means features of the segments' pixels, one plane each in segment order so that
 /// every pass over a segment reads contiguous memory.
 struct ColourFeatures {
@@ -421,15 +417,9 @@ ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWor
     ws.feature.resize(6 * M);
     float* f[6];
     for (int q = 0; q < 6; ++q) f[q] = ws.feature.data() + static_cast<std::size_t>(q) * M;
-    // The colour term is the chromaticity, rgb / (r + g + b), at the scale of 8-bit colour
-    // (a grey pixel of any brightness: 85, 85, 85): light falling on two faces of one box at
-    // other angles scales their colour and leaves it, so the two parts are two materials,
-    // not a lit face and a shaded one.
-    auto chroma = [&](std::size_t p, float* out) {
-        const float r = x.c.r[p], g = x.c.g[p], b = x.c.b[p];
-        const float k = 255.0f / (r + g + b + kDark);
-        out[0] = k * (r + kDark / 3), out[1] = k * (g + kDark / 3), out[2] = k * (b + kDark / 3);
-    };
+    // The colour term is the chromaticity (chromaticity()): light falling on two faces of
+    // one box at other angles scales their colour and leaves it, so the two parts are two
+    // materials, not a lit face and a shaded one.
 #pragma omp parallel for schedule(static)
     for (int i = first; i < last; ++i) {
         const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
@@ -437,7 +427,7 @@ ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWor
         f[1][i - first] = cp.delta * x.c.y[p];
         f[2][i - first] = cp.delta * x.c.z[p];
         float c[3];
-        chroma(p, c);
+        chromaticity(x.c, p, c);
         f[3][i - first] = cp.alpha * c[0];
         f[4][i - first] = cp.alpha * c[1];
         f[5][i - first] = cp.alpha * c[2];
@@ -987,14 +977,15 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
 }
 
 /// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
-/// thread order). Returns the splits, and adds those by material to `by_material`. Cost:
-/// one pass over the split segments' pixels.
+/// thread order), with the split segment's ws.origin. Returns the splits, and adds those by
+/// material to `by_material`. Cost: one pass over the split segments' pixels.
 int number_splits(SegmentWorkspace& ws, int n, int& by_material) {
     int splits = 0, next = n;
     for (int l = 1; l <= n; ++l) {
         if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
         by_material += ws.split[static_cast<std::size_t>(l)] == kSplitByMaterial;
         const int id = ++next;
+        ws.origin[static_cast<std::size_t>(id)] = ws.origin[static_cast<std::size_t>(l)];
         const int o = ws.offsets[static_cast<std::size_t>(l)];
         const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
         for (int i = 0; i < m; ++i) {
@@ -1048,10 +1039,14 @@ int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n,
 /// same tests judge a split between the segment's materials (split_by_materials). A second
 /// round tries the two parts of each split segment again: three flush boxes of three colours
 /// need two cuts. In: ws.label (1..n with gaps). Out: ws.label with the new parts numbered
-/// n + 1, n + 2, ... (round 1's in segment order, then round 2's); `by_material` counts the
-/// splits between materials. Cost: split_round once, twice when it split anything.
+/// n + 1, n + 2, ... (round 1's in segment order, then round 2's), and ws.origin, each
+/// label's segment before the cue; `by_material` counts the splits between materials. Cost:
+/// split_round once, twice when it split anything.
 int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
     by_material = 0;
+    // Each label's segment before the cue; a round adds at most one label per segment.
+    ws.origin.resize(4 * static_cast<std::size_t>(n) + 1);
+    for (int l = 0; l <= n; ++l) ws.origin[static_cast<std::size_t>(l)] = l;
     ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
     const int first = split_round(x, support, ws, n, by_material);
     if (first == 0) return 0;

@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <map>
 #include <set>
 
 #include "side_by_side.hpp"  // src/: the pipeline's private choice, tested here
@@ -265,3 +266,47 @@ TEST(SideBySideChoice, TriesBothWaysThenKeepsTheFaster) {
     }
     EXPECT_FALSE(choice.next());
 }
+
+#ifdef WUL3D_SCENEGEN
+// A generated scene (eval/scenegen.py seed 2088, of the range 2000-2099 generated to check
+// the rule, rendered here): a box with a checked print and another box lying on it. The
+// crease along the upper box's wall cuts the lower box in two pieces, and the convexity
+// merge keeps them apart, since that wall runs along their boundary too; the colour cue
+// then parts the upper box from the piece it was joined to. Without color_rejoin the lower box stays in two objects; with it the pieces,
+// now meeting along their own convex edge, are one.
+TEST(GeneratedScene, BoxUnderABox_PiecesRejoinedAfterTheColourCue) {
+    TempDir dir;
+    const CommandResult gen = run_command(
+        {WUL3D_PYTHON3, WUL3D_SCENEGEN, "--out", dir.path().string(), "--seeds", "2088"});
+    ASSERT_EQ(gen.exit_code, 0) << gen.err;
+    const LabelImage truth = read_label_png((dir.path() / "scene_02088" / "label.png").string());
+    auto share_of_lower_box = [&](bool rejoin, int& merges) {
+        auto source = open_source(dir.path().string(), SourceOptions{});
+        SourceItem item;
+        source->read(0, item);
+        PipelineParams params;
+        params.segmentation.color_rejoin = rejoin;
+        Pipeline pipeline(params);
+        const FrameResult& r = pipeline.process(item.frame);
+        merges = r.segment_stats.merges;
+        // Truth label 4 is the lower box: the share of it its dominant object holds.
+        std::map<int, int> counts;
+        int total = 0;
+        for (std::size_t p = 0; p < truth.labels.size(); ++p)
+            if (truth.labels[p] == 4) {
+                ++counts[r.objects.labels[p]];
+                ++total;
+            }
+        int best = 0;
+        for (const auto& [id, n] : counts)
+            if (id != 0) best = std::max(best, n);
+        return total > 0 ? static_cast<double>(best) / total : 0.0;
+    };
+    int merges_without = 0, merges_with = 0;
+    const double without = share_of_lower_box(false, merges_without);
+    ASSERT_LT(without, 0.75) << "the lower box should be in two pieces without the rule (test premise)";
+    const double with = share_of_lower_box(true, merges_with);
+    EXPECT_GT(with, 0.9) << "the lower box's pieces were not rejoined";
+    EXPECT_EQ(merges_with, merges_without + 1);
+}
+#endif

@@ -98,6 +98,12 @@ struct SegmentParams {
                                  ///< longer than color_max_compact allows are one material
                                  ///< (they interleave); the same tests judge the split
                                  ///< between two materials: stripes beside a plain box
+    bool color_rejoin = true;  ///< after the colour cue, the convexity merge again between
+                               ///< segments that it found apart and that are one material
+                               ///< (their mean colours' chromaticities within
+                               ///< color_min_distance, brightness within color_min_step):
+                               ///< a box's pieces that the wall of the box lying on it
+                               ///< kept apart
     // Stacks (needs the support plane; not kmeans): a segment whose upward faces lie at two
     // heights over the support, nothing facing up between them, is two objects, one resting
     // on the other; it is cut just over the lower one's top.
@@ -197,6 +203,10 @@ struct SegmentWorkspace {
     std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
+    std::vector<int> origin;           ///< colour cue: the segment (before it) each label
+                                       ///< comes from
+    std::vector<std::array<double, 4>> material;  ///< rejoin: per segment, sums of r, g, b
+                                                  ///< and the pixels
     std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
                                                                   ///< offset per line (steps)
     std::vector<std::uint8_t> occluded_outline;  ///< occlusion: 1 = outline pixel, one row
@@ -249,7 +259,8 @@ struct SegmentStats {
     int texture_splits = 0;  ///< of color_splits, those between a texture and another
                              ///< material (color_textures)
     int stack_splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
-    int merges = 0;        ///< segment pairs joined across a non-concave boundary
+    int merges = 0;        ///< segment pairs joined across a non-concave boundary (and
+                           ///< after the colour cue: color_rejoin)
     int containers = 0;    ///< insides joined to their container across the rim
     int occluded = 0;      ///< parts of one surface joined across the object before them
     std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
