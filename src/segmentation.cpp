@@ -328,14 +328,12 @@ int rejoin_materials(const Ctx& x, SegmentWorkspace& ws, int n) {
             m[0] += x.c.r[p], m[1] += x.c.g[p], m[2] += x.c.b[p], m[3] += 1;
         }
     }
-    // The mean colour's chromaticity (chromaticity()'s formula) and brightness.
+    // The mean colour's chromaticity and brightness.
     auto material = [&](int l, double (&c)[3]) {
         const std::array<double, 4>& m = ws.material[static_cast<std::size_t>(l)];
-        const double r = m[0] / m[3], g = m[1] / m[3], b = m[2] / m[3], bright = r + g + b + kDark;
-        c[0] = 255 * (r + kDark / 3) / bright;
-        c[1] = 255 * (g + kDark / 3) / bright;
-        c[2] = 255 * (b + kDark / 3) / bright;
-        return bright;
+        const double r = m[0] / m[3], g = m[1] / m[3], b = m[2] / m[3];
+        chromaticity(r, g, b, c);
+        return r + g + b + kDark;
     };
     return merge_convex(x, ws, n, [&](int a, int b) {
         if (ws.origin[static_cast<std::size_t>(a)] == ws.origin[static_cast<std::size_t>(b)]) return false;

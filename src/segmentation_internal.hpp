@@ -38,14 +38,19 @@ inline bool row_has_label(const int* row, int from, int to) {
 /// noisy pixels near grey, and their brightness ratios small.
 constexpr float kDark = 30.0f;
 
-/// Pixel p's chromaticity, rgb / (r + g + b), at the scale of 8-bit colour (a grey pixel of
-/// any brightness: 85, 85, 85; kDark pulls dark pixels towards grey): what the colour cue
-/// calls a material's colour, as light falling at other angles scales a colour and leaves
-/// its chromaticity.
+/// The chromaticity of the colour (r, g, b), rgb / (r + g + b), at the scale of 8-bit colour
+/// (a grey of any brightness: 85, 85, 85; kDark pulls dark colours towards grey): what the
+/// colour cue calls a material's colour, as light falling at other angles scales a colour
+/// and leaves its chromaticity.
+template <class T>
+void chromaticity(T r, T g, T b, T (&out)[3]) {
+    const T dark = static_cast<T>(kDark), k = static_cast<T>(255) / (r + g + b + dark);
+    out[0] = k * (r + dark / 3), out[1] = k * (g + dark / 3), out[2] = k * (b + dark / 3);
+}
+
+/// Pixel p's chromaticity.
 inline void chromaticity(const OrganizedCloud& c, std::size_t p, float (&out)[3]) {
-    const float r = c.r[p], g = c.g[p], b = c.b[p];
-    const float k = 255.0f / (r + g + b + kDark);
-    out[0] = k * (r + kDark / 3), out[1] = k * (g + kDark / 3), out[2] = k * (b + kDark / 3);
+    chromaticity<float>(c.r[p], c.g[p], c.b[p], out);
 }
 
 /// A pixel faces sideways (an upright surface: a wall, a box's or a can's side) when its
