@@ -82,10 +82,11 @@ struct SegmentParams {
                                       ///< scales a colour, only another material turns it;
                                       ///< (0, 90)
     float color_min_step = 1.15f;     ///< ... or, either way: of the boundary pairs that
-                                      ///< cross a smooth surface (6 at least), 70 % lie on one
-                                      ///< plane and are this many times brighter (r + g + b)
-                                      ///< a crease step away on one part's side than on the
-                                      ///< other's: two materials of one hue; <= 1: off
+                                      ///< cross a smooth surface, half or more (6 at least)
+                                      ///< lie on one plane, and 70 % of those are this many
+                                      ///< times brighter (r + g + b) a crease step away on
+                                      ///< one part's side than on the other's: two materials
+                                      ///< of one hue; <= 1: off
     float color_round_deg = 25;       ///< no split of a segment that stands round on the
                                       ///< support (a can, a bottle, a cup: its colours are
                                       ///< print): its walls, normals within this of the
