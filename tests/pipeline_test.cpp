@@ -267,6 +267,25 @@ TEST(SideBySideChoice, TriesBothWaysThenKeepsTheFaster) {
     EXPECT_FALSE(choice.next());
 }
 
+// The white bowl of data/samples/uois_tabletop/image_0000 (lower right) is one object. Its
+// floor lies partly in its own shadow, and 2-means parts the shadow from the lit floor:
+// along that boundary every pair on one plane is a brightness step, but those are 6 of 52
+// pairs across the smooth curved floor, so the colour cue's brightness step (DESIGN.md, "The
+// brightness step") must not split there. (372, 410) lies in the part it would split off,
+// (427, 359) in the rest; both are bowl at the default --decimate 2.
+TEST(RealTabletopBowl, ShadowOnTheFloor_DoesNotSplitIt) {
+    auto source = open_source((sample_dir() / "uois_tabletop" / "image_0000").string(), SourceOptions{});
+    SourceItem item;
+    source->read(0, item);
+    Pipeline pipeline(PipelineParams{});
+    const FrameResult& r = pipeline.process(item.frame);
+    const int W = r.objects.width;
+    const std::uint16_t shadow_side = r.objects.labels[410 * W + 372];
+    const std::uint16_t lit_side = r.objects.labels[359 * W + 427];
+    EXPECT_NE(shadow_side, 0);
+    EXPECT_EQ(shadow_side, lit_side) << "the bowl was split along its floor's shadow";
+}
+
 #ifdef WUL3D_SCENEGEN
 namespace {
 
