@@ -311,7 +311,8 @@ GeneratedFrame render_generated(const TempDir& dir, int seed) {
 }
 
 /// The object holding most of truth label t's pixels, background left out, and the share
-/// of them it holds (0 when no object holds any).
+/// of them it holds (0 when no object holds any). Not synthetic_scene.hpp's dominant_share:
+/// that one counts background as a candidate and reads the ray-cast scenes' int truth.
 std::pair<int, double> dominant_object(const LabelImage& objects, const LabelImage& truth, int t) {
     std::map<int, int> counts;
     int total = 0;
@@ -332,8 +333,9 @@ std::pair<int, double> dominant_object(const LabelImage& objects, const LabelIma
 // the rule, rendered here): a box with a checked print and another box lying on it. The
 // crease along the upper box's wall cuts the lower box in two pieces, and the convexity
 // merge keeps them apart, since that wall runs along their boundary too; the colour cue
-// then parts the upper box from the piece it was joined to. Without color_rejoin the lower box stays in two objects; with it the pieces,
-// now meeting along their own convex edge, are one.
+// then parts the upper box from the piece it was joined to. Without color_rejoin the lower
+// box stays in two objects; with it the pieces, now meeting along their own convex edge,
+// are one.
 TEST(GeneratedScene, BoxUnderABox_PiecesRejoinedAfterTheColourCue) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 2088);
