@@ -57,6 +57,20 @@ bool in_path(const std::string& program) {
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
+/// `xvfb-run` on a free display with a 1600x900 screen, its X authority file in `tmp`.
+/// Given its own file, xvfb-run makes and removes no temporary directory of its own: once,
+/// in CI, its `rm -r` of that directory failed after the viewer had exited, and xvfb-run
+/// then exits 5 in place of the viewer's status. The test's TempDir removes the file.
+std::vector<std::string> xvfb_run(const TempDir& tmp) {
+    return {"xvfb-run", "-a", "-f", (tmp / "Xauthority").string(), "-s", "-screen 0 1600x900x24"};
+}
+
+/// `prefix` followed by `rest`.
+std::vector<std::string> concat(std::vector<std::string> prefix, const std::vector<std::string>& rest) {
+    prefix.insert(prefix.end(), rest.begin(), rest.end());
+    return prefix;
+}
+
 TEST(ViewCommand, NoDisplay_OneLineExitTwo) {
     const auto r = run_with_env(
         {cli_path().string(), "view", (sample_dir() / "uois_tabletop").string()},
@@ -85,8 +99,8 @@ TEST(ViewCommand, ScreenshotUnderXvfb_ClusterColoursWhereTheObjectsAre) {
     const fs::path shot = tmp / "view.png";
     const fs::path input = sample_dir() / "uois_tabletop";
     const auto r = run_with_env(
-        {"xvfb-run", "-a", "-s", "-screen 0 1600x900x24", cli_path().string(), "view",
-         input.string(), "--screenshot", shot.string(), "--exit-after", "3"},
+        concat(xvfb_run(tmp), {cli_path().string(), "view", input.string(), "--screenshot",
+                               shot.string(), "--exit-after", "3"}),
         {{"LIBGL_ALWAYS_SOFTWARE", "1"},
          // Leak checking is off for this one process: Mesa's software driver keeps
          // allocations until exit and is unloaded before LeakSanitizer reports, so its
@@ -172,9 +186,9 @@ Shot view_screenshot(const TempDir& tmp, const fs::path& input, const std::strin
                      int frames, const std::vector<std::string>& extra, const std::string& panel) {
     Shot s;
     const fs::path shot = tmp / (name + ".png");
-    std::vector<std::string> args = {"xvfb-run", "-a", "-s", "-screen 0 1600x900x24",
-                                     cli_path().string(), "view", input.string(), "--screenshot",
-                                     shot.string(), "--exit-after", std::to_string(frames)};
+    std::vector<std::string> args =
+        concat(xvfb_run(tmp), {cli_path().string(), "view", input.string(), "--screenshot",
+                               shot.string(), "--exit-after", std::to_string(frames)});
     args.insert(args.end(), extra.begin(), extra.end());
     s.run = run_with_env(args, {{"LIBGL_ALWAYS_SOFTWARE", "1"}, {"ASAN_OPTIONS", "detect_leaks=0"}});
     if (s.run.exit_code != 0 || !fs::is_regular_file(shot)) return s;
@@ -409,9 +423,10 @@ TEST(ViewCommand, ObjectsModeUnderXvfb_AClickSelectsAnObjectAndFollowsIt) {
 
 TEST(ViewCommand, SelectOutsideTheFrame_OneLineExitTwo) {
     ASSERT_TRUE(in_path("xvfb-run")) << "xvfb-run not found (scripts/install-deps.sh)";
+    TempDir tmp;
     const auto r = run_with_env(
-        {"xvfb-run", "-a", "-s", "-screen 0 1600x900x24", cli_path().string(), "view",
-         (sample_dir() / "uois_tabletop").string(), "--select", "700,10", "--exit-after", "1"},
+        concat(xvfb_run(tmp), {cli_path().string(), "view", (sample_dir() / "uois_tabletop").string(),
+                               "--select", "700,10", "--exit-after", "1"}),
         {{"LIBGL_ALWAYS_SOFTWARE", "1"}, {"ASAN_OPTIONS", "detect_leaks=0"}});
     EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
     EXPECT_NE(r.err.find("--select 700,10 is outside the 640x480 frame"), std::string::npos) << r.err;
@@ -432,9 +447,9 @@ TEST(ViewCommand, LiveCameraUnderFakenect_PlaysAndScreenshots) {
         {"export-fakenect", (sample_dir() / "uois_tabletop").string(), dump.string()});
     ASSERT_EQ(e.exit_code, 0) << e.err;
     const auto r = run_with_env(
-        {"timeout", "120", "xvfb-run", "-a", "-s", "-screen 0 1600x900x24", "fakenect",
-         dump.string(), cli_path().string(), "view", "--camera", "freenect", "--lossless",
-         "--screenshot", shot.string(), "--exit-after", "3"},
+        concat(concat({"timeout", "120"}, xvfb_run(tmp)),
+               {"fakenect", dump.string(), cli_path().string(), "view", "--camera", "freenect",
+                "--lossless", "--screenshot", shot.string(), "--exit-after", "3"}),
         {{"LIBGL_ALWAYS_SOFTWARE", "1"}, {"ASAN_OPTIONS", "detect_leaks=0"}});
     ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
     EXPECT_TRUE(fs::is_regular_file(shot)) << r.out;
