@@ -79,40 +79,61 @@ double circle_tolerance(const SegmentParams& prm, double z) {
     return prm.rim_max_residual_m * std::max(1.0, z * z);
 }
 
-/// A circle fitted to the front segment's edge along the steps ws.steps[i0, i1) (the nearer
-/// pixels of the depth steps that lie in `front`), on the plane (fit_circle). Appends {front,
-/// back, centre (2), radius, rim height} to ws.rim_fits when the edge lies on the circle
-/// (circle_tolerance at the edge's depth) and spans enough of it. Cost: three passes and
-/// fit_circle's six over the pair's boundary pairs; no allocation but the append.
-void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
-             std::size_t i0, std::size_t i1, int front, int back) {
-    const SegmentParams& prm = x.prm;
-    const auto& label = ws.label;
-    auto for_edge = [&](auto&& visit) {
-        for (std::size_t j = i0; j < i1; ++j)
-            if (((ws.steps[j].key >> 1) & 1) && label[ws.steps[j].near] == front) visit(ws.steps[j].near);
-    };
+/// The front's extent across the line of sight, in radii of a circle fitted with the far
+/// rim, at least: 1 (a container's outer wall spans 2, or less where something hides it).
+/// 1.5 lost half the gain on the generated tune seeds (docs/ABLATION.md, "The far rim").
+constexpr double kFarRimMinWidth = 1.0;
+
+/// The front segment's extent on the plane across the line of sight through `centre` (the
+/// camera lies at the plane's origin). Cost: one pass over the front's rows.
+double front_width(const Ctx& x, const PlaneAxes& plane_xy, const SegmentWorkspace& ws, int front,
+                   const Eigen::Vector2d& centre) {
+    const Eigen::Vector2d across = Eigen::Vector2d(centre.y(), -centre.x()).normalized();
+    const int r0 = ws.rim_rows[2 * static_cast<std::size_t>(front)];
+    const int r1 = ws.rim_rows[2 * static_cast<std::size_t>(front) + 1];
+    double lo = std::numeric_limits<double>::max(), hi = -lo;
+    for (std::size_t p = static_cast<std::size_t>(r0) * x.W; p < static_cast<std::size_t>(r1 + 1) * x.W; ++p) {
+        if (ws.label[p] != front) continue;
+        const double t = plane_xy(x.c, p).dot(across);
+        lo = std::min(lo, t);
+        hi = std::max(hi, t);
+    }
+    return hi - lo;
+}
+
+/// A rim's circle on the support plane: its centre, radius and mean height over the plane.
+struct RimCircle {
+    Eigen::Vector2d centre;
+    double radius = 0, height = 0;
+};
+
+/// A circle fitted to the rim points `for_rim` visits (it calls its argument with each
+/// pixel), on the plane (fit_circle), when the points lie on it (circle_tolerance at their
+/// depth) and span enough of it (rim_min_arc); nothing otherwise. Cost: three passes and
+/// fit_circle's six over the points.
+template <class ForRim>
+std::optional<RimCircle> rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, ForRim&& for_rim) {
     double m = 0, height = 0, z = 0;
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    for_edge([&](std::size_t p) {
+    for_rim([&](std::size_t p) {
         ++m;
         mean += plane_xy(x.c, p);
         height += pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
         z += x.c.z[p];
     });
-    if (m < 3) return;
+    if (m < 3) return std::nullopt;
     mean /= m;
     height /= m;
     z /= m;
-    const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_edge));
+    const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_rim));
     const Eigen::Vector2d centre = fit.centre;
     const double R = fit.radius;
-    if (!std::isfinite(R)) return;
-    // Geometric residual, and the widest chord: the farthest edge pixel from the mean,
-    // then the farthest from that one.
+    if (!std::isfinite(R)) return std::nullopt;
+    // Geometric residual, and the widest chord: the farthest rim pixel from the mean, then
+    // the farthest from that one.
     double res = 0, far_d = -1, chord = 0;
     Eigen::Vector2d far = Eigen::Vector2d::Zero();
-    for_edge([&](std::size_t p) {
+    for_rim([&](std::size_t p) {
         const Eigen::Vector2d d = plane_xy(x.c, p) - mean;
         const double r = (d - centre).norm() - R;
         res += r * r;
@@ -121,10 +142,95 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
             far = d;
         }
     });
-    for_edge([&](std::size_t p) { chord = std::max(chord, (plane_xy(x.c, p) - mean - far).norm()); });
-    if (std::sqrt(res / m) > circle_tolerance(prm, z) || chord < prm.rim_min_arc * 2 * R) return;
-    ws.rim_fits.push_back({static_cast<double>(front), static_cast<double>(back), centre.x() + mean.x(),
-                           centre.y() + mean.y(), R, height});
+    for_rim([&](std::size_t p) { chord = std::max(chord, (plane_xy(x.c, p) - mean - far).norm()); });
+    if (std::sqrt(res / m) > circle_tolerance(x.prm, z) || chord < x.prm.rim_min_arc * 2 * R) return std::nullopt;
+    return RimCircle{centre + mean, R, height};
+}
+
+/// The back segment's pixels on its far rim, into ws.rim_far_px: within rim_height_tol_m of
+/// `rim_height` over the plane, and nearer across a depth step than a 4-neighbour that
+/// belongs to neither segment (or has no depth). A container's inside, seen over its front
+/// wall, ends there at the far half of the rim. Cost: one pass over the back's rows.
+void collect_far_rim(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int front, int back, double rim_height) {
+    const int W = x.W, H = x.H;
+    const auto& label = ws.label;
+    auto steps_to_farther = [&](std::size_t p, std::size_t q) {
+        if (label[q] == back || label[q] == front) return false;
+        const float zq = x.c.z[q];
+        return !(zq > 0) || (zq > x.c.z[p] && !x.connected(p, q));
+    };
+    ws.rim_far_px.clear();
+    const int v0 = ws.rim_rows[2 * static_cast<std::size_t>(back)], v1 = ws.rim_rows[2 * static_cast<std::size_t>(back) + 1];
+    for (int v = std::max(v0, 0); v <= v1; ++v)
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            if (label[p] != back) continue;
+            if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) - rim_height) > x.prm.rim_height_tol_m) continue;
+            const bool on_outline = (u > 0 && steps_to_farther(p, p - 1)) || (u + 1 < W && steps_to_farther(p, p + 1)) ||
+                                    (v > 0 && steps_to_farther(p, p - W)) || (v + 1 < H && steps_to_farther(p, p + W));
+            if (on_outline) ws.rim_far_px.push_back(static_cast<int>(p));
+        }
+}
+
+/// The far rim's candidate (rim_far) for the pair (front, back), whose front edge
+/// `for_edge` visits: a circle fitted to that edge and to the back's far rim
+/// (collect_far_rim, at the edge's mean height). A small cup's front edge at --decimate 2
+/// can be 6 pairs long, too short an arc to fit alone, or it fits a circle too small for the
+/// inside; with the far half of the rim the circle spans the whole rim. Kept when
+///  - the front spans a radius of it across the line of sight (kFarRimMinWidth): a
+///    container's outer wall spans its diameter;
+///  - the far rim alone fits a circle that agrees with it (rim_far_agree): it is the same
+///    rim. This is what keeps an object behind a box out: its outline at the box's height
+///    reaches "the rim" by how the far rim is chosen, but traces its own shape, not the
+///    circle through the box's straight edge.
+/// Cost: one pass over the back's rows and one over the front's; rim_circle's passes over
+/// the edge and the far rim, twice. ws.rim_far_px keeps its capacity across frames.
+template <class ForEdge>
+std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+                                        ForEdge& for_edge, int front, int back) {
+    double m = 0, rim_height = 0;
+    for_edge([&](std::size_t p) {
+        ++m;
+        rim_height += pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+    });
+    if (m < 3) return std::nullopt;
+    collect_far_rim(x, pl, ws, front, back, rim_height / m);
+    auto for_far = [&](auto&& visit) {
+        for (const int p : ws.rim_far_px) visit(static_cast<std::size_t>(p));
+    };
+    auto for_rim = [&](auto&& visit) {
+        for_edge(visit);
+        for_far(visit);
+    };
+    const auto both = rim_circle(x, pl, plane_xy, for_rim);
+    if (!both || front_width(x, plane_xy, ws, front, both->centre) < kFarRimMinWidth * both->radius)
+        return std::nullopt;
+    const auto far = rim_circle(x, pl, plane_xy, for_far);
+    const double agree = x.prm.rim_far_agree * both->radius;
+    if (!far || std::fabs(far->radius - both->radius) > agree || (far->centre - both->centre).norm() > agree)
+        return std::nullopt;
+    return both;
+}
+
+/// The rim of the pair (front, back) along the steps ws.steps[i0, i1): a circle fitted to
+/// the front segment's edge there (the nearer pixels of the depth steps that lie in
+/// `front`), and with rim_far a second one through the back's far rim too
+/// (far_rim_circle). Appends each that passes to ws.rim_fits as {front, back, centre (2),
+/// radius, rim height}; the inside test then judges each. Cost: rim_circle's passes over
+/// the pair's boundary pairs, and far_rim_circle's; no allocation but the appends.
+void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+             std::size_t i0, std::size_t i1, int front, int back) {
+    auto for_edge = [&](auto&& visit) {
+        for (std::size_t j = i0; j < i1; ++j)
+            if (((ws.steps[j].key >> 1) & 1) && ws.label[ws.steps[j].near] == front) visit(ws.steps[j].near);
+    };
+    auto keep = [&](const RimCircle& c) {
+        ws.rim_fits.push_back({static_cast<double>(front), static_cast<double>(back), c.centre.x(), c.centre.y(),
+                               c.radius, c.height});
+    };
+    if (const auto edge = rim_circle(x, pl, plane_xy, for_edge)) keep(*edge);
+    if (!x.prm.rim_far) return;
+    if (const auto both = far_rim_circle(x, pl, plane_xy, ws, for_edge, front, back)) keep(*both);
 }
 
 /// Candidates: segment pairs that meet (almost) only across depth steps; the front is the

@@ -379,4 +379,43 @@ TEST(GeneratedScene, FlushBoxesOfOneHue_PartedByTheStepOnTheirSharedPlanes) {
     EXPECT_GT(light.second, 0.9);
     EXPECT_GT(dark.second, 0.9);
 }
+
+// A generated scene (eval/scenegen.py seed 2001, of the range 2000-2099): a cup 3 cm in
+// radius seen from above. Its front wall's edge along the inside meets it over 6 boundary
+// pairs at --decimate 2, a 1 cm chord, too short an arc for the rim test, so the inside and
+// the outer wall stay two objects. The inside's far outline lies on the same rim: with it
+// the circle spans the rim and the inside joins.
+TEST(GeneratedScene, SmallCup_JoinedAcrossItsFarRim) {
+    TempDir dir;
+    const GeneratedFrame g = render_generated(dir, 2001);
+    auto cup_share = [&](bool far_rim) {
+        PipelineParams params;
+        params.segmentation.rim_far = far_rim;
+        Pipeline pipeline(params);
+        return dominant_object(pipeline.process(g.frame).objects, g.truth, 1).second;  // truth 1: the cup
+    };
+    ASSERT_LT(cup_share(false), 0.6) << "without the far rim the cup should be in two objects (test premise)";
+    EXPECT_GT(cup_share(true), 0.85) << "the cup's inside did not join its outer wall";
+}
+
+// A generated scene (eval/scenegen.py seed 1028, of the report range 1000-1099): a cylinder
+// stands behind a box, its top at the height of the box's top. The far rim is chosen at the
+// front edge's height, so the cylinder's far outline is "a far rim", and a circle through it
+// and the box's straight back edge passes the fit and the inside test. The far rim alone
+// traces the cylinder's own circle (2 cm across the plane, against 15 cm), so it does not
+// agree, and the two stay apart.
+TEST(GeneratedScene, CylinderBehindABox_NotJoinedAsItsInside) {
+    TempDir dir;
+    const GeneratedFrame g = render_generated(dir, 1028);
+    auto one_object = [&](float agree) {
+        PipelineParams params;
+        params.segmentation.rim_far_agree = agree;
+        Pipeline pipeline(params);
+        const auto& objects = pipeline.process(g.frame).objects;
+        // truth 2: the cylinder; 3: the box in front of it
+        return dominant_object(objects, g.truth, 2).first == dominant_object(objects, g.truth, 3).first;
+    };
+    ASSERT_TRUE(one_object(1e9f)) << "with any far rim agreeing, the cylinder should join the box (test premise)";
+    EXPECT_FALSE(one_object(SegmentParams{}.rim_far_agree)) << "the cylinder was joined to the box";
+}
 #endif

@@ -131,6 +131,13 @@ struct SegmentParams {
     bool rim_islands = true;            ///< object regions no segment reached (a small cup's
                                         ///< inside at --decimate 2, every pixel on a crease)
                                         ///< are candidates too, kept only where joined
+    bool rim_far = true;                ///< a second candidate circle per pair, fitted to the
+                                        ///< front's edge and the inside's far outline at the
+                                        ///< rim's height (its far rim), when the front spans
+                                        ///< a radius across the view and the far rim agrees
+    float rim_far_agree = 1.0f / 3;     ///< the far rim's own circle: radius and centre within
+                                        ///< this share of the radius of the circle through
+                                        ///< both edges (it is the same rim); > 0
     /// Gaps in a container's floor: a patch of unlabelled points enclosed by one segment and
     /// touching its inside (kPlaneInside: floor points whose patch was too noisy to pass the
     /// plane's island test) joins that segment. A true hole (a mug's handle, the table seen
@@ -218,6 +225,7 @@ struct SegmentWorkspace {
                                                   ///< rim height per candidate
     std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
     std::vector<int> rim_next;         ///< candidates of one back segment, linked
+    std::vector<int> rim_far_px;       ///< the back's far rim, of the pair being fitted
     // Floor gaps:
     std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
     std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
