@@ -118,7 +118,7 @@ class Scenegen(unittest.TestCase):
                     round_kind = kind_of[lab] in ("cylinder", "cup", "bowl")
                     self.assertEqual(isinstance(prim, scenegen.Cone), round_kind, kind_of[lab])
 
-    def test_kinds_scores_a_perfect_run_good_and_an_empty_one_missed(self):
+    def test_kinds_scores_a_perfect_run_good_and_an_empty_one_missed_and_compares_them(self):
         with tempfile.TemporaryDirectory() as tmp:
             gen, perfect, empty = (pathlib.Path(tmp) / d for d in ("gen", "perfect", "empty"))
             scenegen.main(["--out", str(gen), "--seeds", "7", "--width", str(W), "--height", str(H)])
@@ -139,6 +139,27 @@ class Scenegen(unittest.TestCase):
                 self.assertEqual(float(total[2]), 1.0 if fate == "good" else 0.0)
             with self.assertRaises(SystemExit) as e:
                 kinds_module.main([str(gen), str(pathlib.Path(tmp) / "none")])
+            self.assertIn("missing", str(e.exception.code))
+            # --against: every object changes by 1 IoU between the empty and the perfect run.
+            for out, against, gains in ((perfect, empty, n), (empty, perfect, 0)):
+                lines = io.StringIO()
+                with contextlib.redirect_stdout(lines):
+                    kinds_module.main([str(gen), str(out), "--against", str(against)])
+                text = lines.getvalue().splitlines()
+                listed = text[text.index(next(t for t in text if t.startswith("against "))) + 1:-1]
+                self.assertEqual(len(listed), n)
+                for row in listed:
+                    self.assertTrue(row.startswith("scene_00007 "), row)
+                    self.assertTrue(row.endswith("0.00 missed -> 1.00 good" if gains else
+                                                 "1.00 good -> 0.00 missed"), row)
+                self.assertEqual(text[-1], f"{gains} gain, {n - gains} lose")
+            # The same run against itself changes nothing.
+            lines = io.StringIO()
+            with contextlib.redirect_stdout(lines):
+                kinds_module.main([str(gen), str(perfect), "--against", str(perfect)])
+            self.assertEqual(lines.getvalue().splitlines()[-1], "0 gain, 0 lose")
+            with self.assertRaises(SystemExit) as e:
+                kinds_module.main([str(gen), str(perfect), "--against", str(pathlib.Path(tmp) / "none")])
             self.assertIn("missing", str(e.exception.code))
 
     def test_bad_seed_range_is_one_line(self):
