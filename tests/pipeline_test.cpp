@@ -327,6 +327,15 @@ std::pair<int, double> dominant_object(const LabelImage& objects, const LabelIma
     return {best.first, total > 0 ? static_cast<double>(best.second) / total : 0.0};
 }
 
+/// g's frame through a pipeline whose default segmentation parameters `set` changed.
+template <class Set>
+FrameResult process_with(const GeneratedFrame& g, Set&& set) {
+    PipelineParams params;
+    set(params.segmentation);
+    Pipeline pipeline(params);
+    return pipeline.process(g.frame);
+}
+
 }  // namespace
 
 // A generated scene (eval/scenegen.py seed 2088, of the range 2000-2099 generated to check
@@ -339,18 +348,14 @@ std::pair<int, double> dominant_object(const LabelImage& objects, const LabelIma
 TEST(GeneratedScene, BoxUnderABox_PiecesRejoinedAfterTheColourCue) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 2088);
-    auto share_of_lower_box = [&](bool rejoin, int& merges) {
-        PipelineParams params;
-        params.segmentation.color_rejoin = rejoin;
-        Pipeline pipeline(params);
-        const FrameResult& r = pipeline.process(g.frame);
-        merges = r.segment_stats.merges;
-        return dominant_object(r.objects, g.truth, 4).second;  // truth label 4: the lower box
+    auto lower_box = [&](bool rejoin) {
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.color_rejoin = rejoin; });
+        // truth label 4: the lower box; its share in one object, and the merges
+        return std::pair{dominant_object(r.objects, g.truth, 4).second, r.segment_stats.merges};
     };
-    int merges_without = 0, merges_with = 0;
-    const double without = share_of_lower_box(false, merges_without);
+    const auto [without, merges_without] = lower_box(false);
     ASSERT_LT(without, 0.75) << "the lower box should be in two pieces without the rule (test premise)";
-    const double with = share_of_lower_box(true, merges_with);
+    const auto [with, merges_with] = lower_box(true);
     EXPECT_GT(with, 0.9) << "the lower box's pieces were not rejoined";
     EXPECT_EQ(merges_with, merges_without + 1);
 }
@@ -366,10 +371,7 @@ TEST(GeneratedScene, FlushBoxesOfOneHue_PartedByTheStepOnTheirSharedPlanes) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 23);
     auto objects = [&](float min_step) {
-        PipelineParams params;
-        params.segmentation.color_min_step = min_step;
-        Pipeline pipeline(params);
-        const FrameResult& r = pipeline.process(g.frame);
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.color_min_step = min_step; });
         return std::pair{dominant_object(r.objects, g.truth, 1), dominant_object(r.objects, g.truth, 2)};
     };
     const auto [light_off, dark_off] = objects(0);
@@ -389,10 +391,8 @@ TEST(GeneratedScene, SmallCup_JoinedAcrossItsFarRim) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 2001);
     auto cup_share = [&](bool far_rim) {
-        PipelineParams params;
-        params.segmentation.rim_far = far_rim;
-        Pipeline pipeline(params);
-        return dominant_object(pipeline.process(g.frame).objects, g.truth, 1).second;  // truth 1: the cup
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.rim_far = far_rim; });
+        return dominant_object(r.objects, g.truth, 1).second;  // truth 1: the cup
     };
     ASSERT_LT(cup_share(false), 0.6) << "without the far rim the cup should be in two objects (test premise)";
     EXPECT_GT(cup_share(true), 0.85) << "the cup's inside did not join its outer wall";
@@ -402,18 +402,15 @@ TEST(GeneratedScene, SmallCup_JoinedAcrossItsFarRim) {
 // stands behind a box, its top at the height of the box's top. The far rim is chosen at the
 // front edge's height, so the cylinder's far outline is "a far rim", and a circle through it
 // and the box's straight back edge passes the fit and the inside test. The far rim alone
-// traces the cylinder's own circle (2 cm across the plane, against 15 cm), so it does not
+// traces the cylinder's own circle (0.8 cm in radius, against 15.5 cm), so it does not
 // agree, and the two stay apart.
 TEST(GeneratedScene, CylinderBehindABox_NotJoinedAsItsInside) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 1028);
     auto one_object = [&](float agree) {
-        PipelineParams params;
-        params.segmentation.rim_far_agree = agree;
-        Pipeline pipeline(params);
-        const auto& objects = pipeline.process(g.frame).objects;
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.rim_far_agree = agree; });
         // truth 2: the cylinder; 3: the box in front of it
-        return dominant_object(objects, g.truth, 2).first == dominant_object(objects, g.truth, 3).first;
+        return dominant_object(r.objects, g.truth, 2).first == dominant_object(r.objects, g.truth, 3).first;
     };
     ASSERT_TRUE(one_object(1e9f)) << "with any far rim agreeing, the cylinder should join the box (test premise)";
     EXPECT_FALSE(one_object(SegmentParams{}.rim_far_agree)) << "the cylinder was joined to the box";
