@@ -146,7 +146,8 @@ class Scenegen(unittest.TestCase):
                 with contextlib.redirect_stdout(lines):
                     kinds_module.main([str(gen), str(out), "--against", str(against)])
                 text = lines.getvalue().splitlines()
-                listed = text[text.index(next(t for t in text if t.startswith("against "))) + 1:-1]
+                start = next(i for i, t in enumerate(text) if t.startswith("against "))
+                listed = text[start + 1:-1]
                 self.assertEqual(len(listed), n)
                 for row in listed:
                     self.assertTrue(row.startswith("scene_00007 "), row)
