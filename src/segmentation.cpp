@@ -81,6 +81,7 @@ void SegmentParams::validate() const {
     require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
     require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
     require(rim_far_agree > 0, "rim_far_agree", rim_far_agree, "> 0");
+    require(island_min_width_px >= 0, "island_min_width_px", island_min_width_px, ">= 0, 0 = off");
     require(gap_max_px >= 0, "gap_max_px", gap_max_px, ">= 0");
     require(occluded_min_lines >= 0, "occluded_min_lines", occluded_min_lines, ">= 0");
     require(occluded_max_offset > 0, "occluded_max_offset", occluded_max_offset, "> 0");
@@ -543,7 +544,12 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     if (!kmeans) {
         stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
         stats.ms.merge = ms_since();
-        if (support) stats.containers = join_containers(x, *support, ws, n);
+        if (support) {
+            const ContainerJoins c = join_containers(x, *support, ws, n);
+            stats.containers = c.joins;
+            stats.islands_kept = c.islands_kept;
+            n += c.labels_added;
+        }
         stats.ms.containers = ms_since();
     }
     if (params.segmenter == Segmenter::Hybrid) {

@@ -170,9 +170,25 @@ inline void relabel_to_roots(SegmentWorkspace& ws) {
 // Each works on ws.label, segments numbered 1..n with gaps, and returns its count for
 // SegmentStats.
 
+/// What the container rule did: the joins, and the lone islands it kept as objects, which
+/// take labels n + 1 .. n + labels_added (with gaps).
+struct ContainerJoins {
+    int joins = 0;
+    int islands_kept = 0;
+    int labels_added = 0;
+};
+
 /// Containers (SegmentParams, "Containers"): joins a container's inside, seen over its rim,
-/// to the container. Returns the joins.
-int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
+/// to the container; with rim_islands, keeps the lone islands (keep_lone_islands).
+ContainerJoins join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
+
+/// Lone islands (SegmentParams::island_min_width_px): of the islands n + 1 .. n + islands in
+/// ws.label, those the rim test joined to nothing, keeps each that meets no segment across
+/// continuous depth, lies behind every segment it meets, and is island_min_width_px wide
+/// (2 x pixels / outline pairs) or more; unlabels the others. Returns the islands kept.
+/// Cost: a vectorized test per row, four neighbours of each island pixel, and a pass over
+/// the rows that hold islands.
+int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands);
 
 /// Floor gaps (SegmentParams::gap_max_px): small unlabelled patches beside a container's
 /// inside, enclosed by one segment, join it. Returns the points filled.

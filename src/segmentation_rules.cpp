@@ -361,18 +361,84 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 /// level edge across a depth step, lying inside that circle and reaching up to it, is the
 /// other's inside (a bowl's or a cup's) and joins it. With rim_islands the regions no
 /// segment reached take part as segments n + 1, ... (add_islands), and after the joins those
-/// that joined no segment are unlabelled again: the root of a joined set is its smallest
-/// label, so what is left above n joined only islands. In: ws.label (1..n with gaps). Out:
-/// ws.label with the insides joined, still within 1..n. Cost: one pass over the pixels and a
-/// sort of the boundary pairs; then per candidate a few passes over its boundary, and one
-/// over the rows of the candidates' insides; with islands, add_islands and one more pass.
-int join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
-    if (x.prm.rim_min_boundary <= 0 || n < 1) return 0;
+/// that joined no segment are lone objects or unlabelled again (keep_lone_islands): the root
+/// of a joined set is its smallest label, so what is left above n joined only islands. In:
+/// ws.label (1..n with gaps). Out: ws.label with the insides joined, within 1..n +
+/// labels_added. Cost: one pass over the pixels and a sort of the boundary pairs; then per
+/// candidate a few passes over its boundary, and one over the rows of the candidates'
+/// insides; with islands, add_islands and keep_lone_islands.
+ContainerJoins join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+    if (x.prm.rim_min_boundary <= 0 || n < 1) return {};
     const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
-    const int joins = join_rims(x, pl, ws, n + islands);
-    if (islands > 0)
-        for (int& l : ws.label) l = l > n ? 0 : l;  // a branch-free pass that vectorizes
-    return joins;
+    ContainerJoins out;
+    out.joins = join_rims(x, pl, ws, n + islands);
+    if (islands > 0) {
+        out.islands_kept = keep_lone_islands(x, ws, n, islands);
+        out.labels_added = out.islands_kept > 0 ? islands : 0;
+    }
+    return out;
+}
+
+/// Why each test: an island that continues into a segment with continuous depth is a piece
+/// of it that no crease test let grow (not an object); one nearer than a segment it meets
+/// lies in depth between two surfaces, as the mixed pixels along an occluding edge and the
+/// broken pieces of one surface do (osd_mosd test59 at --decimate 2: a 77-point piece of a
+/// box's top, nearer than one neighbour and farther than the other); one narrower than
+/// island_min_width_px is such a band of mixed pixels (a RealSense frame, image_0003: 1.7
+/// points wide along the drill's top edge). What is left is seen past every segment it
+/// meets: a bowl's inside whose rim fitted no circle, an object's top between nearer ones.
+int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands) {
+    int* const label = ws.label.data();
+    const int W = x.W, H = x.H;
+    const int min_width = x.prm.island_min_width_px;
+    // Rows without an island are skipped by a test that vectorizes (most rows hold none).
+    auto has_island = [&](const int* row) {
+        int any = 0;
+        for (int u = 0; u < W; ++u) any |= row[u] > n;
+        return any != 0;
+    };
+    // Per island: its pixels, its outline pairs (to anything but itself; none past the frame)
+    // and whether it is still lone.
+    ws.island_pixels.assign(static_cast<std::size_t>(islands) + 1, 0);
+    ws.island_outline.assign(static_cast<std::size_t>(islands) + 1, 0);
+    ws.island_lone.assign(static_cast<std::size_t>(islands) + 1, min_width > 0);
+    int first_row = H, last_row = -1;
+    for (int v = 0; v < H; ++v) {
+        const int* const row = label + static_cast<std::size_t>(v) * W;
+        if (!has_island(row)) continue;
+        first_row = std::min(first_row, v), last_row = v;
+        if (min_width <= 0) continue;  // every island dropped: only the rows are needed
+        for (int u = 0; u < W; ++u) {
+            const int l = row[u];
+            if (l <= n) continue;
+            const std::size_t i = static_cast<std::size_t>(l - n);
+            ++ws.island_pixels[i];
+            const int p = v * W + u;
+            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1, v + 1 < H ? p + W : -1};
+            for (const int q : nb) {
+                if (q < 0 || label[q] == l) continue;  // past the frame, or itself
+                ++ws.island_outline[i];
+                const std::size_t a = static_cast<std::size_t>(p), b = static_cast<std::size_t>(q);
+                if (label[q] > 0 && label[q] <= n && (x.connected(a, b) || x.c.z[a] <= x.c.z[b]))
+                    ws.island_lone[i] = 0;
+            }
+        }
+    }
+    // Width 2 * pixels / outline pairs: a band w wide and L long has w L pixels and about 2 L
+    // outline pairs.
+    int kept = 0;
+    for (std::size_t i = 1; i <= static_cast<std::size_t>(islands); ++i) {
+        ws.island_lone[i] &= static_cast<std::uint8_t>(
+            ws.island_pixels[i] > 0 && 2LL * ws.island_pixels[i] >= static_cast<long long>(min_width) * ws.island_outline[i]);
+        kept += ws.island_lone[i];
+    }
+    const std::uint8_t* const lone = ws.island_lone.data();
+    for (int v = first_row; v <= last_row; ++v) {
+        int* const row = label + static_cast<std::size_t>(v) * W;
+        for (int u = 0; u < W; ++u)
+            if (row[u] > n && !lone[row[u] - n]) row[u] = 0;
+    }
+    return kept;
 }
 
 // ---- floor gaps ----------------------------------------------------------------------------

@@ -415,4 +415,23 @@ TEST(GeneratedScene, CylinderBehindABox_NotJoinedAsItsInside) {
     ASSERT_TRUE(one_object(1e9f)) << "with any far rim agreeing, the cylinder should join the box (test premise)";
     EXPECT_FALSE(one_object(SegmentParams{}.rim_far_agree)) << "the cylinder was joined to the box";
 }
+
+// A generated scene (eval/scenegen.py tune seed 30): a bowl whose inside, every pixel of it
+// on a crease at --decimate 2, seeds no segment, and whose rim fits no circle, so the rim
+// test joins that island to nothing. It meets no segment with continuous depth, lies behind
+// every segment it meets, and is 3.9 points wide: a lone island, kept as the bowl.
+TEST(GeneratedScene, BowlSeenOnlyAsAnIsland_KeptAsALoneIsland) {
+    TempDir dir;
+    const GeneratedFrame g = render_generated(dir, 30);
+    auto bowl = [&](int min_width) {
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.island_min_width_px = min_width; });
+        return std::pair{dominant_object(r.objects, g.truth, 13).second, r.segment_stats.islands_kept};  // truth 13: the bowl
+    };
+    const auto [without, kept_without] = bowl(0);
+    ASSERT_LT(without, 0.1) << "without lone islands the bowl should be missed (test premise)";
+    EXPECT_EQ(kept_without, 0);
+    const auto [with, kept] = bowl(SegmentParams{}.island_min_width_px);
+    EXPECT_GT(with, 0.85) << "the bowl's island was not kept";
+    EXPECT_GE(kept, 1);
+}
 #endif

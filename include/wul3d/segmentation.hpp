@@ -130,7 +130,16 @@ struct SegmentParams {
     float rim_height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
     bool rim_islands = true;            ///< object regions no segment reached (a small cup's
                                         ///< inside at --decimate 2, every pixel on a crease)
-                                        ///< are candidates too, kept only where joined
+                                        ///< are candidates too; those joined to nothing are
+                                        ///< dropped unless lone (island_min_width_px)
+    /// Lone islands: an island the rim test joined to nothing is an object of its own (a
+    /// bowl's inside whose rim fitted no circle, an object's top seen between nearer ones)
+    /// when no segment continues into it with continuous depth, it lies behind every segment
+    /// it meets (not in depth between two, as the mixed pixels of an occluding edge and the
+    /// pieces of a broken surface do), and it is this wide at least: 2 x pixels / outline
+    /// pairs, in input pixels (scaled with --decimate); a band of mixed pixels is narrower.
+    /// >= 0, 0 = no island is kept.
+    int island_min_width_px = 6;
     bool rim_far = true;                ///< a second candidate circle per pair, fitted to the
                                         ///< front's edge and the inside's far outline at the
                                         ///< rim's height (its far rim), when the front spans
@@ -226,6 +235,8 @@ struct SegmentWorkspace {
     std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
     std::vector<int> rim_next;         ///< candidates of one back segment, linked
     std::vector<int> rim_far_px;       ///< the back's far rim, of the pair being fitted
+    std::vector<int> island_pixels, island_outline;  ///< lone islands: per island
+    std::vector<std::uint8_t> island_lone;           ///< 1 = kept
     // Floor gaps:
     std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
     std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
@@ -271,6 +282,7 @@ struct SegmentStats {
     int merges = 0;        ///< segment pairs joined across a non-concave boundary (and
                            ///< after the colour cue: color_rejoin)
     int containers = 0;    ///< insides joined to their container across the rim
+    int islands_kept = 0;  ///< lone islands kept as objects (island_min_width_px)
     int occluded = 0;      ///< parts of one surface joined across the object before them
     std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached

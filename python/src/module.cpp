@@ -89,6 +89,7 @@ Result make_result(const FrameResult& r) {
     out.stats["segments"] = r.segment_stats.segments;
     out.stats["merges"] = r.segment_stats.merges;
     out.stats["containers"] = r.segment_stats.containers;
+    out.stats["islands_kept"] = r.segment_stats.islands_kept;
     out.stats["occluded_joins"] = r.segment_stats.occluded;
     out.stats["gaps_filled"] = r.segment_stats.gaps_filled;
     out.stats["color_splits"] = r.segment_stats.color_splits;
