@@ -425,11 +425,13 @@ int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands) {
         }
     }
     // Width 2 * pixels / outline pairs: a band w wide and L long has w L pixels and about 2 L
-    // outline pairs.
+    // outline pairs. One smaller than an object is not kept: it could not be one, and its
+    // pixels stay free for the floor gaps (fill_container_gaps).
     int kept = 0;
     for (std::size_t i = 1; i <= static_cast<std::size_t>(islands); ++i) {
+        const long long pixels = ws.island_pixels[i];
         ws.island_lone[i] &= static_cast<std::uint8_t>(
-            ws.island_pixels[i] > 0 && 2LL * ws.island_pixels[i] >= static_cast<long long>(min_width) * ws.island_outline[i]);
+            pixels >= x.prm.min_points && 2 * pixels >= static_cast<long long>(min_width) * ws.island_outline[i]);
         kept += ws.island_lone[i];
     }
     const std::uint8_t* const lone = ws.island_lone.data();

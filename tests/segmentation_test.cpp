@@ -359,7 +359,8 @@ TEST(SegmentObjects, SmallThinCup_RegionNoSeedReachedJoinedAcrossTheRim) {
 // Lone islands (keep_lone_islands) on a hand-built frame of 24 x 8 pixels: segment 1 in
 // columns [0, 8) at 1 m, an island (label 3: n = 2, one island) in the columns after it,
 // and beyond it segment 2 or nothing. An island is kept only when it lies behind every
-// segment it meets, across a depth step, and is wide enough (2 x pixels / outline pairs).
+// segment it meets, across a depth step, is wide enough (2 x pixels / outline pairs) and
+// holds min_points.
 TEST(SegmentObjects, LoneIslands_KeptWhenBehindEverySegmentAndWide) {
     struct Case {
         const char* what;
@@ -368,6 +369,7 @@ TEST(SegmentObjects, LoneIslands_KeptWhenBehindEverySegmentAndWide) {
         float beyond_z;  // segment 2's depth beyond the island; 0: no segment
         int min_width;
         bool kept;
+        int min_points = 64;  // the island's size when 8 columns wide
     };
     const Case cases[] = {
         {"behind segment 1, nothing beyond", 1.2f, 8, 0, 3, true},
@@ -378,6 +380,7 @@ TEST(SegmentObjects, LoneIslands_KeptWhenBehindEverySegmentAndWide) {
         {"8 wide (64 pixels, 16 outline pairs) at a minimum of 8", 1.2f, 8, 0, 8, true},
         {"8 wide at a minimum of 9", 1.2f, 8, 0, 9, false},
         {"island_min_width_px 0", 1.2f, 8, 0, 0, false},
+        {"smaller than min_points", 1.2f, 8, 0, 3, false, 65},
     };
     const int W = 24, H = 8, n = 2, island = n + 1;
     for (const Case& t : cases) {
@@ -396,6 +399,7 @@ TEST(SegmentObjects, LoneIslands_KeptWhenBehindEverySegmentAndWide) {
         const std::vector<int> before = ws.label;
         SegmentParams prm;
         prm.island_min_width_px = t.min_width;
+        prm.min_points = t.min_points;
         const NormalMap normals;
         const std::vector<std::uint8_t> classes;
         const detail::Ctx x{prm, cloud, normals, classes, W, H};

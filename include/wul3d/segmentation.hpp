@@ -138,7 +138,7 @@ struct SegmentParams {
     /// it meets (not in depth between two, as the mixed pixels of an occluding edge and the
     /// pieces of a broken surface do), and it is this wide at least: 2 x pixels / outline
     /// pairs, in input pixels (scaled with --decimate); a band of mixed pixels is narrower.
-    /// >= 0, 0 = no island is kept.
+    /// It holds min_points too. >= 0, 0 = no island is kept.
     int island_min_width_px = 6;
     bool rim_far = true;                ///< a second candidate circle per pair, fitted to the
                                         ///< front's edge and the inside's far outline at the
