@@ -185,8 +185,8 @@ ContainerJoins join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& 
 /// Lone islands (SegmentParams::island_min_width_px): of the islands n + 1 .. n + islands in
 /// ws.label, those the rim test joined to nothing, keeps each that meets no segment across
 /// continuous depth, lies behind every segment it meets, is island_min_width_px wide (2 x
-/// pixels / outline pairs) or more and holds min_points; unlabels the others. Returns the islands kept.
-/// Cost: a vectorized test per row, four neighbours of each island pixel, and a pass over
+/// pixels / outline pairs) or more and holds min_points; unlabels the others. Returns the
+/// islands kept. Cost: a vectorized test per row, four neighbours of each island pixel, and a pass over
 /// the rows that hold islands.
 int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands);
 

@@ -406,7 +406,8 @@ int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands) {
     for (int v = 0; v < H; ++v) {
         const int* const row = label + static_cast<std::size_t>(v) * W;
         if (!has_island(row)) continue;
-        first_row = std::min(first_row, v), last_row = v;
+        first_row = std::min(first_row, v);
+        last_row = v;
         if (min_width <= 0) continue;  // every island dropped: only the rows are needed
         for (int u = 0; u < W; ++u) {
             const int l = row[u];

@@ -345,8 +345,9 @@ TEST(SegmentObjects, SmallThinCup_RegionNoSeedReachedJoinedAcrossTheRim) {
         EXPECT_EQ(stats.segments, 1) << radius;
 
         // Islands that join nothing change nothing: with no rim fitting a circle, the labels
-        // are those of the run without islands. (Nor is either kept as a lone island: the
-        // one island is narrower than island_min_width_px, 4.4 and 3.3 pixels wide.)
+        // are those of the run without islands. (Nor is it kept as a lone island: at both
+        // radii the one island is narrower than island_min_width_px, 4.4 and 3.3 pixels, and
+        // smaller than min_points.)
         SegmentParams no_rims;
         no_rims.rim_max_residual_m = 1e-7f;
         SegmentParams no_rims_no_islands = no_rims;
@@ -376,7 +377,7 @@ TEST(SegmentObjects, LoneIslands_KeptWhenBehindEverySegmentAndWide) {
         {"behind segment 1 and a nearer segment 2", 1.2f, 8, 1.1f, 3, true},
         {"between segment 1 and a farther segment 2 in depth", 1.2f, 8, 1.4f, 3, false},
         {"continuous with segment 1", 1.001f, 8, 0, 3, false},
-        {"a band 2 pixels wide", 1.2f, 2, 0, 3, false},
+        {"a band 2 pixels wide", 1.2f, 2, 0, 3, false, 16},
         {"8 wide (64 pixels, 16 outline pairs) at a minimum of 8", 1.2f, 8, 0, 8, true},
         {"8 wide at a minimum of 9", 1.2f, 8, 0, 9, false},
         {"island_min_width_px 0", 1.2f, 8, 0, 0, false},
