@@ -178,10 +178,7 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
     while (head < tail) {
         const int p = ws.queue[head++];
         if (ws.dist[p] >= max_steps) continue;
-        const int u = p % W, v = p / W;
-        const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
-                           v + 1 < H ? p + W : -1};
-        for (int q : nb) {
+        for (int q : four_neighbours(p, p % W, p / W, W, H)) {
             if (q < 0 || ws.label[q] || x.cls[q] == kPlaneRemoved) continue;
             if (inside_only && x.cls[q] != kPlaneInside) continue;
             // The inside is enclosed by the object, whatever the depth step at its edge.

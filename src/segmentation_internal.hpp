@@ -3,6 +3,7 @@
 // coordinates on the support plane, the union-find over segments, and the rules the driver
 // calls (segmentation_rules.cpp, segmentation_stacks.cpp, segmentation_occlusion.cpp).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -32,6 +33,20 @@ inline bool row_has_label(const int* row, int from, int to) {
     int any = 0;
     for (int u = from; u < to; ++u) any |= row[u];
     return any != 0;
+}
+
+/// Whether any of row[from, to) holds a label over n (an island, in the container rule): the
+/// same OR over the row as row_has_label.
+inline bool row_has_label_over(const int* row, int from, int to, int n) {
+    int any = 0;
+    for (int u = from; u < to; ++u) any |= row[u] > n;
+    return any != 0;
+}
+
+/// The 4-neighbours of pixel p = v W + u in a W x H image (left, right, up, down); -1 where
+/// one lies past the frame.
+inline std::array<int, 4> four_neighbours(int p, int u, int v, int W, int H) {
+    return {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1, v + 1 < H ? p + W : -1};
 }
 
 /// Added to a pixel's r + g + b before a ratio of colours: keeps the chromaticity of dark,
@@ -124,9 +139,7 @@ int flood_region(const Ctx& x, std::vector<int>& queue, int seed, IsOpen&& is_op
     queue[static_cast<std::size_t>(tail++)] = seed;
     while (head < tail) {
         const int p = queue[static_cast<std::size_t>(head++)];
-        const int u = p % W, v = p / W;
-        const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1, v + 1 < H ? p + W : -1};
-        for (int q : nb) {
+        for (int q : four_neighbours(p, p % W, p / W, W, H)) {
             if (q < 0 || !is_open(static_cast<std::size_t>(q))) continue;
             if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) continue;
             mark(static_cast<std::size_t>(q));
@@ -186,8 +199,8 @@ ContainerJoins join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& 
 /// ws.label, those the rim test joined to nothing, keeps each that meets no segment across
 /// continuous depth, lies behind every segment it meets, is island_min_width_px wide (2 x
 /// pixels / outline pairs) or more and holds min_points; unlabels the others. Returns the
-/// islands kept. Cost: a vectorized test per row, four neighbours of each island pixel, and a pass over
-/// the rows that hold islands.
+/// islands kept. Cost: a vectorized test per row, four neighbours of each island pixel, and
+/// a pass over the rows that hold islands.
 int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands);
 
 /// Floor gaps (SegmentParams::gap_max_px): small unlabelled patches beside a container's

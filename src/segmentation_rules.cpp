@@ -391,32 +391,25 @@ int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands) {
     int* const label = ws.label.data();
     const int W = x.W, H = x.H;
     const int min_width = x.prm.island_min_width_px;
-    // Rows without an island are skipped by a test that vectorizes (most rows hold none).
-    auto has_island = [&](const int* row) {
-        int any = 0;
-        for (int u = 0; u < W; ++u) any |= row[u] > n;
-        return any != 0;
-    };
     // Per island: its pixels, its outline pairs (to anything but itself; none past the frame)
     // and whether it is still lone.
     ws.island_pixels.assign(static_cast<std::size_t>(islands) + 1, 0);
     ws.island_outline.assign(static_cast<std::size_t>(islands) + 1, 0);
-    ws.island_lone.assign(static_cast<std::size_t>(islands) + 1, min_width > 0);
+    ws.island_lone.assign(static_cast<std::size_t>(islands) + 1, 1);
     int first_row = H, last_row = -1;
     for (int v = 0; v < H; ++v) {
         const int* const row = label + static_cast<std::size_t>(v) * W;
-        if (!has_island(row)) continue;
+        if (!row_has_label_over(row, 0, W, n)) continue;  // most rows hold no island
         first_row = std::min(first_row, v);
         last_row = v;
-        if (min_width <= 0) continue;  // every island dropped: only the rows are needed
+        if (min_width <= 0) continue;  // no island kept (none counts pixels): only the rows
         for (int u = 0; u < W; ++u) {
             const int l = row[u];
             if (l <= n) continue;
             const std::size_t i = static_cast<std::size_t>(l - n);
             ++ws.island_pixels[i];
             const int p = v * W + u;
-            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1, v + 1 < H ? p + W : -1};
-            for (const int q : nb) {
+            for (const int q : four_neighbours(p, u, v, W, H)) {
                 if (q < 0 || label[q] == l) continue;  // past the frame, or itself
                 ++ws.island_outline[i];
                 const std::size_t a = static_cast<std::size_t>(p), b = static_cast<std::size_t>(q);
@@ -469,9 +462,7 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws) {
             const int p = ws.queue[head++];
             const int pu = p % W, pv = p / W;
             if (pu == 0 || pv == 0 || pu == W - 1 || pv == H - 1) enclosed = false;
-            const int nb[4] = {pu > 0 ? p - 1 : -1, pu + 1 < W ? p + 1 : -1, pv > 0 ? p - W : -1,
-                               pv + 1 < H ? p + W : -1};
-            for (int q : nb) {
+            for (int q : four_neighbours(p, pu, pv, W, H)) {
                 if (q < 0) continue;
                 const int l = ws.label[static_cast<std::size_t>(q)];
                 if (l) {
@@ -788,9 +779,7 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, co
         const int p = px[i];
         const int u = p % W, v = p / W;
         if (part[p] == small_part) {
-            const int nb[4] = {u > 0 ? p - 1 : -1, u + 1 < W ? p + 1 : -1, v > 0 ? p - W : -1,
-                               v + 1 < x.H ? p + W : -1};
-            for (const int q : nb)
+            for (const int q : four_neighbours(p, u, v, W, x.H))
                 sb.small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
         }
         for_part_boundary_pairs(x, ws, l, p, [&](int q, int du, int dv) {
