@@ -125,7 +125,13 @@ bool is_own_file_name(const std::string& name) { return name.rfind(".wul3d.", 0)
 bool is_own_entry(const fs::directory_entry& entry, std::string& what) {
     const std::string name = entry.path().filename().string();
     std::error_code ec;
-    if (name == kSummaryFile || name == kFramesFile || is_own_file_name(name)) return true;
+    if (is_own_file_name(name)) return true;
+    if (name == kSummaryFile || name == kFramesFile) {
+        // Only as a plain file: a link or a FIFO under the name is not wul3d's.
+        if (entry.is_regular_file(ec) && !entry.is_symlink(ec)) return true;
+        what = entry.path().string();
+        return false;
+    }
     if (!entry.is_directory(ec) || entry.is_symlink(ec)) {
         what = entry.path().string();
         return false;

@@ -21,6 +21,7 @@
 #include "wul3d/objects.hpp"
 #include "wul3d/output.hpp"
 #include "wul3d/stop.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d {
 namespace fs = std::filesystem;
@@ -143,10 +144,9 @@ struct StageLog {
 class FramesLog {
 public:
     explicit FramesLog(const std::string& path) : path_(path) {
-        // O_APPEND on a fresh file: each line lands whole at its end.
-        const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_APPEND | O_CLOEXEC, 0644);
-        if (fd < 0) throw IoError(path + ": cannot write (" + std::strerror(errno) + ")");
-        fd_ = fd;
+        // A new file (a link or a FIFO under the name is refused, never followed), appended
+        // to: each line lands whole at its end.
+        fd_ = open_new_append_file(path);
     }
     ~FramesLog() { ::close(fd_); }
     FramesLog(const FramesLog&) = delete;
@@ -209,42 +209,14 @@ struct Selection {
     }
 };
 
-/// `p` absolute, with symbolic links resolved as far as it exists, for comparing folders.
-fs::path resolved(const std::string& p) {
-    std::error_code ec;
-    const fs::path abs = fs::absolute(p, ec).lexically_normal();
-    const fs::path c = fs::weakly_canonical(abs, ec);
-    fs::path r = ec ? abs : c;
-    if (r.filename().empty()) r = r.parent_path();  // no trailing separator
-    return r;
-}
-
-/// Whether `inner` is `outer` or lies under it.
-bool within(const fs::path& inner, const fs::path& outer) {
-    auto o = outer.begin(), i = inner.begin();
-    for (; o != outer.end(); ++o, ++i)
-        if (i == inner.end() || *i != *o) return false;
-    return true;
-}
-
 /// Refuses an output folder that is, holds or lies in an input: the outputs would replace
 /// the recording's files (a frame's folder and OUT/<frame>/ would be one).
 void check_out_apart_from_inputs(const RunOptions& o) {
-    const fs::path out = resolved(o.out_dir);
     std::vector<std::string> inputs;
     if (!o.feed.input.empty()) inputs.push_back(o.feed.input);
     const std::string& calib = o.feed.source.calibration;
     if (!calib.empty() && calib != "kinect_v2") inputs.push_back(calib);
-    for (const std::string& input : inputs) {
-        const fs::path in = resolved(input);
-        const char* how = out == in            ? "is the input"
-                          : within(out, in)    ? "lies inside the input"
-                          : within(in, out)    ? "contains the input"
-                                               : nullptr;
-        if (how)
-            throw ParamError("output folder " + o.out_dir + " " + how + " " + input +
-                             "; the outputs would overwrite it: choose an output folder apart");
-    }
+    check_write_target(o.out_dir, WriteTarget::Folder, inputs, "output folder");
 }
 
 /// summary.json's frame-independent part.
@@ -283,8 +255,8 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     RunObserver silent;
     RunObserver& obs = observer ? *observer : silent;
     FrameFeed feed(o.feed, o.stop);
+    check_out_apart_from_inputs(o);
     if (!feed.live()) {
-        check_out_apart_from_inputs(o);
         // Every name before the first frame: a run must not fail at frame 50,000 for it.
         for (std::size_t i = 0; i < feed.size(); ++i) check_frame_name(feed.source()->name(i));
     }
@@ -293,6 +265,8 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
         feed.live() ? o.max_frames
                     : (o.max_frames ? std::min(o.max_frames, feed.size()) : feed.size());
     prepare_out_dir(o.out_dir, o.overwrite);
+    const OutputLock lock(o.out_dir);  // one writer at a time: frames.jsonl would interleave
+    remove_stale_temporaries(o.out_dir);  // of a run killed mid-write (SIGKILL, power)
     const fs::path out_dir(o.out_dir);
 
     Pipeline pipeline(o.params);

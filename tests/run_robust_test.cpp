@@ -187,7 +187,7 @@ TEST(RunOutputs, OutNeverTheInputNorAroundIt) {
     const fs::path seq = tiny_tum(dir / "seq", 2);
     for (const fs::path& out : {seq, seq / "out", dir.path()}) {
         RunOptions o = tiny_run(seq, out);
-        EXPECT_THROW(run_sequence(o), ParamError) << out;
+        EXPECT_THROW(run_sequence(o), InputError) << out;
     }
     EXPECT_FALSE(fs::exists(seq / "out"));
     EXPECT_EQ(test::list_files(seq).size(), 4u);  // rgb.txt, depth.txt and the two images

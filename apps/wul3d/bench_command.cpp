@@ -3,7 +3,6 @@
 // Figure 7. Parsing, timing and reporting only; the pipeline is the library's.
 #include <sys/resource.h>
 #include <sys/wait.h>
-#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,6 +21,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
+#include "wul3d/threads.hpp"
 
 namespace wul3d::cli {
 namespace {
@@ -113,7 +113,7 @@ void measure_one(const BenchOptions& o) {
     params.detect_objects = o.pipeline == "objects";
     if (!o.segmenter.empty()) params.segmentation.segmenter = parse_segmenter(o.segmenter);
     params.decimation = decimation_of(o);
-    if (o.threads > 0) omp_set_num_threads(o.threads);
+    if (o.threads > 0) wul3d::set_num_threads(o.threads);
     Pipeline pipeline(params);
     pipeline.process(frames.front());  // seeding is a one-off: not timed
     std::vector<double> ms;
@@ -270,8 +270,8 @@ void add_bench_command(CLI::App& app) {
                     "(back-projection to eq. 9 colours)")
         ->capture_default_str();
     cmd->add_option("--segmenter", opts->segmenter, "geometric|kmeans|hybrid (default: hybrid)");
-    cmd->add_option("--threads", opts->threads, "Worker threads (default: all cores)")
-        ->check(CLI::Range(0, 1 << 16));
+    cmd->add_option("--threads", opts->threads, "Worker threads, [1, 1024] (default: all cores)")
+        ->check(CLI::Range(0, wul3d::kMaxThreads));
     cmd->add_option("--decimate", opts->decimate,
                     "Run the stages on every N-th pixel in u and v, results at the input's size "
                     "(default: 2 with --pipeline objects, 1 with paper)")

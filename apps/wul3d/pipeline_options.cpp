@@ -1,11 +1,10 @@
 #include "pipeline_options.hpp"
 
-#include <omp.h>
-
 #include <sstream>
 
 #include "wul3d/error.hpp"
 #include "wul3d/segmentation.hpp"
+#include "wul3d/threads.hpp"
 
 namespace wul3d::cli {
 
@@ -70,7 +69,7 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     cmd->add_option("--object-psi", o.object_psi,
                     "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
     cmd->add_option("--threads", o.threads, "Worker threads, [1, 1024] (default: all cores)")
-        ->check(CLI::Range(1, 1024));
+        ->check(CLI::Range(1, wul3d::kMaxThreads));
     cmd->add_option("--decimate", o.decimate,
                     "N in [1, 8]: run the stages on every N-th pixel in u and v (N^2 times fewer "
                     "points), results at the input's size (default 2; 1 with --preset paper)");
@@ -145,7 +144,7 @@ std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o) {
 }
 
 void apply_threads(const PipelineOptions& o) {
-    if (o.threads > 0) omp_set_num_threads(o.threads);
+    if (o.threads > 0) wul3d::set_num_threads(o.threads);
 }
 
 }  // namespace wul3d::cli

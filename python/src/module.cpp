@@ -2,7 +2,6 @@
 // its result, frame reading and scoring; python/wul3d/__init__.py re-exports them with the
 // pure-Python helpers. Errors: ParamError -> ValueError, InputError -> wul3d.InputError
 // (a ValueError), IoError -> wul3d.IoError (an OSError).
-#include <omp.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -23,6 +22,7 @@
 #include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/threads.hpp"
 
 #if __has_include("wul3d/image_view.hpp")
 #include "wul3d/image_view.hpp"
@@ -628,19 +628,18 @@ PYBIND11_MODULE(_wul3d, m) {
     bind_reading(m);
     bind_eval(m);
     bind_run(m);
+    bind_write_guard(m);
     m.def("read_label_image", [](const std::string& path) { return to_array(wul3d::read_label_png(path)); },
           py::arg("path"), "A 16-bit label PNG (labels.png, objects.png, ground truth) as (H, W) uint16.");
     m.def("read_color_image", [](const std::string& path) { return to_array(wul3d::read_color_image(path)); },
           py::arg("path"), "An 8-bit PNG or JPEG as (H, W, 3) uint8 RGB.");
-    m.def("set_num_threads", [](int n) {
-              if (n < 1) throw py::value_error("threads = " + std::to_string(n) + ": must be >= 1");
-              omp_set_num_threads(n);
-          },
-          py::arg("n"), "Worker threads of every pipeline in this process (default: all cores).");
+    m.def("set_num_threads", &wul3d::set_num_threads, py::arg("n"),
+          "Worker threads of every pipeline in this process, in [1, 1024] (default: all "
+          "cores); ValueError outside that range.");
     m.def("_concurrency", []() { return py::make_tuple(g_running.load(), g_max_running.load()); },
           "(running now, most at once): Pipeline.process calls running without the GIL.");
     m.def("_reset_concurrency", []() { g_max_running = g_running.load(); },
           "Restarts the count of _concurrency's maximum.");
-    m.def("get_num_threads", []() { return omp_get_max_threads(); },
+    m.def("get_num_threads", &wul3d::num_threads,
           "Worker threads a pipeline uses.");
 }

@@ -6,12 +6,14 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "convert.hpp"
 #include "params.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/write_guard.hpp"
 
 #if __has_include("wul3d/run.hpp")
 #include "wul3d/run.hpp"
@@ -154,5 +156,26 @@ void bind_run(py::module_& m) {
 #else
 void bind_run(py::module_&) {}  // the library has no run loop yet
 #endif
+
+void bind_write_guard(py::module_& m) {
+    m.def(
+        "_check_write_target",
+        [](const std::string& target, const std::string& kind,
+           const std::vector<std::string>& inputs, const std::string& flag) {
+            if (kind != "file" && kind != "folder")
+                throw py::value_error("kind '" + kind + "': must be 'file' or 'folder'");
+            check_write_target(target, kind == "file" ? WriteTarget::File : WriteTarget::Folder,
+                               inputs, flag);
+        },
+        py::arg("target"), py::arg("kind"), py::arg("inputs"), py::arg("flag") = "",
+        "The library's guard of every write (wul3d/write_guard.hpp): raises wul3d.InputError "
+        "unless `target` is apart from every input and not a link out.");
+    py::class_<OutputLock>(m, "_OutputLock",
+                           "The advisory lock of an output folder (wul3d/write_guard.hpp): "
+                           "raises wul3d.InputError when another process writes it.")
+        .def(py::init<const std::string&>(), py::arg("dir"));
+    m.def("_remove_stale_temporaries", &remove_stale_temporaries, py::arg("dir"),
+          "Removes the .wul3d.tmp-* / .wul3d.partial-* a killed writer left in `dir`.");
+}
 
 }  // namespace wul3d::python
