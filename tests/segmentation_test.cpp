@@ -6,7 +6,7 @@
 #include <random>
 
 #include "circle_fit.hpp"  // src/: the rims' and the round test's circle fit, tested here
-#include "segmentation_internal.hpp"  // src/: keep_lone_islands, tested on a hand-built frame
+#include "segmentation/internal.hpp"  // src/: keep_lone_islands, tested on a hand-built frame
 #include "synthetic_scene.hpp"
 #include "wul3d/background.hpp"
 #include "wul3d/error.hpp"

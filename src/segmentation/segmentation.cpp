@@ -7,8 +7,8 @@
 #include <limits>
 #include <sstream>
 
-#include "param_check.hpp"
-#include "segmentation_internal.hpp"  // Ctx, union-find, the rules
+#include "../param_check.hpp"
+#include "internal.hpp"  // Ctx, union-find, the rules
 #include "wul3d/error.hpp"
 #include "wul3d/normals.hpp"  // smooth_normals
 #include "wul3d/plane.hpp"

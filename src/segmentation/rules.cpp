@@ -11,8 +11,8 @@
 #include <optional>
 #include <utility>
 
-#include "circle_fit.hpp"
-#include "segmentation_internal.hpp"
+#include "../circle_fit.hpp"
+#include "internal.hpp"
 #include "wul3d/clustering.hpp"  // ClusterParams: the colour cue's alpha and delta
 
 namespace wul3d::detail {

@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "segmentation_internal.hpp"
+#include "internal.hpp"
 
 namespace wul3d::detail {
 namespace {

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <vector>
 
-#include "segmentation_internal.hpp"
+#include "internal.hpp"
 
 namespace wul3d::detail {
 namespace {
