@@ -1,6 +1,6 @@
 #pragma once
 // A circle through 2D points: the rims of containers and the walls of round objects, on the
-// support plane (segmentation_rules.cpp). Header-only: the points come from a visitor, so the
+// support plane (segmentation/containers.cpp, colour_cue.cpp). Header-only: the points come from a visitor, so the
 // callers map pixels to the plane without a copy, and the tests feed plain points.
 #include <Eigen/Dense>
 #include <cmath>
