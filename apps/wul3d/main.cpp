@@ -5,6 +5,7 @@
 
 #include "cli.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/version.hpp"
 
 namespace wul3d::cli {
 
@@ -22,7 +23,7 @@ int main(int argc, char** argv) {
     CLI::App app{"wul3d: real-time object detection in RGB-D video by weighted unsupervised "
                  "learning (Kowsari & Alassaf)"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "wul3d 0.1.0");
+    app.set_version_flag("--version", "wul3d " WUL3D_VERSION);
     wul3d::cli::add_run_command(app);
     wul3d::cli::add_bench_command(app);
     wul3d::cli::add_eval_command(app);

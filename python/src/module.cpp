@@ -23,6 +23,7 @@
 #include "wul3d/pipeline.hpp"
 #include "wul3d/registration.hpp"
 #include "wul3d/threads.hpp"
+#include "wul3d/version.hpp"
 
 #if __has_include("wul3d/image_view.hpp")
 #include "wul3d/image_view.hpp"
@@ -621,6 +622,7 @@ void bind_eval(py::module_& m) {
 PYBIND11_MODULE(_wul3d, m) {
     using namespace wul3d::python;
     m.doc() = "The compiled part of wul3d (see the package wul3d).";
+    m.attr("__version__") = WUL3D_VERSION;  // CMake's project(VERSION), as `wul3d --version`
     bind_errors(m);
     bind_intrinsics(m);
     bind_result(m);

@@ -38,6 +38,7 @@ from ._wul3d import (  # noqa: F401  (re-exported)
     set_num_threads,
 )
 from . import _wul3d
+from ._wul3d import __version__  # noqa: F401  (CMake's project(VERSION))
 
 __all__ = [
     "Frame", "InputError", "Instance", "Intrinsics", "IoError", "Pipeline", "Result",
