@@ -586,7 +586,8 @@ void ClusterState::assign(const Grid& grid) {
         double* sums = chunk_sums_.data() + static_cast<std::size_t>(ch) * k * kSums;
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
-            // A block is 256 points against every centre: some 0.1 s at k = 65535.
+            // A block is 256 points against every centre: long enough at the largest k to be
+            // worth a look for a stop request.
             if (stop_requested()) break;  // thrown below, outside the parallel region
             const std::size_t g1 = std::min(last, g0 + kAssignBlock);
             const PointView pts = grid.points(g0, g1, pb);

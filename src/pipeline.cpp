@@ -41,10 +41,9 @@ PipelineParams PipelineParams::stage_params() const {
     // What counts an object's pixels or spans the scene scales, so that --min-points 300 is
     // the same object at every N; 0 keeps meaning "off". The neighbourhoods (normal radius,
     // crease step and smoothing, re-attachment, depth jumps), the seeds' size and the plane's
-    // grid step stay in the decimated pixels: scaling the neighbourhoods cost up to 7 points
-    // of Boundary F on osd_mosd's learn frames (docs/SPEED.md, "Decimation"); a grid that kept its
-    // points scored about the same as one with N^2 fewer (docs/DESIGN.md) and cost 0.6-0.9 ms
-    // more at N = 2.
+    // grid step stay in the decimated pixels: scaling the neighbourhoods lost Boundary F on
+    // osd_mosd's learn frames (docs/DESIGN.md, "Decimation"); a grid that kept its points scored
+    // about the same as one with N^2 fewer (docs/DESIGN.md) and cost time at N = 2.
     auto length = [n](int px, int at_least) { return px == 0 ? 0 : std::max(at_least, (px + n / 2) / n); };
     auto area = [n](int px) { return px == 0 ? 0 : std::max(1, (px + n * n / 2) / (n * n)); };
     s.plane.hull_margin_px = length(plane.hull_margin_px, 0);

@@ -36,8 +36,8 @@ struct PipelineParams {
     /// 1: every pixel. N in [2, 8]: the stages run on the frame decimated N x N
     /// (decimation.hpp) and the per-pixel results come back at the input's size. The
     /// parameters above stay in the input's pixels; stage_params() scales them. The default
-    /// 2 is 2.2-2.8 times as fast as every pixel at 640x480 and scores as well on OSD but
-    /// for its most cluttered frames (docs/SPEED.md, "Decimation").
+    /// 2: a quarter of the pixels to work on, and the same score on OSD but for its most
+    /// cluttered frames (docs/SPEED.md, "Decimation", measures both).
     int decimation = 2;
 
     /// The paper's setting: ClusterParams::paper(), depth range 0.5-4.5 m (Kinect v2), every

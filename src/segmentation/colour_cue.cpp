@@ -155,8 +155,8 @@ double principal_axis(const double (&cov)[3][3], double (&e)[3]) {
 /// position. Seeds at the farthest colours (the pixel farthest from the mean, then the one
 /// farthest from it) let a few outlying pixels, the feet a segment took from the table or
 /// a line of mixed colour at an edge, pull 2-means into a part of their own, which the
-/// share test then rejects; they move the principal axis little (generated tune seeds
-/// 88.5 -> 89.8 Overlap F, docs/ABLATION.md). False, and no seeds, when the colour spread
+/// share test then rejects; they move the principal axis little (better on the generated
+/// tune seeds, docs/ABLATION.md). False, and no seeds, when the colour spread
 /// cannot hold parts `min_spread` apart (feature units). `total`: the planes' sums (in
 /// double, pixel order), which two_means needs too. Cost: three passes over the segment's
 /// planes.
@@ -434,8 +434,8 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
 
 /// Colours per segment when 2-means followed a texture: a textured object's two, a plain
 /// one's beside it, and one more for what fits none (mixed pixels along edges, a third
-/// colour). Chosen on the generated tune seeds: 3, 4 and 5 colours scored 92.8, 93.1 and
-/// 92.9 Overlap F, learnt from every pixel (docs/ABLATION.md, "Textures").
+/// colour). Chosen on the generated tune seeds, where 4 scored above 3 and 5, learnt from
+/// every pixel (docs/ABLATION.md, "Colour cue").
 constexpr int kTextureColours = 4;
 
 /// k-means learns the colours from at most this many pixels per colour (every stride-th
