@@ -138,7 +138,7 @@ struct HullMask {
     /// the frame with the table running on under them: where the hull reaches the bottom
     /// edge there, they are over the support; where the table's near edge is in view, the
     /// hull stops above it and they are not. Beyond the top and sides a foot stays off the
-    /// image (docs/ABLATION.md, "Feet below the frame").
+    /// image (docs/ABLATION.md, "Support plane").
     float below_to_edge(float gv) const { return std::min(gv, fh - 0.5f); }
 
     /// The grid cell the foot projects into, -1 off the image.

@@ -60,14 +60,14 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
 /// sensor's depth step is z^2 / (f b)), which scatters the points along the rays. Only the
 /// rims use it: the round test keeps rim_max_residual_m, since a looser bound there let more
 /// segments pass as round, which the colour cue then leaves unsplit (docs/ABLATION.md,
-/// "Circles").
+/// "Containers").
 double circle_tolerance(const SegmentParams& prm, double z) {
     return prm.rim_max_residual_m * std::max(1.0, z * z);
 }
 
 /// The front's extent across the line of sight, in radii of a circle fitted with the far
 /// rim, at least: 1 (a container's outer wall spans 2, or less where something hides it).
-/// 1.5 lost half the gain on the generated tune seeds (docs/ABLATION.md, "The far rim").
+/// 1.5 lost half the gain on the generated tune seeds (docs/ABLATION.md, "Containers").
 constexpr double kFarRimMinWidth = 1.0;
 
 /// The front segment's extent on the plane across the line of sight through `centre` (the
