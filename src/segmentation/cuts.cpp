@@ -1,5 +1,5 @@
 // The crease cuts: where two object pixels a crease step apart face each other across a
-// concave fold (LCCP's test, docs/DESIGN.md, "Objects", 1), the pixels between are cut, so
+// concave fold (LCCP's test, docs/DESIGN.md, "Cuts"), the pixels between are cut, so
 // that objects touching each other, or standing on each other, seed apart. The kmeans
 // segmenter cuts along the paper's cluster boundaries instead. The seeds go to the
 // components (components.cpp).

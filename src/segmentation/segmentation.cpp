@@ -46,8 +46,8 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     ms.components = lap();
     stats.reattached = reattach_foreground(x, ws);
     ms.reattach = lap();
-    // The rules on segments (docs/DESIGN.md, "Objects", 2), in this order. One that does not
-    // run leaves its time to the next that does.
+    // The rules on segments (docs/DESIGN.md, "Objects", a section each), in this order. One
+    // that does not run leaves its time to the next that does.
     auto rule = [&](bool on, double& phase_ms, Rule run) {
         if (!on) return;
         run(x, support, ws, n, stats);
