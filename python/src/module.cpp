@@ -211,8 +211,13 @@ public:
         const auto n = static_cast<py::ssize_t>(size());
         if (index < 0) index += n;
         if (index < 0 || index >= n) throw py::index_error("frame index out of range");
+        // The source, the item and the registration's buffers are this reader's, reused from
+        // frame to frame: one thread at a time reads, up to the copies into arrays. A thread
+        // waits for the lock without the GIL, so the one holding it can take the GIL back.
+        std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
         {
             py::gil_scoped_release release;
+            lock.lock();
             source_->read(static_cast<std::size_t>(index), item_);
             if (item_.is_raw) {
                 if (registration_ == RegistrationMode::DepthToColor)
@@ -237,6 +242,7 @@ public:
 private:
     std::unique_ptr<FrameSource> source_;
     RegistrationMode registration_;
+    std::mutex mutex_;  ///< held by get() from the read to the last copy out
     SourceItem item_;
     RegistrationWorkspace ws_;
     RgbdFrame registered_;
