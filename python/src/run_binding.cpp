@@ -2,7 +2,6 @@
 
 #include <pybind11/stl.h>
 
-#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -12,6 +11,7 @@
 #include "params.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/parse.hpp"
 #include "wul3d/registration.hpp"
 #include "wul3d/write_guard.hpp"
 
@@ -25,74 +25,30 @@ namespace wul3d::python {
 #ifdef WUL3D_PYTHON_HAS_RUN
 namespace {
 
-template <typename T>
-std::optional<T> take(py::dict& d, const char* key) {
-    if (!d.contains(key)) return std::nullopt;
-    py::object v = d[key];
-    PyDict_DelItemString(d.ptr(), key);
-    if (v.is_none()) return std::nullopt;
-    try {
-        return v.cast<T>();
-    } catch (const py::cast_error&) {
-        throw py::type_error(std::string("run: option '") + key + "' has the wrong type (" +
-                             py::str(py::type::of(v).attr("__name__")).cast<std::string>() + ")");
-    }
-}
-
-/// "fx,fy,cx,cy" (as --intrinsics), wul3d.Intrinsics or a dict.
-PinholeIntrinsics intrinsics_option(const py::object& v) {
-    if (py::isinstance<py::str>(v)) {
-        const std::string text = v.cast<std::string>();
-        double x[4];
-        char tail = 0;
-        if (std::sscanf(text.c_str(), "%lf,%lf,%lf,%lf%c", &x[0], &x[1], &x[2], &x[3], &tail) != 4)
-            throw ParamError("--intrinsics '" + text + "': expected 4 comma-separated numbers");
-        if (!(x[0] > 0 && x[1] > 0))
-            throw ParamError("--intrinsics '" + text + "': fx and fy must be > 0");
-        PinholeIntrinsics K;
-        K.fx = x[0];
-        K.fy = x[1];
-        K.cx = x[2];
-        K.cy = x[3];
-        K.validate_unsized("--intrinsics '" + text + "'");
-        return K;
-    }
-    return to_intrinsics(v, 0, 0);  // each frame's own size
-}
-
+/// wul3d.run(select=...): "u,v" as `--select` (the library's parser, parse.hpp), or a pair
+/// of numbers given to the same bound check.
 std::pair<int, int> select_option(const py::object& v) {
-    if (py::isinstance<py::str>(v)) {
-        const std::string text = v.cast<std::string>();
-        double u = 0, w = 0;
-        char tail = 0;
-        if (std::sscanf(text.c_str(), "%lf,%lf%c", &u, &w, &tail) != 2)
-            throw ParamError("--select '" + text + "': expected 2 comma-separated numbers");
-        return {static_cast<int>(u), static_cast<int>(w)};
-    }
-    const auto uv = v.cast<std::pair<int, int>>();
-    return uv;
+    if (py::isinstance<py::str>(v)) return parse_select(v.cast<std::string>());
+    if (!py::isinstance<py::sequence>(v) || py::len(v) != 2)
+        throw py::type_error("select: expected \"u,v\" or a pair (u, v), got " +
+                             py::str(py::type::of(v).attr("__name__")).cast<std::string>());
+    const auto pair = py::reinterpret_borrow<py::sequence>(v);
+    const double u = to_double(pair[0], "select[0]"), w = to_double(pair[1], "select[1]");
+    return select_pixel(u, w, py::str(v).cast<std::string>());
+}
+
+/// Removes `key` from `o`; its value unless absent or None.
+std::optional<py::object> pop(py::dict& o, const char* key) {
+    if (!o.contains(key)) return std::nullopt;
+    py::object v = o[key];
+    PyDict_DelItemString(o.ptr(), key);
+    if (v.is_none()) return std::nullopt;
+    return v;
 }
 
 RunOptions run_options(const std::string& input, const std::string& out, py::dict o) {
     RunOptions r;
-    ParamArgs a;
-    a.preset = take<std::string>(o, "preset");
-    a.k = take<int>(o, "k");
-    a.alpha = take<float>(o, "alpha");
-    a.delta = take<float>(o, "delta");
-    a.gamma = take<float>(o, "gamma");
-    a.psi = take<float>(o, "psi");
-    a.iters = take<int>(o, "iters");
-    a.stride = take<int>(o, "stride");
-    a.seed = take<std::uint64_t>(o, "seed");
-    a.zmin = take<float>(o, "zmin");
-    a.zmax = take<float>(o, "zmax");
-    a.normal_radius = take<int>(o, "normal_radius");
-    a.segmenter = take<std::string>(o, "segmenter");
-    a.scope = take<std::string>(o, "scope");
-    a.min_points = take<int>(o, "min_points");
-    a.object_psi = take<float>(o, "object_psi");
-    a.decimate = take<int>(o, "decimate");
+    ParamArgs a = take_param_args(o);
     if (take<bool>(o, "no_plane").value_or(false)) a.remove_plane = false;
     r.params = make_params(a);
     r.preset = a.preset.value_or("");
@@ -102,19 +58,11 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     SourceOptions& s = r.feed.source;
     s.format = parse_input_format(take<std::string>(o, "format").value_or("auto"));
     s.tum_camera = take<std::string>(o, "tum_camera").value_or("");
-    s.calibration = take<std::string>(o, "calibration").value_or("");
+    if (const auto v = pop(o, "calibration")) s.calibration = to_path(*v, "calibration");
     s.registration =
         parse_registration_mode(take<std::string>(o, "registration").value_or("depth-to-color"));
-    if (o.contains("intrinsics")) {
-        py::object v = o["intrinsics"];
-        PyDict_DelItemString(o.ptr(), "intrinsics");
-        if (!v.is_none()) s.intrinsics = intrinsics_option(v);
-    }
-    if (o.contains("select")) {
-        py::object v = o["select"];
-        PyDict_DelItemString(o.ptr(), "select");
-        if (!v.is_none()) r.select = select_option(v);
-    }
+    if (const auto v = pop(o, "intrinsics")) s.intrinsics = intrinsics_override(*v);
+    if (const auto v = pop(o, "select")) r.select = select_option(*v);
     const auto frames = take<long long>(o, "frames");
     if (frames && *frames < 1) throw ParamError("--frames " + std::to_string(*frames) + ": must be >= 1");
     r.max_frames = frames ? static_cast<std::size_t>(*frames) : 0;
@@ -125,7 +73,8 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     if (!o.empty()) {
         std::string keys;
         for (const auto& item : o) keys += (keys.empty() ? "" : ", ") + py::str(item.first).cast<std::string>();
-        throw py::type_error("run: unknown option(s): " + keys);
+        throw py::type_error("run: unknown option(s): " + keys +
+                             (o.contains("threads") ? " (threads: wul3d.set_num_threads)" : ""));
     }
     return r;
 }
@@ -135,8 +84,9 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
 void bind_run(py::module_& m) {
     m.def(
         "_run",
-        [](const std::string& input, const std::string& out, const py::dict& options) {
-            const RunOptions r = run_options(input, out, options.attr("copy")());  // a copy to consume
+        [](const py::object& input, const py::object& out, const py::dict& options) {
+            const RunOptions r = run_options(to_path(input, "input"), to_path(out, "out"),
+                                             options.attr("copy")());  // a copy to consume
             RunSummary s;
             {
                 py::gil_scoped_release release;

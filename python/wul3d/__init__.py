@@ -22,6 +22,8 @@ Contents:
     wul3d.batch   many sequences on Dask (python3 -m wul3d.batch)
 """
 
+import operator
+import os
 from collections.abc import Iterator, Sequence
 
 from ._wul3d import (  # noqa: F401  (re-exported)
@@ -54,9 +56,9 @@ class Reader(Sequence):
 
     def __init__(self, path, format="auto", tum_camera="", intrinsics=None, calibration="",
                  registration="depth-to-color"):
-        self.path = str(path)
-        self._reader = _wul3d._Reader(self.path, format, tum_camera, intrinsics, calibration,
+        self._reader = _wul3d._Reader(path, format, tum_camera, intrinsics, calibration,
                                       registration)
+        self.path = os.fsdecode(path)
 
     @property
     def format(self) -> str:
@@ -69,7 +71,10 @@ class Reader(Sequence):
     def __getitem__(self, index):
         if isinstance(index, slice):
             return [self._reader[i] for i in range(*index.indices(len(self)))]
-        return self._reader[index]
+        i = operator.index(index)  # TypeError for a non-int, as a list
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"frame index {i} out of range ({len(self)} frames)")
+        return self._reader[i]
 
     def __iter__(self) -> Iterator[Frame]:
         for i in range(len(self)):
@@ -155,4 +160,4 @@ def run(input, out, **options) -> dict:
     """
     if not hasattr(_wul3d, "_run"):
         raise NotImplementedError("wul3d.run: this build's library has no run loop")
-    return _wul3d._run(str(input), str(out), dict(options))
+    return _wul3d._run(input, out, dict(options))
