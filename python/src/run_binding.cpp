@@ -2,6 +2,8 @@
 
 #include <pybind11/stl.h>
 
+#include <chrono>
+#include <csignal>
 #include <optional>
 #include <string>
 #include <utility>
@@ -13,6 +15,7 @@
 #include "wul3d/io.hpp"
 #include "wul3d/parse.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/stop.hpp"
 #include "wul3d/write_guard.hpp"
 
 #if __has_include("wul3d/run.hpp")
@@ -79,18 +82,100 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     return r;
 }
 
+/// SIGINT while a run is on the main thread: the CLI's handling (frame_feed.cpp) for as long
+/// as the run lasts. The handler asks the library to stop (stop.hpp), which the stages check
+/// mid-frame; the run then ends as "signal" with its outputs complete, and KeyboardInterrupt
+/// is raised once summary.json is written. Python's own handler cannot do this: it runs only
+/// when the main thread runs Python, which it does not until the run returns.
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_interrupt(int) {
+    g_interrupted = 1;
+    request_stop();
+}
+
+class InterruptScope {
+public:
+    /// Takes SIGINT over only where Python would raise KeyboardInterrupt for it: on the main
+    /// thread, with the default handler (signal.default_int_handler) in place. GIL held.
+    InterruptScope() {
+        const py::module_ threading = py::module_::import("threading");
+        const py::module_ signal = py::module_::import("signal");
+        if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return;
+        if (!signal.attr("getsignal")(SIGINT).is(signal.attr("default_int_handler"))) return;
+        g_interrupted = 0;
+        clear_stop_request();
+        struct sigaction sa {};
+        sa.sa_handler = on_interrupt;
+        sigemptyset(&sa.sa_mask);
+        sa.sa_flags = SA_RESETHAND;  // as the command: a second Ctrl-C ends the process at once
+        installed_ = sigaction(SIGINT, &sa, &previous_) == 0;
+    }
+    ~InterruptScope() {
+        if (!installed_) return;
+        sigaction(SIGINT, &previous_, nullptr);  // Python's handler again
+        if (g_interrupted) clear_stop_request();  // later runs and pipelines start afresh
+    }
+    InterruptScope(const InterruptScope&) = delete;
+    InterruptScope& operator=(const InterruptScope&) = delete;
+
+    bool interrupted() const { return installed_ && g_interrupted; }
+
+private:
+    bool installed_ = false;
+    struct sigaction previous_ {};
+};
+
+/// Between frames, at most every 50 ms: Python's pending signals, with the GIL taken back
+/// for the check. A handler that raises (SIGINT where InterruptScope did not take it over, or
+/// a handler of the caller's) ends the run as "signal"; its exception is raised after it.
+class SignalPoll {
+public:
+    bool operator()() {
+        const auto now = std::chrono::steady_clock::now();
+        if (now < next_) return false;
+        next_ = now + std::chrono::milliseconds(50);
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() == 0) return false;
+        PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
+        PyErr_Fetch(&type, &value, &trace);
+        type_ = py::reinterpret_steal<py::object>(type);
+        value_ = py::reinterpret_steal<py::object>(value);
+        trace_ = py::reinterpret_steal<py::object>(trace);
+        return true;
+    }
+    /// Raises the handler's exception, if one ended the run. GIL held.
+    void rethrow() {
+        if (!type_) return;
+        PyErr_Restore(type_.release().ptr(), value_.release().ptr(), trace_.release().ptr());
+        throw py::error_already_set();
+    }
+
+private:
+    std::chrono::steady_clock::time_point next_{};
+    py::object type_, value_, trace_;
+};
+
 }  // namespace
 
 void bind_run(py::module_& m) {
     m.def(
         "_run",
         [](const py::object& input, const py::object& out, const py::dict& options) {
-            const RunOptions r = run_options(to_path(input, "input"), to_path(out, "out"),
-                                             options.attr("copy")());  // a copy to consume
+            RunOptions r = run_options(to_path(input, "input"), to_path(out, "out"),
+                                       options.attr("copy")());  // a copy to consume
+            const InterruptScope interrupt;
+            SignalPoll poll;
+            r.stop = [&interrupt, &poll] { return interrupt.interrupted() || poll(); };
             RunSummary s;
             {
                 py::gil_scoped_release release;
                 s = run_sequence(r);
+            }
+            poll.rethrow();
+            if (interrupt.interrupted()) {
+                PyErr_SetNone(PyExc_KeyboardInterrupt);
+                throw py::error_already_set();
             }
             return py::dict(py::arg("frames") = s.frames, py::arg("stopped_by") = s.stopped_by,
                             py::arg("ms_per_frame_median") = s.ms_per_frame_median,

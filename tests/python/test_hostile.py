@@ -122,6 +122,148 @@ def test_run_refers_threads_to_set_num_threads(tmp_path):
         wul3d.run(TABLETOP, tmp_path / "o", threads=65536)
 
 
+# ---- item 9: Ctrl-C in wul3d.run ----------------------------------------------------------
+
+def png(path, array, bit_depth, colour_type):
+    """A minimal PNG writer (no dependency): 8-bit RGB or 16-bit grey."""
+    rows = b"".join(b"\0" + row.tobytes() for row in array)
+    h, w = array.shape[:2]
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" +
+                     chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, bit_depth, colour_type, 0, 0, 0)) +
+                     chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def tiny_tum(root, n):
+    """A TUM sequence of n 8 x 8 frames (a tilted surface with a box on it, as
+    tests/run_robust_test.cpp), one pair of images listed n times under distinct stamps."""
+    (root / "rgb").mkdir(parents=True)
+    (root / "depth").mkdir()
+    v, u = np.mgrid[0:8, 0:8]
+    box = (u >= 3) & (u <= 5) & (v >= 2) & (v <= 4)
+    depth = np.where(box, 900, 1000 + 60 * v).astype(">u2")
+    color = np.where(box[..., None], np.array([40, 120, 200]), 180).astype(np.uint8)
+    png(root / "depth" / "d.png", depth, 16, 0)
+    png(root / "rgb" / "c.png", color, 8, 2)
+    stamps = [f"{1000 + i}.000000" for i in range(n)]
+    (root / "rgb.txt").write_text("".join(f"{s} rgb/c.png\n" for s in stamps))
+    (root / "depth.txt").write_text("".join(f"{s} depth/d.png\n" for s in stamps))
+    return root
+
+
+TINY = dict(intrinsics="8,8,3.5,3.5", decimate=1, k=3, min_points=2)
+
+RUN_LONG = """
+import signal, sys, wul3d
+if sys.argv[3] == "own-handler":
+    class Mine(Exception):
+        pass
+    def handler(sig, frame):
+        raise Mine("the caller's own SIGINT handler")
+    signal.signal(signal.SIGINT, handler)
+wul3d.set_num_threads(1)
+print("start", flush=True)
+wul3d.run(sys.argv[1], sys.argv[2], format="tum", intrinsics="8,8,3.5,3.5", decimate=1, k=3,
+          min_points=2)
+print("returned", flush=True)
+"""
+
+
+def lines(path):
+    try:
+        return path.read_text().count("\n")
+    except FileNotFoundError:
+        return 0
+
+
+def interrupt_when_written(proc, out, frames, limit_s=60):
+    """SIGINT once OUT/frames.jsonl has `frames` lines; the seconds until proc ended."""
+    deadline = time.monotonic() + limit_s
+    while lines(out / "frames.jsonl") < frames:
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the run did not start"
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    try:
+        stdout, stderr = proc.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        pytest.fail("wul3d.run ran on for 10 s after SIGINT")
+    return time.monotonic() - t0, stdout, stderr
+
+
+def assert_out_as_the_command_leaves_it(out, n_frames):
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped_by"] == "signal"
+    folders = [p for p in out.iterdir() if p.is_dir()]
+    assert summary["frames"] == len(folders) == lines(out / "frames.jsonl")
+    assert 0 < len(folders) < n_frames
+    for f in folders:  # every frame written is whole
+        assert (f / "objects.json").is_file() and (f / "labels.png").is_file(), f
+    return summary
+
+
+@pytest.mark.parametrize("handler", ["default", "own-handler"])
+def test_sigint_stops_a_long_run(tmp_path, handler):
+    # main: all 3000 frames, then KeyboardInterrupt (72 s on the machine of the report).
+    seq, out = tiny_tum(tmp_path / "seq", 3000), tmp_path / "out"
+    proc = start_python(RUN_LONG, seq, out, handler)
+    elapsed, stdout, stderr = interrupt_when_written(proc, out, 20)
+    assert elapsed < 2, elapsed
+    assert "returned" not in stdout
+    expected = "KeyboardInterrupt" if handler == "default" else "Mine: the caller's own SIGINT"
+    assert expected in stderr, stderr
+    assert stderr.count("Traceback") == 1, stderr
+    assert_out_as_the_command_leaves_it(out, 3000)
+
+
+RUN_SLOW_FRAME = """
+import sys, wul3d
+print("start", flush=True)
+try:
+    wul3d.run(sys.argv[1], sys.argv[2], k=65535, decimate=1)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+# The stop request is withdrawn: the next run goes to its end.
+s = wul3d.run(sys.argv[3], sys.argv[4], format="tum", frames=3, intrinsics="8,8,3.5,3.5",
+              decimate=1, k=3, min_points=2)
+print("next run:", s["stopped_by"], s["frames"], flush=True)
+"""
+
+
+def test_sigint_stops_a_frame_of_minutes(tmp_path):
+    # k = 65535 on a 640x480 frame: main ran on for over 97 s after SIGINT (rc 124 at 100 s).
+    out, seq = tmp_path / "out", tiny_tum(tmp_path / "seq", 5)
+    proc = start_python(RUN_SLOW_FRAME, TABLETOP / "image_0000", out, seq, tmp_path / "next")
+    assert proc.stdout.readline() == "start\n"
+    deadline = time.monotonic() + 60
+    while not (out / "frames.jsonl").exists():  # OUT prepared: the frame is under way
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    try:
+        stdout, stderr = proc.communicate(timeout=20)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        pytest.fail("wul3d.run ran on for 20 s after SIGINT")
+    assert proc.returncode == 0, stderr
+    assert stdout.startswith("interrupted\n"), (stdout, stderr)
+    assert "next run: frames 3" in stdout
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stopped_by"] == "signal" and summary["frames"] == 0
+    # Both runs within the bound: the stop took under 2 s, the 3 tiny frames well under 1 s.
+    assert time.monotonic() - t0 < 4
+
+
 # ---- item 14: select out of range ---------------------------------------------------------
 
 @pytest.mark.parametrize("select", ["1e20,1", "nan,1", "inf,2", "1,-inf", "-1,5", "70000,1",
