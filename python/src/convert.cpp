@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 
+#include "wul3d/io.hpp"
 #include "wul3d/parse.hpp"
 
 namespace wul3d::python {
@@ -182,9 +183,14 @@ FrameArrays check_frame_arrays(const py::object& color, const py::object& depth)
         throw py::value_error("depth: shape " + shape_text(a.depth) + ", expected (H, W)");
     if (a.depth.shape(0) == 0 || a.depth.shape(1) == 0)
         throw py::value_error("depth: empty image " + shape_text(a.depth));
-    if (a.depth.shape(0) > std::numeric_limits<int>::max() / 4 ||
-        a.depth.shape(1) > std::numeric_limits<int>::max() / 4)
-        throw py::value_error("depth: image too large " + shape_text(a.depth));
+    // The readers' limits (io.hpp, the command's --max-pixels; wul3d.set_max_pixels), before
+    // the pipeline allocates anything for the frame.
+    const auto h = static_cast<std::uint64_t>(a.depth.shape(0));
+    const auto w = static_cast<std::uint64_t>(a.depth.shape(1));
+    if (h > kMaxImageSide || w > kMaxImageSide || h * w > max_image_pixels())
+        throw py::value_error("depth: image " + shape_text(a.depth) + " is larger than the limit of " +
+                              std::to_string(max_image_pixels()) + " pixels and " +
+                              std::to_string(kMaxImageSide) + " a side (wul3d.set_max_pixels)");
     require_c_order(a.depth, "depth");
     a.height = static_cast<int>(a.depth.shape(0));
     a.width = static_cast<int>(a.depth.shape(1));

@@ -644,6 +644,17 @@ PYBIND11_MODULE(_wul3d, m) {
         "Worker threads of every pipeline in this process, in [1, 1024] (default: all cores): "
         "the command's --threads. ValueError outside that range, TypeError for a non-int; "
         "nothing changes then.");
+    m.def(
+        "set_max_pixels",
+        [](const py::object& n) {
+            wul3d::set_max_image_pixels(to_uint64(n, "max_pixels"));  // ParamError -> ValueError
+        },
+        py::arg("n"),
+        "The largest image, width x height, that wul3d.read, wul3d.run and Pipeline.process "
+        "accept, process-wide: the command's --max-pixels (default 2^24 = 16777216; in "
+        "[1, 2^30], else ValueError). Images are refused by their declared size, before any "
+        "decoding or allocation.");
+    m.def("get_max_pixels", &wul3d::max_image_pixels, "The largest image accepted (set_max_pixels).");
     m.def("_concurrency", []() { return py::make_tuple(g_running.load(), g_max_running.load()); },
           "(running now, most at once): Pipeline.process calls running without the GIL.");
     m.def("_reset_concurrency", []() { g_max_running = g_running.load(); },

@@ -34,17 +34,19 @@ from ._wul3d import (  # noqa: F401  (re-exported)
     IoError,
     Pipeline,
     Result,
+    get_max_pixels,
     get_num_threads,
     read_color_image,
     read_label_image,
+    set_max_pixels,
     set_num_threads,
 )
 from . import _wul3d
 
 __all__ = [
     "Frame", "InputError", "Instance", "Intrinsics", "IoError", "Pipeline", "Result",
-    "Reader", "evaluate", "get_num_threads", "read", "read_color_image", "read_label_image",
-    "run", "set_num_threads",
+    "Reader", "evaluate", "get_max_pixels", "get_num_threads", "read", "read_color_image",
+    "read_label_image", "run", "set_max_pixels", "set_num_threads",
 ]
 
 

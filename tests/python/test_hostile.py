@@ -377,3 +377,42 @@ def test_numpy_scalars_and_path_objects_are_accepted(frame, tmp_path):
     assert s["frames"] == 1
     assert len(wul3d.read(os.fsencode(TABLETOP))) == len(wul3d.read(str(TABLETOP))) == 4
 
+
+# ---- image sizes -----------------------------------------------------------------------------
+
+@pytest.fixture()
+def max_pixels():
+    before = wul3d.get_max_pixels()
+    yield before
+    wul3d.set_max_pixels(before)
+
+
+@pytest.mark.parametrize("n", [0, -1, 2**30 + 1, 2**64])
+def test_max_pixels_out_of_range(max_pixels, n):
+    with pytest.raises(ValueError, match="pixels"):
+        wul3d.set_max_pixels(n)
+    assert wul3d.get_max_pixels() == max_pixels == 2**24
+
+
+def test_process_refuses_an_image_past_the_limit_before_running(max_pixels):
+    # 4097 x 4097 > 2^24: main ran the pipeline on it (an InputError after the work).
+    depth = np.zeros((4097, 4097), np.uint16)
+    K = {"fx": 4000.0, "fy": 4000.0, "cx": 2048.0, "cy": 2048.0}
+    with pytest.raises(ValueError, match=r"larger than the limit of 16777216 pixels") as err:
+        wul3d.Pipeline().process(None, depth, K)
+    assert not isinstance(err.value, wul3d.InputError)
+    with pytest.raises(ValueError, match="65536 a side"):
+        wul3d.Pipeline().process(None, np.zeros((1, 65537), np.uint16), K)
+    wul3d.set_max_pixels(2**25)  # then it is read, and found to have no depth
+    with pytest.raises(wul3d.InputError, match="no valid pixel"):
+        wul3d.Pipeline().process(None, depth, K)
+
+
+def test_read_and_run_honour_max_pixels(max_pixels, tmp_path):
+    wul3d.set_max_pixels(640 * 480 - 1)
+    with pytest.raises(wul3d.InputError, match="pixels"):
+        wul3d.read(TABLETOP)[0]
+    with pytest.raises(wul3d.InputError, match="pixels"):
+        wul3d.run(TABLETOP, tmp_path / "o", frames=1)
+    wul3d.set_max_pixels(640 * 480)
+    assert wul3d.read(TABLETOP)[0].depth.shape == (480, 640)
