@@ -378,6 +378,70 @@ def test_numpy_scalars_and_path_objects_are_accepted(frame, tmp_path):
     assert len(wul3d.read(os.fsencode(TABLETOP))) == len(wul3d.read(str(TABLETOP))) == 4
 
 
+# ---- outputs against the input -------------------------------------------------------------
+
+@pytest.fixture()
+def own_input(tmp_path):
+    """A copy of the tabletop frames to attack, and its digest."""
+    src = tmp_path / "in"
+    shutil.copytree(TABLETOP, src)
+    return src, tree_digest(src)
+
+
+@pytest.mark.parametrize("where", ["same", "inside", "holding", "same-through-link",
+                                   "same-through-dotdot"])
+def test_out_against_the_input_is_refused(tmp_path, own_input, where):
+    src, digest = own_input
+    out = {"same": src, "inside": src / "image_0000" / "o", "holding": tmp_path,
+           "same-through-link": tmp_path / "link",
+           "same-through-dotdot": src / "image_0000" / ".."}[where]
+    if where == "same-through-link":
+        out.symlink_to(src)
+    for overwrite in (False, True):
+        with pytest.raises(wul3d.InputError, match="input"):
+            wul3d.run(src, out, overwrite=overwrite, frames=1)
+        assert tree_digest(src) == digest
+
+
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_frames_jsonl_as_a_symlink_is_refused(tmp_path, own_input, overwrite):
+    src, digest = own_input
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "frames.jsonl").symlink_to(src / "image_0000" / "intrinsics.json")
+    with pytest.raises(wul3d.InputError, match="frames.jsonl"):
+        wul3d.run(src, out, overwrite=overwrite, frames=1)
+    assert tree_digest(src) == digest
+    assert (out / "frames.jsonl").is_symlink()
+
+
+def test_an_out_being_written_is_refused_at_once(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    lock = wul3d._wul3d._OutputLock(str(out))  # what a run writing OUT holds
+    with pytest.raises(wul3d.InputError, match="out"):
+        wul3d.run(TABLETOP, out, frames=1)
+    del lock
+    assert wul3d.run(TABLETOP, out, frames=1)["frames"] == 1
+
+
+@pytest.mark.parametrize("overwrite", ["False", "True"])
+def test_frames_jsonl_as_a_fifo_is_refused_without_blocking(tmp_path, overwrite):
+    out = tmp_path / "out"
+    out.mkdir()
+    os.mkfifo(out / "frames.jsonl")
+    script = """
+import sys, wul3d
+try:
+    wul3d.run(sys.argv[1], sys.argv[2], frames=1, overwrite=sys.argv[3] == "True")
+except wul3d.InputError as e:
+    print("InputError:", e)
+"""
+    proc = python(script, TABLETOP, out, overwrite, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("InputError:") and "frames.jsonl" in proc.stdout, proc.stdout
+
+
 # ---- image sizes -----------------------------------------------------------------------------
 
 @pytest.fixture()
