@@ -183,6 +183,12 @@ void bind_run(py::module_& m) {
                             py::arg("peak_rss_mb") = s.peak_rss_mb);
         },
         py::arg("input"), py::arg("out"), py::arg("options"));
+    m.def("_request_stop", &request_stop,
+          "Asks every wul3d.run and Pipeline.process running now or later in this process to "
+          "stop (the library's stop request, stop.hpp): a run ends as \"signal\" with its "
+          "outputs complete. For a caller that handles its signals itself (the batch's worker "
+          "threads, which SIGINT does not reach); withdraw it with _clear_stop_request.");
+    m.def("_clear_stop_request", &clear_stop_request, "Withdraws _request_stop's request.");
     m.def(
         "_check_run_options",
         [](const py::dict& options) { run_options("", "", options.attr("copy")()); },

@@ -264,6 +264,28 @@ def test_sigint_stops_a_frame_of_minutes(tmp_path):
     assert time.monotonic() - t0 < 4
 
 
+def test_a_run_on_another_thread_stops_on_the_stop_request(tmp_path):
+    # SIGINT reaches the main thread only: a caller with runs on other threads (the batch)
+    # stops them with the library's stop request.
+    import threading
+    seq, out = tiny_tum(tmp_path / "seq", 3000), tmp_path / "out"
+    result = {}
+    worker = threading.Thread(target=lambda: result.update(wul3d.run(seq, out, format="tum", **TINY)))
+    worker.start()
+    try:
+        deadline = time.monotonic() + 60
+        while lines(out / "frames.jsonl") < 20 and worker.is_alive() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        wul3d._wul3d._request_stop()
+        worker.join(timeout=10)
+    finally:
+        wul3d._wul3d._clear_stop_request()
+    assert not worker.is_alive()
+    assert result["stopped_by"] == "signal"
+    assert_out_as_the_command_leaves_it(out, 3000)
+    assert wul3d.run(seq, tmp_path / "again", format="tum", frames=2, **TINY)["stopped_by"] == "frames"
+
+
 # ---- item 14: select out of range ---------------------------------------------------------
 
 @pytest.mark.parametrize("select", ["1e20,1", "nan,1", "inf,2", "1,-inf", "-1,5", "70000,1",
