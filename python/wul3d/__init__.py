@@ -102,7 +102,9 @@ def read(path, format="auto", tum_camera="", intrinsics=None, calibration="",
         registration: "depth-to-color" or "color-to-depth" (unregistered input).
 
     Frames of unregistered input come back registered. Raises wul3d.InputError (a
-    ValueError) for a missing path or an empty sequence, ValueError for a bad option.
+    ValueError) for a missing path, an empty sequence or an image past wul3d.set_max_pixels,
+    ValueError for a bad option, TypeError for an option of the wrong type. One reader may
+    be shared by threads (they take turns).
     """
     return Reader(path, format, tum_camera, intrinsics, calibration, registration)
 
@@ -157,8 +159,12 @@ def run(input, out, **options) -> dict:
         dict: frames, stopped_by, ms_per_frame_median, fps, wall_s, peak_rss_mb (as in
         summary.json). The GIL is released while it runs.
 
-    Raises ValueError (parameters), wul3d.InputError (input), wul3d.IoError (output),
-    TypeError (an unknown option).
+    Ctrl-C stops the run within a second, even mid-frame: the frames before are complete,
+    OUT/summary.json says "stopped_by": "signal", then KeyboardInterrupt is raised.
+
+    Raises ValueError (parameters, select out of range), wul3d.InputError (input; OUT equal
+    to, inside or holding the input), wul3d.IoError (output), TypeError (an unknown option,
+    a value of the wrong type; the message names it).
     """
     if not hasattr(_wul3d, "_run"):
         raise NotImplementedError("wul3d.run: this build's library has no run loop")
