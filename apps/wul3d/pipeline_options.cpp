@@ -1,32 +1,11 @@
 #include "pipeline_options.hpp"
 
-#include <sstream>
-
 #include "wul3d/error.hpp"
+#include "wul3d/parse.hpp"
 #include "wul3d/segmentation.hpp"
 #include "wul3d/threads.hpp"
 
 namespace wul3d::cli {
-
-std::vector<double> parse_numbers(const std::string& flag, const std::string& text,
-                                  std::size_t expected) {
-    std::vector<double> values;
-    std::stringstream ss(text);
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-        try {
-            std::size_t used = 0;
-            values.push_back(std::stod(item, &used));
-            if (used != item.size()) throw std::invalid_argument(item);
-        } catch (const std::exception&) {
-            throw ParamError(flag + " '" + text + "': '" + item + "' is not a number");
-        }
-    }
-    if (values.size() != expected)
-        throw ParamError(flag + " '" + text + "': expected " + std::to_string(expected) +
-                         " comma-separated numbers");
-    return values;
-}
 
 void add_max_pixels_option(CLI::App* cmd) {
     cmd->add_option_function<std::uint64_t>(
@@ -119,28 +98,13 @@ SourceOptions make_source_options(const PipelineOptions& o) {
     s.tum_camera = o.tum_camera;
     s.calibration = o.calibration;
     s.registration = parse_registration_mode(o.registration);
-    if (!o.intrinsics.empty()) {
-        const auto v = parse_numbers("--intrinsics", o.intrinsics, 4);
-        PinholeIntrinsics K;  // width and height 0: each frame's own size, checked then
-        K.fx = v[0];
-        K.fy = v[1];
-        K.cx = v[2];
-        K.cy = v[3];
-        K.validate_unsized("--intrinsics '" + o.intrinsics + "'");
-        s.intrinsics = K;
-    }
+    if (!o.intrinsics.empty()) s.intrinsics = parse_intrinsics_override(o.intrinsics);
     return s;
 }
 
 std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o) {
     if (o.select.empty()) return std::nullopt;
-    const auto uv = parse_numbers("--select", o.select, 2);
-    // Checked before the conversion: a double outside int's range has no int value.
-    for (const double c : uv)
-        if (!(c >= 0 && c < kMaxSidePx))
-            throw ParamError("--select '" + o.select + "': U and V must be pixels in [0, " +
-                             std::to_string(kMaxSidePx) + ")");
-    return std::make_pair(static_cast<int>(uv[0]), static_cast<int>(uv[1]));
+    return parse_select(o.select);  // the Python module's parser too (wul3d/parse.hpp)
 }
 
 void apply_threads(const PipelineOptions& o) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "wul3d/io.hpp"
+#include "wul3d/parse.hpp"  // parse_numbers, parse_select: shared with Python
 #include "wul3d/pipeline.hpp"
 
 namespace wul3d::cli {
@@ -49,9 +50,5 @@ SourceOptions make_source_options(const PipelineOptions& o);
 std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o);
 /// Applies --threads.
 void apply_threads(const PipelineOptions& o);
-
-/// Splits "a,b,c" into exactly `expected` numbers; throws ParamError naming the flag.
-std::vector<double> parse_numbers(const std::string& flag, const std::string& text,
-                                  std::size_t expected);
 
 }  // namespace wul3d::cli

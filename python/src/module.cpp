@@ -145,7 +145,8 @@ public:
     explicit PyPipeline(const ParamArgs& args) : pipeline_(make_params(args)) {}
 
     Result process(const py::object& color, const py::object& depth,
-                   const py::object& intrinsics, double depth_scale) {
+                   const py::object& intrinsics, const py::object& depth_scale_arg) {
+        const double depth_scale = to_double(depth_scale_arg, "depth_scale");
         if (!(depth_scale > 0) || !std::isfinite(depth_scale) || depth_scale > 1e3)
             throw py::value_error("depth_scale = " + std::to_string(depth_scale) +
                                   ": must be a positive number of metres per unit");
@@ -212,8 +213,13 @@ public:
         const auto n = static_cast<py::ssize_t>(size());
         if (index < 0) index += n;
         if (index < 0 || index >= n) throw py::index_error("frame index out of range");
+        // The source, the item and the registration's buffers are this reader's, reused from
+        // frame to frame: one thread at a time reads, up to the copies into arrays. A thread
+        // waits for the lock without the GIL, so the one holding it can take the GIL back.
+        std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
         {
             py::gil_scoped_release release;
+            lock.lock();
             source_->read(static_cast<std::size_t>(index), item_);
             if (item_.is_raw) {
                 if (registration_ == RegistrationMode::DepthToColor)
@@ -238,6 +244,7 @@ public:
 private:
     std::unique_ptr<FrameSource> source_;
     RegistrationMode registration_;
+    std::mutex mutex_;  ///< held by get() from the read to the last copy out
     SourceItem item_;
     RegistrationWorkspace ws_;
     RgbdFrame registered_;
@@ -324,14 +331,15 @@ Args:
     width (int, optional): image width; 0 = the arrays' size.
     height (int, optional): image height; 0 = the arrays' size.
 )doc")
-        .def(py::init([](double fx, double fy, double cx, double cy, int width, int height) {
+        .def(py::init([](const py::object& fx, const py::object& fy, const py::object& cx,
+                         const py::object& cy, const py::object& width, const py::object& height) {
                  PinholeIntrinsics K;
-                 K.fx = fx;
-                 K.fy = fy;
-                 K.cx = cx;
-                 K.cy = cy;
-                 K.width = width;
-                 K.height = height;
+                 K.fx = to_double(fx, "fx");
+                 K.fy = to_double(fy, "fy");
+                 K.cx = to_double(cx, "cx");
+                 K.cy = to_double(cy, "cy");
+                 K.width = to_value<int>(width, "width");
+                 K.height = to_value<int>(height, "height");
                  return K;
              }),
              py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"), py::arg("width") = 0,
@@ -481,35 +489,25 @@ Example:
     >>> r = p.process(color, depth, wul3d.Intrinsics(525, 525, 319.5, 239.5))
     >>> [(i.id, i.pixels) for i in r.instances]
 )doc")
-        .def(py::init([](std::optional<std::string> preset, std::optional<int> k,
-                         std::optional<float> alpha, std::optional<float> delta,
-                         std::optional<float> gamma, std::optional<float> psi,
-                         std::optional<int> iters, std::optional<int> stride,
-                         std::optional<std::uint64_t> seed, std::optional<float> zmin,
-                         std::optional<float> zmax, std::optional<int> normal_radius,
-                         std::optional<std::string> segmenter, std::optional<std::string> scope,
-                         bool remove_plane,
-                         std::optional<int> min_points, std::optional<float> object_psi,
-                         std::optional<int> decimate) {
-                 ParamArgs a;
-                 a.preset = preset;
-                 a.k = k;
-                 a.alpha = alpha;
-                 a.delta = delta;
-                 a.gamma = gamma;
-                 a.psi = psi;
-                 a.iters = iters;
-                 a.stride = stride;
-                 a.seed = seed;
-                 a.zmin = zmin;
-                 a.zmax = zmax;
-                 a.normal_radius = normal_radius;
-                 a.segmenter = segmenter;
-                 a.scope = scope;
-                 a.remove_plane = remove_plane;
-                 a.min_points = min_points;
-                 a.object_psi = object_psi;
-                 a.decimate = decimate;
+        .def(py::init([](const py::object& preset, const py::object& k, const py::object& alpha,
+                         const py::object& delta, const py::object& gamma, const py::object& psi,
+                         const py::object& iters, const py::object& stride, const py::object& seed,
+                         const py::object& zmin, const py::object& zmax,
+                         const py::object& normal_radius, const py::object& segmenter,
+                         const py::object& scope, const py::object& remove_plane,
+                         const py::object& min_points, const py::object& object_psi,
+                         const py::object& decimate) {
+                 // Each converted by name (params.hpp): a wrong type is a TypeError naming it.
+                 py::dict d(py::arg("preset") = preset, py::arg("k") = k, py::arg("alpha") = alpha,
+                            py::arg("delta") = delta, py::arg("gamma") = gamma, py::arg("psi") = psi,
+                            py::arg("iters") = iters, py::arg("stride") = stride,
+                            py::arg("seed") = seed, py::arg("zmin") = zmin, py::arg("zmax") = zmax,
+                            py::arg("normal_radius") = normal_radius,
+                            py::arg("segmenter") = segmenter, py::arg("scope") = scope,
+                            py::arg("min_points") = min_points, py::arg("object_psi") = object_psi,
+                            py::arg("decimate") = decimate);
+                 ParamArgs a = take_param_args(d);
+                 a.remove_plane = to_bool(remove_plane, "remove_plane");
                  return std::make_unique<PyPipeline>(a);
              }),
              py::kw_only(), py::arg("preset") = py::none(), py::arg("k") = py::none(),
@@ -555,18 +553,16 @@ void bind_reading(py::module_& m) {
         });
 
     py::class_<Reader>(m, "_Reader")
-        .def(py::init([](const std::string& path, const std::string& format,
-                         const std::string& tum_camera, const py::object& intrinsics,
-                         const std::string& calibration, const std::string& registration) {
+        .def(py::init([](const py::object& path, const py::object& format,
+                         const py::object& tum_camera, const py::object& intrinsics,
+                         const py::object& calibration, const py::object& registration) {
                  SourceOptions o;
-                 o.format = parse_input_format(format);
-                 o.tum_camera = tum_camera;
-                 o.calibration = calibration;
-                 o.registration = parse_registration_mode(registration);
-                 if (!intrinsics.is_none()) {
-                     o.intrinsics = to_intrinsics(intrinsics, 0, 0);  // each frame's own size
-                 }
-                 return std::make_unique<Reader>(path, o);
+                 o.format = parse_input_format(to_string(format, "format"));
+                 o.tum_camera = to_string(tum_camera, "tum_camera");
+                 o.calibration = to_path(calibration, "calibration");
+                 o.registration = parse_registration_mode(to_string(registration, "registration"));
+                 if (!intrinsics.is_none()) o.intrinsics = intrinsics_override(intrinsics);
+                 return std::make_unique<Reader>(to_path(path, "path"), o);
              }),
              py::arg("path"), py::arg("format"), py::arg("tum_camera"), py::arg("intrinsics"),
              py::arg("calibration"), py::arg("registration"))
@@ -578,11 +574,14 @@ void bind_reading(py::module_& m) {
 void bind_eval(py::module_& m) {
     m.def(
         "_score_image",
-        [](const py::object& pred, const py::object& gt, double fraction, int tolerance,
-           double detected_f) {
+        [](const py::object& pred, const py::object& gt, const py::object& fraction,
+           const py::object& tolerance, const py::object& detected_f) {
+            const EvalParams params =
+                eval_params(to_double(fraction, "boundary_fraction"),
+                            to_value<int>(tolerance, "boundary_tolerance_px"),
+                            to_double(detected_f, "detected_f"));
             const LabelImage p = to_label_image(pred, "pred");
             const LabelImage g = to_label_image(gt, "gt");
-            const EvalParams params = eval_params(fraction, tolerance, detected_f);
             ImageScore s;
             {
                 py::gil_scoped_release release;
@@ -631,13 +630,33 @@ PYBIND11_MODULE(_wul3d, m) {
     bind_eval(m);
     bind_run(m);
     bind_write_guard(m);
-    m.def("read_label_image", [](const std::string& path) { return to_array(wul3d::read_label_png(path)); },
+    m.def("read_label_image",
+          [](const py::object& path) { return to_array(wul3d::read_label_png(to_path(path, "path"))); },
           py::arg("path"), "A 16-bit label PNG (labels.png, objects.png, ground truth) as (H, W) uint16.");
-    m.def("read_color_image", [](const std::string& path) { return to_array(wul3d::read_color_image(path)); },
+    m.def("read_color_image",
+          [](const py::object& path) { return to_array(wul3d::read_color_image(to_path(path, "path"))); },
           py::arg("path"), "An 8-bit PNG or JPEG as (H, W, 3) uint8 RGB.");
-    m.def("set_num_threads", &wul3d::set_num_threads, py::arg("n"),
-          "Worker threads of every pipeline in this process, in [1, 1024] (default: all "
-          "cores); ValueError outside that range.");
+    m.def(
+        "set_num_threads",
+        [](const py::object& n) {
+            // The library's bound (threads.hpp), checked on the Python int before it is narrowed.
+            wul3d::set_num_threads(static_cast<int>(to_int(n, "threads", 1, wul3d::kMaxThreads)));
+        },
+        py::arg("n"),
+        "Worker threads of every pipeline in this process, in [1, 1024] (default: all cores): "
+        "the command's --threads. ValueError outside that range, TypeError for a non-int; "
+        "nothing changes then.");
+    m.def(
+        "set_max_pixels",
+        [](const py::object& n) {
+            wul3d::set_max_image_pixels(to_uint64(n, "max_pixels"));  // ParamError -> ValueError
+        },
+        py::arg("n"),
+        "The largest image, width x height, that wul3d.read, wul3d.run and Pipeline.process "
+        "accept, process-wide: the command's --max-pixels (default 2^24 = 16777216; in "
+        "[1, 2^30], else ValueError). Images are refused by their declared size, before any "
+        "decoding or allocation.");
+    m.def("get_max_pixels", &wul3d::max_image_pixels, "The largest image accepted (set_max_pixels).");
     m.def("_concurrency", []() { return py::make_tuple(g_running.load(), g_max_running.load()); },
           "(running now, most at once): Pipeline.process calls running without the GIL.");
     m.def("_reset_concurrency", []() { g_max_running = g_running.load(); },

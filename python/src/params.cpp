@@ -5,6 +5,28 @@
 
 namespace wul3d::python {
 
+ParamArgs take_param_args(py::dict& o) {
+    ParamArgs a;
+    a.preset = take<std::string>(o, "preset");
+    a.k = take<int>(o, "k");
+    a.alpha = take<float>(o, "alpha");
+    a.delta = take<float>(o, "delta");
+    a.gamma = take<float>(o, "gamma");
+    a.psi = take<float>(o, "psi");
+    a.iters = take<int>(o, "iters");
+    a.stride = take<int>(o, "stride");
+    a.seed = take<std::uint64_t>(o, "seed");
+    a.zmin = take<float>(o, "zmin");
+    a.zmax = take<float>(o, "zmax");
+    a.normal_radius = take<int>(o, "normal_radius");
+    a.segmenter = take<std::string>(o, "segmenter");
+    a.scope = take<std::string>(o, "scope");
+    a.min_points = take<int>(o, "min_points");
+    a.object_psi = take<float>(o, "object_psi");
+    a.decimate = take<int>(o, "decimate");
+    return a;
+}
+
 PipelineParams make_params(const ParamArgs& a) {
     PipelineParams p;
     if (a.preset && *a.preset == "paper") {

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "convert.hpp"
 #include "wul3d/pipeline.hpp"
 
 namespace wul3d::python {
@@ -21,6 +22,20 @@ struct ParamArgs {
     std::optional<std::uint64_t> seed;
     bool remove_plane = true;
 };
+
+/// Removes `key` from `options` and returns its value as T (None or absent: nullopt); a
+/// wrong type raises TypeError naming the key (convert.hpp).
+template <typename T>
+std::optional<T> take(py::dict& options, const char* key) {
+    if (!options.contains(key)) return std::nullopt;
+    const py::object v = options[key];
+    PyDict_DelItemString(options.ptr(), key);
+    return to_optional<T>(v, key);
+}
+
+/// The pipeline's parameters among `options` (preset, k, alpha, ..., decimate; not the
+/// plane switch, which Pipeline and run spell apart), removed from it as they are taken.
+ParamArgs take_param_args(py::dict& options);
 
 /// The same rules as `wul3d run`'s options (apps/wul3d/pipeline_options.cpp), so that a
 /// Pipeline built from the same settings gives the same outputs: the preset first, then each

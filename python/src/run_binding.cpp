@@ -2,7 +2,8 @@
 
 #include <pybind11/stl.h>
 
-#include <cstdio>
+#include <chrono>
+#include <csignal>
 #include <optional>
 #include <string>
 #include <utility>
@@ -12,7 +13,9 @@
 #include "params.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/parse.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/stop.hpp"
 #include "wul3d/write_guard.hpp"
 
 #if __has_include("wul3d/run.hpp")
@@ -25,74 +28,30 @@ namespace wul3d::python {
 #ifdef WUL3D_PYTHON_HAS_RUN
 namespace {
 
-template <typename T>
-std::optional<T> take(py::dict& d, const char* key) {
-    if (!d.contains(key)) return std::nullopt;
-    py::object v = d[key];
-    PyDict_DelItemString(d.ptr(), key);
-    if (v.is_none()) return std::nullopt;
-    try {
-        return v.cast<T>();
-    } catch (const py::cast_error&) {
-        throw py::type_error(std::string("run: option '") + key + "' has the wrong type (" +
-                             py::str(py::type::of(v).attr("__name__")).cast<std::string>() + ")");
-    }
-}
-
-/// "fx,fy,cx,cy" (as --intrinsics), wul3d.Intrinsics or a dict.
-PinholeIntrinsics intrinsics_option(const py::object& v) {
-    if (py::isinstance<py::str>(v)) {
-        const std::string text = v.cast<std::string>();
-        double x[4];
-        char tail = 0;
-        if (std::sscanf(text.c_str(), "%lf,%lf,%lf,%lf%c", &x[0], &x[1], &x[2], &x[3], &tail) != 4)
-            throw ParamError("--intrinsics '" + text + "': expected 4 comma-separated numbers");
-        if (!(x[0] > 0 && x[1] > 0))
-            throw ParamError("--intrinsics '" + text + "': fx and fy must be > 0");
-        PinholeIntrinsics K;
-        K.fx = x[0];
-        K.fy = x[1];
-        K.cx = x[2];
-        K.cy = x[3];
-        K.validate_unsized("--intrinsics '" + text + "'");
-        return K;
-    }
-    return to_intrinsics(v, 0, 0);  // each frame's own size
-}
-
+/// wul3d.run(select=...): "u,v" as `--select` (the library's parser, parse.hpp), or a pair
+/// of numbers given to the same bound check.
 std::pair<int, int> select_option(const py::object& v) {
-    if (py::isinstance<py::str>(v)) {
-        const std::string text = v.cast<std::string>();
-        double u = 0, w = 0;
-        char tail = 0;
-        if (std::sscanf(text.c_str(), "%lf,%lf%c", &u, &w, &tail) != 2)
-            throw ParamError("--select '" + text + "': expected 2 comma-separated numbers");
-        return {static_cast<int>(u), static_cast<int>(w)};
-    }
-    const auto uv = v.cast<std::pair<int, int>>();
-    return uv;
+    if (py::isinstance<py::str>(v)) return parse_select(v.cast<std::string>());
+    if (!py::isinstance<py::sequence>(v) || py::len(v) != 2)
+        throw py::type_error("select: expected \"u,v\" or a pair (u, v), got " +
+                             py::str(py::type::of(v).attr("__name__")).cast<std::string>());
+    const auto pair = py::reinterpret_borrow<py::sequence>(v);
+    const double u = to_double(pair[0], "select[0]"), w = to_double(pair[1], "select[1]");
+    return select_pixel(u, w, py::str(v).cast<std::string>());
+}
+
+/// Removes `key` from `o`; its value unless absent or None.
+std::optional<py::object> pop(py::dict& o, const char* key) {
+    if (!o.contains(key)) return std::nullopt;
+    py::object v = o[key];
+    PyDict_DelItemString(o.ptr(), key);
+    if (v.is_none()) return std::nullopt;
+    return v;
 }
 
 RunOptions run_options(const std::string& input, const std::string& out, py::dict o) {
     RunOptions r;
-    ParamArgs a;
-    a.preset = take<std::string>(o, "preset");
-    a.k = take<int>(o, "k");
-    a.alpha = take<float>(o, "alpha");
-    a.delta = take<float>(o, "delta");
-    a.gamma = take<float>(o, "gamma");
-    a.psi = take<float>(o, "psi");
-    a.iters = take<int>(o, "iters");
-    a.stride = take<int>(o, "stride");
-    a.seed = take<std::uint64_t>(o, "seed");
-    a.zmin = take<float>(o, "zmin");
-    a.zmax = take<float>(o, "zmax");
-    a.normal_radius = take<int>(o, "normal_radius");
-    a.segmenter = take<std::string>(o, "segmenter");
-    a.scope = take<std::string>(o, "scope");
-    a.min_points = take<int>(o, "min_points");
-    a.object_psi = take<float>(o, "object_psi");
-    a.decimate = take<int>(o, "decimate");
+    ParamArgs a = take_param_args(o);
     if (take<bool>(o, "no_plane").value_or(false)) a.remove_plane = false;
     r.params = make_params(a);
     r.preset = a.preset.value_or("");
@@ -102,19 +61,11 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     SourceOptions& s = r.feed.source;
     s.format = parse_input_format(take<std::string>(o, "format").value_or("auto"));
     s.tum_camera = take<std::string>(o, "tum_camera").value_or("");
-    s.calibration = take<std::string>(o, "calibration").value_or("");
+    if (const auto v = pop(o, "calibration")) s.calibration = to_path(*v, "calibration");
     s.registration =
         parse_registration_mode(take<std::string>(o, "registration").value_or("depth-to-color"));
-    if (o.contains("intrinsics")) {
-        py::object v = o["intrinsics"];
-        PyDict_DelItemString(o.ptr(), "intrinsics");
-        if (!v.is_none()) s.intrinsics = intrinsics_option(v);
-    }
-    if (o.contains("select")) {
-        py::object v = o["select"];
-        PyDict_DelItemString(o.ptr(), "select");
-        if (!v.is_none()) r.select = select_option(v);
-    }
+    if (const auto v = pop(o, "intrinsics")) s.intrinsics = intrinsics_override(*v);
+    if (const auto v = pop(o, "select")) r.select = select_option(*v);
     const auto frames = take<long long>(o, "frames");
     if (frames && *frames < 1) throw ParamError("--frames " + std::to_string(*frames) + ": must be >= 1");
     r.max_frames = frames ? static_cast<std::size_t>(*frames) : 0;
@@ -125,22 +76,106 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     if (!o.empty()) {
         std::string keys;
         for (const auto& item : o) keys += (keys.empty() ? "" : ", ") + py::str(item.first).cast<std::string>();
-        throw py::type_error("run: unknown option(s): " + keys);
+        throw py::type_error("run: unknown option(s): " + keys +
+                             (o.contains("threads") ? " (threads: wul3d.set_num_threads)" : ""));
     }
     return r;
 }
+
+/// SIGINT while a run is on the main thread: the CLI's handling (frame_feed.cpp) for as long
+/// as the run lasts. The handler asks the library to stop (stop.hpp), which the stages check
+/// mid-frame; the run then ends as "signal" with its outputs complete, and KeyboardInterrupt
+/// is raised once summary.json is written. Python's own handler cannot do this: it runs only
+/// when the main thread runs Python, which it does not until the run returns.
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_interrupt(int) {
+    g_interrupted = 1;
+    request_stop();
+}
+
+class InterruptScope {
+public:
+    /// Takes SIGINT over only where Python would raise KeyboardInterrupt for it: on the main
+    /// thread, with the default handler (signal.default_int_handler) in place. GIL held.
+    InterruptScope() {
+        const py::module_ threading = py::module_::import("threading");
+        const py::module_ signal = py::module_::import("signal");
+        if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return;
+        if (!signal.attr("getsignal")(SIGINT).is(signal.attr("default_int_handler"))) return;
+        g_interrupted = 0;
+        clear_stop_request();
+        struct sigaction sa {};
+        sa.sa_handler = on_interrupt;
+        sigemptyset(&sa.sa_mask);
+        sa.sa_flags = SA_RESETHAND;  // as the command: a second Ctrl-C ends the process at once
+        installed_ = sigaction(SIGINT, &sa, &previous_) == 0;
+    }
+    ~InterruptScope() {
+        if (!installed_) return;
+        sigaction(SIGINT, &previous_, nullptr);  // Python's handler again
+        if (g_interrupted) clear_stop_request();  // later runs and pipelines start afresh
+    }
+    InterruptScope(const InterruptScope&) = delete;
+    InterruptScope& operator=(const InterruptScope&) = delete;
+
+    bool interrupted() const { return installed_ && g_interrupted; }
+
+private:
+    bool installed_ = false;
+    struct sigaction previous_ {};
+};
+
+/// Between frames, at most every 50 ms: Python's pending signals, with the GIL taken back
+/// for the check. A handler that raises (SIGINT where InterruptScope did not take it over, or
+/// a handler of the caller's) ends the run as "signal"; its exception is raised after it.
+class SignalPoll {
+public:
+    bool operator()() {
+        const auto now = std::chrono::steady_clock::now();
+        if (now < next_) return false;
+        next_ = now + std::chrono::milliseconds(50);
+        py::gil_scoped_acquire gil;
+        if (PyErr_CheckSignals() == 0) return false;
+        PyObject *type = nullptr, *value = nullptr, *trace = nullptr;
+        PyErr_Fetch(&type, &value, &trace);
+        type_ = py::reinterpret_steal<py::object>(type);
+        value_ = py::reinterpret_steal<py::object>(value);
+        trace_ = py::reinterpret_steal<py::object>(trace);
+        return true;
+    }
+    /// Raises the handler's exception, if one ended the run. GIL held.
+    void rethrow() {
+        if (!type_) return;
+        PyErr_Restore(type_.release().ptr(), value_.release().ptr(), trace_.release().ptr());
+        throw py::error_already_set();
+    }
+
+private:
+    std::chrono::steady_clock::time_point next_{};
+    py::object type_, value_, trace_;
+};
 
 }  // namespace
 
 void bind_run(py::module_& m) {
     m.def(
         "_run",
-        [](const std::string& input, const std::string& out, const py::dict& options) {
-            const RunOptions r = run_options(input, out, options.attr("copy")());  // a copy to consume
+        [](const py::object& input, const py::object& out, const py::dict& options) {
+            RunOptions r = run_options(to_path(input, "input"), to_path(out, "out"),
+                                       options.attr("copy")());  // a copy to consume
+            const InterruptScope interrupt;
+            SignalPoll poll;
+            r.stop = [&interrupt, &poll] { return interrupt.interrupted() || poll(); };
             RunSummary s;
             {
                 py::gil_scoped_release release;
                 s = run_sequence(r);
+            }
+            poll.rethrow();
+            if (interrupt.interrupted()) {
+                PyErr_SetNone(PyExc_KeyboardInterrupt);
+                throw py::error_already_set();
             }
             return py::dict(py::arg("frames") = s.frames, py::arg("stopped_by") = s.stopped_by,
                             py::arg("ms_per_frame_median") = s.ms_per_frame_median,
@@ -148,6 +183,12 @@ void bind_run(py::module_& m) {
                             py::arg("peak_rss_mb") = s.peak_rss_mb);
         },
         py::arg("input"), py::arg("out"), py::arg("options"));
+    m.def("_request_stop", &request_stop,
+          "Asks every wul3d.run and Pipeline.process running now or later in this process to "
+          "stop (the library's stop request, stop.hpp): a run ends as \"signal\" with its "
+          "outputs complete. For a caller that handles its signals itself (the batch's worker "
+          "threads, which SIGINT does not reach); withdraw it with _clear_stop_request.");
+    m.def("_clear_stop_request", &clear_stop_request, "Withdraws _request_stop's request.");
     m.def(
         "_check_run_options",
         [](const py::dict& options) { run_options("", "", options.attr("copy")()); },

@@ -22,6 +22,8 @@ Contents:
     wul3d.batch   many sequences on Dask (python3 -m wul3d.batch)
 """
 
+import operator
+import os
 from collections.abc import Iterator, Sequence
 
 from ._wul3d import (  # noqa: F401  (re-exported)
@@ -32,9 +34,11 @@ from ._wul3d import (  # noqa: F401  (re-exported)
     IoError,
     Pipeline,
     Result,
+    get_max_pixels,
     get_num_threads,
     read_color_image,
     read_label_image,
+    set_max_pixels,
     set_num_threads,
 )
 from . import _wul3d
@@ -42,8 +46,8 @@ from ._wul3d import __version__  # noqa: F401  (CMake's project(VERSION))
 
 __all__ = [
     "Frame", "InputError", "Instance", "Intrinsics", "IoError", "Pipeline", "Result",
-    "Reader", "evaluate", "get_num_threads", "read", "read_color_image", "read_label_image",
-    "run", "set_num_threads",
+    "Reader", "evaluate", "get_max_pixels", "get_num_threads", "read", "read_color_image",
+    "read_label_image", "run", "set_max_pixels", "set_num_threads",
 ]
 
 
@@ -55,9 +59,9 @@ class Reader(Sequence):
 
     def __init__(self, path, format="auto", tum_camera="", intrinsics=None, calibration="",
                  registration="depth-to-color"):
-        self.path = str(path)
-        self._reader = _wul3d._Reader(self.path, format, tum_camera, intrinsics, calibration,
+        self._reader = _wul3d._Reader(path, format, tum_camera, intrinsics, calibration,
                                       registration)
+        self.path = os.fsdecode(path)
 
     @property
     def format(self) -> str:
@@ -70,7 +74,10 @@ class Reader(Sequence):
     def __getitem__(self, index):
         if isinstance(index, slice):
             return [self._reader[i] for i in range(*index.indices(len(self)))]
-        return self._reader[index]
+        i = operator.index(index)  # TypeError for a non-int, as a list
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"frame index {i} out of range ({len(self)} frames)")
+        return self._reader[i]
 
     def __iter__(self) -> Iterator[Frame]:
         for i in range(len(self)):
@@ -96,7 +103,9 @@ def read(path, format="auto", tum_camera="", intrinsics=None, calibration="",
         registration: "depth-to-color" or "color-to-depth" (unregistered input).
 
     Frames of unregistered input come back registered. Raises wul3d.InputError (a
-    ValueError) for a missing path or an empty sequence, ValueError for a bad option.
+    ValueError) for a missing path, an empty sequence or an image past wul3d.set_max_pixels,
+    ValueError for a bad option, TypeError for an option of the wrong type. One reader may
+    be shared by threads (they take turns).
     """
     return Reader(path, format, tum_camera, intrinsics, calibration, registration)
 
@@ -151,9 +160,13 @@ def run(input, out, **options) -> dict:
         dict: frames, stopped_by, ms_per_frame_median, fps, wall_s, peak_rss_mb (as in
         summary.json). The GIL is released while it runs.
 
-    Raises ValueError (parameters), wul3d.InputError (input), wul3d.IoError (output),
-    TypeError (an unknown option).
+    Ctrl-C stops the run within a second, even mid-frame: the frames before are complete,
+    OUT/summary.json says "stopped_by": "signal", then KeyboardInterrupt is raised.
+
+    Raises ValueError (parameters, select out of range), wul3d.InputError (input; OUT equal
+    to, inside or holding the input), wul3d.IoError (output), TypeError (an unknown option,
+    a value of the wrong type; the message names it).
     """
     if not hasattr(_wul3d, "_run"):
         raise NotImplementedError("wul3d.run: this build's library has no run loop")
-    return _wul3d._run(str(input), str(out), dict(options))
+    return _wul3d._run(input, out, dict(options))
