@@ -327,7 +327,15 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
         s.stopped_by = "error";
         s.error = e.what();
     }
-    obs.frames_done();
+    try {
+        obs.frames_done();  // e.g. a video that cannot be finished: an error like a frame's
+    } catch (const std::exception& e) {
+        if (!failed) {
+            failed = std::current_exception();
+            s.stopped_by = "error";
+            s.error = e.what();
+        }
+    }
 
     s.ms_per_frame_median = log.compute_ms.median();
     s.fps = s.ms_per_frame_median > 0 ? 1000.0 / s.ms_per_frame_median : 0.0;

@@ -22,6 +22,7 @@
 #include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
 #include "wul3d/threads.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace {
@@ -232,6 +233,7 @@ void run(const BenchOptions& o) {
         }
     }
     open_source(o.input, SourceOptions{});  // a bad input fails here, once, with its message
+    if (!o.csv.empty()) check_write_target(o.csv, WriteTarget::File, {o.input}, "--csv");
     const std::string header = "k,width,height,points,fps_median,ms_median,peak_rss_mb";
     std::vector<std::string> rows;
     std::cout << header << std::endl;

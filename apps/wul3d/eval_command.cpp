@@ -18,6 +18,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/eval.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace fs = std::filesystem;
@@ -148,6 +149,8 @@ void run(const EvalOptions& o) {
         throw ParamError("--gt-background-max " + std::to_string(o.gt_background_max) +
                          ": must be in [0, 65535]");
     const std::vector<FramePair> frames = pair_frames(o);
+    // Before scoring: a refused --json costs no time, and replaces no prediction or label.
+    if (!o.json.empty()) check_write_target(o.json, WriteTarget::File, {o.pred, o.gt}, "--json");
 
     std::optional<SequenceScorer> sequence;
     if (o.temporal) sequence.emplace(params);

@@ -1,7 +1,9 @@
 #include "pipeline_options.hpp"
 
+#include <cstdlib>
 #include <sstream>
 
+#include "wul3d/capture.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/segmentation.hpp"
 #include "wul3d/threads.hpp"
@@ -145,6 +147,19 @@ std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o) {
 
 void apply_threads(const PipelineOptions& o) {
     if (o.threads > 0) wul3d::set_num_threads(o.threads);
+}
+
+std::vector<std::string> input_paths(const PipelineOptions& o) {
+    std::vector<std::string> inputs;
+    if (!o.input.empty()) inputs.push_back(o.input);
+    if (!o.calibration.empty() && o.calibration != "kinect_v2") inputs.push_back(o.calibration);
+    if (!o.camera.empty()) {
+        const CameraSpec spec = parse_camera_spec(o.camera);
+        if (spec.backend == "openni2" && !spec.arg.empty()) inputs.push_back(spec.arg);
+        const char* fake = std::getenv("FAKENECT_PATH");
+        if (spec.backend == "freenect" && fake && *fake) inputs.emplace_back(fake);
+    }
+    return inputs;
 }
 
 }  // namespace wul3d::cli

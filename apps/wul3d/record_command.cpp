@@ -14,6 +14,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace fs = std::filesystem;
@@ -29,6 +30,8 @@ struct RecordOptions {
 
 void record(const RecordOptions& o) {
     if (o.input.camera.empty()) throw ParamError("record: --camera is required");
+    // Before the camera opens: a replay's own file or dump is never recorded over.
+    check_write_target(o.out_dir, WriteTarget::Folder, input_paths(o.input), "--out");
     install_stop_signals();
     FrameFeed feed(feed_options(o.input, SourceOptions{}), stop_requested);
     std::error_code ec;

@@ -1,0 +1,243 @@
+// The command line's other ways to write and to fail (issue 46): every flag that names an
+// output goes through the write guard (write_guard.hpp) against the command's own inputs; a
+// --video that cannot be written is refused before the first frame, or ends the run with its
+// summary.json; limits of threads, label counts and resolutions; names that are not UTF-8;
+// duplicate TUM timestamps; and the messages of bad numbers. Every command runs under
+// `timeout 60`, so a hang fails as exit 124 instead of stalling the suite.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+#include "wul3d/io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using wul3d::test::CommandResult;
+using wul3d::test::EnvChange;
+using wul3d::test::sample_dir;
+using wul3d::test::TempDir;
+
+fs::path tabletop() { return sample_dir() / "uois_tabletop"; }
+
+CommandResult run_bounded(const std::vector<std::string>& args, const std::vector<EnvChange>& env = {}) {
+    std::vector<std::string> argv = {"timeout", "60", wul3d::test::cli_path().string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return wul3d::test::run_command(argv, env);
+}
+
+std::string describe(const CommandResult& r) {
+    return "exit " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out +
+           "--- stderr ---\n" + r.err;
+}
+
+/// Exit `code` and one error line on stderr (besides "wul3d: note:" lines) holding `words`.
+void expect_one_line(const CommandResult& r, int code, const std::vector<std::string>& words) {
+    EXPECT_EQ(r.exit_code, code) << describe(r);
+    std::vector<std::string> errors;
+    std::istringstream lines(r.err);
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("wul3d: note:", 0) != 0) errors.push_back(line);
+    ASSERT_EQ(errors.size(), 1u) << describe(r);
+    for (const auto& w : words)
+        EXPECT_NE(errors[0].find(w), std::string::npos) << w << "\n" << describe(r);
+}
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_text(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+void copy_frame(const fs::path& src, const fs::path& dst) {
+    fs::create_directories(dst);
+    for (const auto& e : fs::directory_iterator(src)) fs::copy_file(e.path(), dst / e.path().filename());
+}
+
+/// Every entry under `dir` (links not followed): its kind and bytes, or a link's target.
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+    std::map<std::string, std::string> s;
+    for (auto it = fs::recursive_directory_iterator(dir); it != fs::recursive_directory_iterator(); ++it) {
+        const std::string rel = fs::relative(it->path(), dir).string();
+        const auto st = it->symlink_status();
+        if (fs::is_symlink(st)) {
+            s[rel] = "link " + fs::read_symlink(it->path()).string();
+        } else if (fs::is_directory(st)) {
+            s[rel] = "folder";
+        } else {
+            s[rel] = "file " + slurp(it->path());
+        }
+    }
+    return s;
+}
+
+nlohmann::json read_json(const fs::path& p) {
+    std::ifstream in(p);
+    return nlohmann::json::parse(in);
+}
+
+// ---- item 4: every flag that writes, against its own input ------------------------------
+
+/// A recording of two frames with a label image each, a prediction folder and a symlink to
+/// an input file, all under `tmp`/data, so that one snapshot covers every input.
+struct Inputs {
+    fs::path data, rec, frame, pred, link;
+    explicit Inputs(const TempDir& tmp)
+        : data(tmp / "data"), rec(data / "rec"), frame(rec / "image_0000"), pred(data / "pred"),
+          link(data / "link.png") {
+        for (const char* name : {"image_0000", "image_0002"}) {
+            copy_frame(tabletop() / name, rec / name);
+            wul3d::LabelImage l;
+            l.width = 640;
+            l.height = 480;
+            l.labels.assign(640 * 480, 0);
+            for (int v = 100; v < 200; ++v)
+                for (int u = 100; u < 200; ++u) l.labels[static_cast<std::size_t>(v) * 640 + u] = 1;
+            wul3d::write_label_png((rec / name / "label.png").string(), l);
+            fs::create_directories(pred / name);
+            wul3d::write_label_png((pred / name / "objects.png").string(), l);
+        }
+        fs::create_symlink(frame / "depth.png", link);
+    }
+};
+
+TEST(WritePaths, EveryFlagThatWritesRefusesItsOwnInput) {
+    TempDir tmp;
+    const Inputs in(tmp);
+    const auto before = snapshot(in.data);
+    const std::string rec = in.rec.string(), frame = in.frame.string(), pred = in.pred.string();
+    const std::string depth = (in.frame / "depth.png").string(), link = in.link.string();
+    const std::string label = (in.frame / "label.png").string();
+    const std::string out = (tmp / "out").string();
+    const std::vector<EnvChange> no_display = {{"DISPLAY", std::nullopt},
+                                               {"WAYLAND_DISPLAY", std::nullopt}};
+    struct Case {
+        std::vector<std::string> args;
+        std::string flag;  // in the error line
+        std::vector<EnvChange> env;
+    };
+    std::vector<Case> cases;
+    // The output folder of run, record and export-fakenect: the input, a folder inside it,
+    // a file of it, a link to one of its files.
+    for (const std::string& target : {rec, frame + "/out", depth, link}) {
+        cases.push_back({{"run", rec, "--out", target, "-q"}, "output folder", {}});
+        cases.push_back({{"export-fakenect", rec, target}, "DUMPDIR", {}});
+        // Under fakenect the dump is record's input: no camera is opened before the refusal.
+        cases.push_back({{"record", "--camera", "freenect", "--out", target, "-q"}, "--out",
+                         {{"FAKENECT_PATH", rec}}});
+    }
+    // The files of run --video, view --screenshot, bench --csv and eval --json: a file of
+    // the input (a name the flag would take), the input folder, a link to an input file.
+    const std::string video = frame + "/clip.mp4";
+    write_text(in.frame / "clip.mp4", "the user's video");
+    for (const std::string& target : {video, rec, link, depth}) {
+        cases.push_back({{"run", rec, "--out", out, "-q", "--video", target}, "--video", {}});
+        cases.push_back({{"view", rec, "--exit-after", "1", "--screenshot", target}, "", no_display});
+        cases.push_back({{"bench", frame, "--k", "2", "--frames", "1", "--passes", "1", "--csv", target},
+                         "--csv", {}});
+    }
+    for (const std::string& target : {label, (in.pred / "image_0000" / "objects.png").string(), rec, pred, link})
+        cases.push_back({{"eval", pred, rec, "--json", target}, "--json", {}});
+    for (const Case& c : cases) {
+        const auto snap = snapshot(in.data);
+        const CommandResult r = run_bounded(c.args, c.env);
+        std::string cmd;
+        for (const auto& a : c.args) cmd += a + " ";
+        SCOPED_TRACE(cmd);
+        // view: the guard, or a build without the viewer; either says so in one line.
+        expect_one_line(r, 2, c.flag.empty() ? std::vector<std::string>{} : std::vector<std::string>{c.flag});
+        EXPECT_TRUE(snapshot(in.data) == snap) << "the input changed";
+        EXPECT_FALSE(fs::exists(out)) << "the refused run wrote its output folder";
+        EXPECT_EQ(r.out, "") << "a refused command measured or wrote something";
+    }
+    auto expected = before;
+    expected["rec/image_0000/clip.mp4"] = "file the user's video";
+    EXPECT_TRUE(snapshot(in.data) == expected);
+}
+
+// The guard's message for a dangling symbolic link as OUT (it said "File exists", exit 1).
+TEST(WritePaths, DanglingLinkAsOutIsNamedAsSuch) {
+    TempDir tmp;
+    fs::create_directory_symlink(tmp / "gone", tmp / "out");
+    const CommandResult r =
+        run_bounded({"run", (tabletop() / "image_0000").string(), "--out", (tmp / "out").string(), "-q"});
+    expect_one_line(r, 2, {"symbolic link to nothing"});
+    EXPECT_FALSE(fs::exists(tmp / "gone"));
+}
+
+// ---- item 6: threads ---------------------------------------------------------------------
+
+// bench --threads 65536 died on signal 11 in its measuring child.
+TEST(WritePaths, BenchRefusesHugeThreadCounts) {
+    const std::string frame = (tabletop() / "image_0000").string();
+    for (const std::string t : {"65536", "1025", "-1"}) {
+        CommandResult r = run_bounded({"bench", frame, "--k", "2", "--frames", "1", "--passes", "1",
+                                       "--threads", t});
+        expect_one_line(r, 2, {"--threads", t});
+        EXPECT_EQ(r.out, "");
+        // The measuring child's own command line (bench --single-k) has the same bound.
+        r = run_bounded({"bench", frame, "--single-k", "2", "--frames", "1", "--passes", "1",
+                         "--threads", t});
+        expect_one_line(r, 2, {"--threads", t});
+    }
+}
+
+// ---- item 11: a --video that cannot be written ----------------------------------------------
+
+TEST(WritePaths, VideoThatCannotBeWrittenIsRefusedBeforeTheFirstFrame) {
+    TempDir tmp;
+    const std::string in = (tabletop() / "image_0000").string();
+    fs::create_directories(tmp / "folder.mp4");
+    fs::create_symlink("/dev/full", tmp / "full.mp4");
+    ASSERT_EQ(::mkfifo((tmp / "fifo.mp4").c_str(), 0600), 0);
+    for (const std::string& video :
+         {(tmp / "clip.xyz").string(), (tmp / "noext").string(), (tmp / "folder.mp4").string(),
+          (tmp / "full.mp4").string(), (tmp / "fifo.mp4").string(), std::string("/dev/full")}) {
+        const CommandResult r =
+            run_bounded({"run", in, "--out", (tmp / "out").string(), "-q", "--video", video});
+        expect_one_line(r, 2, {"--video", video});
+        EXPECT_FALSE(fs::exists(tmp / "out")) << video;
+    }
+    EXPECT_FALSE(fs::exists(tmp / "clip.xyz"));
+}
+
+TEST(WritePaths, VideoFailingMidRunLeavesTheSummary) {
+    // 1x1 frames have no video frame (H.264 wants even sizes of at least 2): known only
+    // at the first frame. Before: exit 1 with "no frame was written", and no summary.json.
+    TempDir tmp;
+    const fs::path frame = tmp / "tiny" / "f";
+    fs::create_directories(frame);
+    wul3d::DepthImage d;
+    d.width = d.height = 1;
+    d.data = {1000};
+    wul3d::write_depth_png((frame / "depth.png").string(), d);
+    write_text(frame / "intrinsics.json",
+               R"({"fx": 1, "fy": 1, "cx": 0, "cy": 0, "width": 1, "height": 1, "depth_scale_m_per_unit": 0.001})");
+    const fs::path out = tmp / "out";
+    const CommandResult r = run_bounded({"run", (tmp / "tiny").string(), "--out", out.string(), "-q",
+                                         "--k", "1", "--min-points", "1", "--decimate", "1",
+                                         "--video", (tmp / "v.mp4").string()});
+    expect_one_line(r, 2, {"v.mp4", "1x1"});
+    ASSERT_TRUE(fs::is_regular_file(out / "summary.json")) << describe(r);
+    const nlohmann::json summary = read_json(out / "summary.json");
+    EXPECT_EQ(summary["stopped_by"], "error");
+    EXPECT_NE(summary["error"].get<std::string>().find("1x1"), std::string::npos);
+    EXPECT_FALSE(fs::exists(tmp / "v.mp4"));
+    for (const auto& e : fs::directory_iterator(tmp.path()))
+        EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
+}
+
+}  // namespace
