@@ -240,4 +240,84 @@ TEST(WritePaths, VideoFailingMidRunLeavesTheSummary) {
         EXPECT_EQ(e.path().filename().string().find(".partial"), std::string::npos) << e.path();
 }
 
+// ---- item 10: label counts and resolutions, bounded before allocation ---------------------
+
+/// `n` objects of 2 x 2 pixels, ids first_id.. (wrapping within 1..65535), on a 400-wide
+/// image.
+wul3d::LabelImage blocks(int n, int first_id) {
+    wul3d::LabelImage l;
+    l.width = 400;
+    l.height = 2 * ((n + 199) / 200);
+    l.labels.assign(static_cast<std::size_t>(l.width) * l.height, 0);
+    for (int i = 0; i < n; ++i) {
+        const int u = 2 * (i % 200), v = 2 * (i / 200);
+        const auto id = static_cast<std::uint16_t>((first_id - 1 + i) % 65535 + 1);
+        for (int dv = 0; dv < 2; ++dv)
+            for (int du = 0; du < 2; ++du)
+                l.labels[static_cast<std::size_t>(v + dv) * l.width + u + du] = id;
+    }
+    return l;
+}
+
+// 20,000 ids took 56 s and 12.5 GB (a table of every pair), 65,535 ended in bad_alloc.
+TEST(WritePaths, EvalOfTensOfThousandsOfObjectsIsQuick) {
+    for (const int n : {20000, 65535}) {
+        TempDir tmp;
+        fs::create_directories(tmp / "gt" / "f");
+        fs::create_directories(tmp / "pred" / "f");
+        wul3d::write_label_png((tmp / "gt" / "f" / "label.png").string(), blocks(n, 1));
+        wul3d::write_label_png((tmp / "pred" / "f" / "objects.png").string(), blocks(n, 7));
+        const auto t0 = std::chrono::steady_clock::now();
+        const CommandResult r = run_bounded({"eval", (tmp / "pred").string(), (tmp / "gt").string(),
+                                             "--json", (tmp / "e.json").string()});
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        ASSERT_EQ(r.exit_code, 0) << n << "\n" << describe(r);
+        EXPECT_LT(s, 20.0) << n << " objects";  // about 0.3 s; 56 s before
+        EXPECT_NE(r.out.find("Overlap F   100.0\n"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("Boundary F  100.0\n"), std::string::npos) << r.out;
+        const nlohmann::json j = read_json(tmp / "e.json");
+        EXPECT_EQ(j["summary"]["gt_objects"], n);
+        EXPECT_EQ(j["images"][0]["matches"].size(), static_cast<std::size_t>(n));
+    }
+}
+
+TEST(WritePaths, EvalRefusesATangleTooLargeToMatchNamingTheFile) {
+    // 1200 vertical stripes against 1200 horizontal ones: every pair overlaps, one group of
+    // 1.44 million pairs, more than the matching takes.
+    TempDir tmp;
+    wul3d::LabelImage v, h;
+    v.width = h.width = v.height = h.height = 1200;
+    v.labels.resize(1200 * 1200);
+    h.labels.resize(1200 * 1200);
+    for (int y = 0; y < 1200; ++y)
+        for (int x = 0; x < 1200; ++x) {
+            v.labels[static_cast<std::size_t>(y) * 1200 + x] = static_cast<std::uint16_t>(x + 1);
+            h.labels[static_cast<std::size_t>(y) * 1200 + x] = static_cast<std::uint16_t>(y + 1);
+        }
+    fs::create_directories(tmp / "gt" / "f");
+    fs::create_directories(tmp / "pred" / "f");
+    wul3d::write_label_png((tmp / "gt" / "f" / "label.png").string(), v);
+    wul3d::write_label_png((tmp / "pred" / "f" / "objects.png").string(), h);
+    const CommandResult r = run_bounded({"eval", (tmp / "pred").string(), (tmp / "gt").string(),
+                                         "--max-pixels", "2000000"});
+    expect_one_line(r, 2, {(tmp / "gt" / "f" / "label.png").string(), "1200 x 1200",
+                           "more than eval matches"});
+}
+
+// 99999x99999 allocated for 57 s, then bad_alloc.
+TEST(WritePaths, BenchResolutionWithinTheImageLimit) {
+    const std::string frame = (tabletop() / "image_0000").string();
+    for (const std::vector<std::string>& extra :
+         {std::vector<std::string>{"--resolution", "99999x99999"},
+          {"--resolution", "4097x4097"},
+          {"--resolution", "70000x2"},
+          {"--resolution", "640x480", "--max-pixels", "300000"}}) {
+        std::vector<std::string> args = {"bench", frame, "--k", "2", "--frames", "1", "--passes", "1"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const CommandResult r = run_bounded(args);
+        expect_one_line(r, 2, {"--resolution", "--max-pixels"});
+        EXPECT_EQ(r.out, "");
+    }
+}
+
 }  // namespace

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "pipeline_options.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
@@ -48,7 +50,8 @@ int decimation_of(const BenchOptions& o) {
     return o.pipeline == "objects" ? PipelineParams{}.decimation : 1;
 }
 
-/// "native" or "WxH".
+/// "native" or "WxH", within the readers' image limit (--max-pixels, io.hpp): checked
+/// before anything is allocated (99999x99999 allocated for a minute, then bad_alloc).
 void parse_resolution(const std::string& text, int& w, int& h) {
     w = h = 0;
     if (text == "native") return;
@@ -56,6 +59,13 @@ void parse_resolution(const std::string& text, int& w, int& h) {
     std::istringstream in(text);
     if (!(in >> w >> x >> h) || x != 'x' || w <= 0 || h <= 0 || !in.eof())
         throw ParamError("--resolution '" + text + "': expected native or WxH, e.g. 1920x1080");
+    const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    if (static_cast<std::uint64_t>(w) > kMaxImageSide ||
+        static_cast<std::uint64_t>(h) > kMaxImageSide || pixels > max_image_pixels())
+        throw ParamError("--resolution '" + text + "': " + std::to_string(pixels) +
+                         " pixels, more than the largest image (--max-pixels " +
+                         std::to_string(max_image_pixels()) + ", sides at most " +
+                         std::to_string(kMaxImageSide) + ")");
 }
 
 /// Nearest-neighbour resampling of a registered frame to w x h, intrinsics scaled per axis:
@@ -169,7 +179,8 @@ std::string run_child(const BenchOptions& o, int k) {
                                          std::to_string(o.frames), "--passes",
                                          std::to_string(o.passes), "--pipeline", o.pipeline,
                                          "--threads", std::to_string(o.threads),
-                                         "--decimate", std::to_string(decimation_of(o))};
+                                         "--decimate", std::to_string(decimation_of(o)),
+                                         "--max-pixels", std::to_string(max_image_pixels())};
         if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
@@ -278,6 +289,7 @@ void add_bench_command(CLI::App& app) {
                     "Run the stages on every N-th pixel in u and v, results at the input's size "
                     "(default: 2 with --pipeline objects, 1 with paper)")
         ->check(CLI::Range(1, 8));
+    add_max_pixels_option(cmd);
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");
     cmd->callback([opts]() { run(*opts); });

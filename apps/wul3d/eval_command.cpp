@@ -179,7 +179,7 @@ void run(const EvalOptions& o) {
         try {
             s = sequence ? sequence->add(pred, gt) : score_image(pred, gt, params);
         } catch (const InputError& e) {
-            throw InputError(f.name + ": " + e.what());
+            throw InputError(f.name + " (" + f.gt.string() + "): " + e.what());
         }
         if (o.per_image)
             std::cout << f.name << ": overlap P/R/F " << pct(s.overlap_p) << " "
