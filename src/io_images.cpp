@@ -24,6 +24,7 @@
 #include <stdexcept>
 
 #include "io_detail.hpp"
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/output.hpp"
@@ -839,7 +840,7 @@ void write_calibration_json(const std::string& path, const StereoCalibration& ca
     j["color"] = intrinsics_to_json(calib.color);
     j["depth_to_color"] = {{"rotation", calib.rotation}, {"translation_m", calib.translation_m}};
     j["depth_scale_m_per_unit"] = float_for_json(calib.depth_scale_m_per_unit);
-    write_text_file(path, j.dump(2) + "\n");
+    write_text_file(path, json_text(j, 2) + "\n");
 }
 
 // ---- outputs ------------------------------------------------------------------------

@@ -16,6 +16,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/objects.hpp"
@@ -153,7 +154,7 @@ public:
     FramesLog& operator=(const FramesLog&) = delete;
 
     void append(const nlohmann::json& line) {
-        const std::string text = line.dump() + "\n";
+        const std::string text = json_text(line) + "\n";
         std::size_t done = 0;
         while (done < text.size()) {
             const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
@@ -350,7 +351,7 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     }
     try {
         write_text_file((out_dir / kSummaryFile).string(),
-                        summary_json(o, feed, s, log, selection).dump(2) + "\n");
+                        json_text(summary_json(o, feed, s, log, selection), 2) + "\n");
     } catch (const std::exception&) {
         if (!failed) throw;  // the first error is the one to report (a full disk, twice)
     }

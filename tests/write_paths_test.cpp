@@ -320,4 +320,49 @@ TEST(WritePaths, BenchResolutionWithinTheImageLimit) {
     }
 }
 
+// ---- item 12: names that are not UTF-8 -----------------------------------------------------
+
+/// Every line of OUT/frames.jsonl, parsed (a line that is not valid UTF-8 JSON fails).
+std::vector<nlohmann::json> frames_lines(const fs::path& out) {
+    std::vector<nlohmann::json> lines;
+    std::ifstream in(out / "frames.jsonl");
+    for (std::string line; std::getline(in, line);) lines.push_back(nlohmann::json::parse(line));
+    return lines;
+}
+
+// A frame folder named "\xff\xfe" was written without its frames.jsonl line, and the run
+// ended with exit 1 and a raw json.exception.type_error.316; the same byte in the input path
+// left no summary.json.
+TEST(WritePaths, NamesThatAreNotUtf8AreWrittenAsValidJson) {
+    TempDir tmp;
+    const std::string bad = "\xff\xfe";
+    copy_frame(tabletop() / "image_0000", tmp / "seq" / bad);
+    copy_frame(tabletop() / "image_0002", tmp / "seq" / "b");
+    CommandResult r = run_bounded({"run", (tmp / "seq").string(), "--out", (tmp / "out").string(), "-q"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_TRUE(fs::is_regular_file(tmp / "out" / bad / "objects.json"));
+    const auto lines = frames_lines(tmp / "out");
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_EQ(lines[0]["name"], "b");
+    EXPECT_EQ(lines[1]["name"], "\xEF\xBF\xBD\xEF\xBF\xBD");  // U+FFFD for each byte
+    EXPECT_EQ(read_json(tmp / "out" / "summary.json")["frames"], 2);
+
+    const fs::path odd_input = tmp / ("in" + bad + "put");
+    copy_frame(tabletop() / "image_0000", odd_input / "a");
+    r = run_bounded({"run", odd_input.string(), "--out", (tmp / "out2").string(), "-q"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    const nlohmann::json summary = read_json(tmp / "out2" / "summary.json");
+    EXPECT_EQ(summary["stopped_by"], "end");
+    EXPECT_NE(summary["input"].get<std::string>().find("in\xEF\xBF\xBD\xEF\xBF\xBDput"), std::string::npos);
+    EXPECT_EQ(frames_lines(tmp / "out2").size(), 1u);
+
+    // eval --json names the frames and the files.
+    fs::create_directories(tmp / "gt" / bad);
+    fs::copy_file(tmp / "out" / bad / "objects.png", tmp / "gt" / bad / "label.png");
+    r = run_bounded({"eval", (tmp / "out").string(), (tmp / "gt").string(), "--json",
+                     (tmp / "e.json").string()});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_EQ(read_json(tmp / "e.json")["images"][0]["name"], "\xEF\xBF\xBD\xEF\xBF\xBD");
+}
+
 }  // namespace

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "json_text.hpp"
 #include "pipeline_options.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/eval.hpp"
@@ -259,7 +260,7 @@ void run(const EvalOptions& o) {
                            {"objects", objs}};
     }
     out["images"] = images;
-    if (!o.json.empty()) write_text_file(o.json, out.dump(2) + "\n");
+    if (!o.json.empty()) write_text_file(o.json, json_text(out, 2) + "\n");
     std::cout << std::flush;
 }
 

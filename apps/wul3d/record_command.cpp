@@ -11,6 +11,7 @@
 
 #include "cli.hpp"
 #include "frame_feed.hpp"
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/registration.hpp"
@@ -68,7 +69,7 @@ void record(const RecordOptions& o) {
                               {"frames_captured", feed.captured()},
                               {"frames_dropped", feed.dropped()},
                               {"stopped_by", stopped_by}};
-    write_text_file((fs::path(o.out_dir) / "recording.json").string(), j.dump(2) + "\n");
+    write_text_file((fs::path(o.out_dir) / "recording.json").string(), json_text(j, 2) + "\n");
     std::cout << "wul3d: recorded " << written << " frames (" << feed.dropped()
               << " dropped) from " << feed.description() << " -> " << o.out_dir << std::endl;
     restore_signals();
