@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+#include <unordered_map>
 
 #include "io_detail.hpp"
 #include "wul3d/error.hpp"
@@ -245,6 +247,7 @@ struct Stamped {
     double t = 0;
     std::string stamp;  ///< as written in the file: the frame name
     std::string file;   ///< relative to the sequence folder
+    int line = 0;       ///< in its list
 };
 
 /// `rgb.txt` / `depth.txt`: "timestamp filename" lines, '#' comments, blank lines skipped.
@@ -266,9 +269,24 @@ std::vector<Stamped> read_tum_list(const fs::path& file) {
             throw InputError(path + ":" + std::to_string(lineno) +
                              ": expected 'timestamp filename', got '" + line + "'");
         }
+        s.line = lineno;
         list.push_back(std::move(s));
     }
     return list;
+}
+
+/// Refuses two depth frames of one timestamp: both would be the frame of that name (OUT/<t>/),
+/// the second replacing the first unseen.
+void check_unique_stamps(const fs::path& file, const std::vector<Stamped>& list) {
+    std::unordered_map<std::string_view, int> first_line;
+    first_line.reserve(list.size());
+    for (const Stamped& s : list) {
+        const auto [it, added] = first_line.emplace(s.stamp, s.line);
+        if (!added)
+            throw InputError(file.string() + ":" + std::to_string(s.line) + ": timestamp " +
+                             s.stamp + " again (first on line " + std::to_string(it->second) +
+                             "): two frames of one name; remove one of them");
+    }
 }
 
 struct TumPair {
@@ -357,6 +375,7 @@ std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& r
     }
     std::vector<Stamped> rgb = read_tum_list(root / "rgb.txt");
     std::vector<Stamped> depth = read_tum_list(root / "depth.txt");
+    check_unique_stamps(root / "depth.txt", depth);
     if (depth.empty()) throw InputError(path + ": no frames found (depth.txt lists none)");
     std::vector<TumPair> pairs = associate(root, std::move(depth), std::move(rgb), options.tum_max_dt_s);
     if (pairs.empty()) {

@@ -365,4 +365,25 @@ TEST(WritePaths, NamesThatAreNotUtf8AreWrittenAsValidJson) {
     EXPECT_EQ(read_json(tmp / "e.json")["images"][0]["name"], "\xEF\xBF\xBD\xEF\xBF\xBD");
 }
 
+// ---- item 15: duplicate TUM timestamps ------------------------------------------------------
+
+// Two depth frames of one timestamp were two frames of one name: the second replaced the
+// first's folder, exit 0.
+TEST(WritePaths, DuplicateTumTimestampIsRefused) {
+    TempDir tmp;
+    const fs::path seq = tmp / "tum";
+    fs::create_directories(seq / "rgb");
+    fs::create_directories(seq / "depth");
+    for (const char* n : {"1", "2"}) {
+        fs::copy_file(tabletop() / "image_0000" / "color.png", seq / "rgb" / (std::string(n) + ".png"));
+        fs::copy_file(tabletop() / "image_0000" / "depth.png", seq / "depth" / (std::string(n) + ".png"));
+    }
+    write_text(seq / "rgb.txt", "1.0 rgb/1.png\n1.01 rgb/2.png\n");
+    write_text(seq / "depth.txt", "# depth\n1.0 depth/1.png\n1.0 depth/2.png\n");
+    const CommandResult r = run_bounded({"run", seq.string(), "--out", (tmp / "out").string(), "-q",
+                                         "--tum-camera", "kinect_v1"});
+    expect_one_line(r, 2, {(seq / "depth.txt").string() + ":3", "timestamp 1.0", "line 2"});
+    EXPECT_FALSE(fs::exists(tmp / "out"));
+}
+
 }  // namespace
