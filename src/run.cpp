@@ -300,6 +300,10 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
             } catch (const Stopped&) {  // SIGINT/SIGTERM mid-frame: this frame is not written
                 s.stopped_by = "signal";
                 break;
+            } catch (const InputError& e) {  // each line names its frame ("k = 7 is larger...")
+                const std::string what = e.what();
+                if (what.rfind(name + ": ", 0) == 0) throw;
+                throw InputError(name + ": " + what);
             }
             const FrameResult& r = *result;
             const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;

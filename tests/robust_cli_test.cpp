@@ -8,7 +8,6 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <array>
 #include <chrono>
@@ -33,6 +32,7 @@ using wul3d::test::CommandResult;
 using wul3d::test::run_command;
 using wul3d::test::sample_dir;
 using wul3d::test::TempDir;
+using wul3d::test::bomb_png;
 
 fs::path tabletop_frame() { return sample_dir() / "uois_tabletop" / "image_0000"; }
 
@@ -67,37 +67,6 @@ void copy_frame(const fs::path& src, const fs::path& dst) {
 
 void write_text(const fs::path& p, const std::string& text) {
     std::ofstream(p, std::ios::binary) << text;
-}
-
-// ---- a PNG that declares a huge image in a few hundred bytes -----------------------------
-
-void put32(std::string& s, std::uint32_t v) {
-    for (int shift = 24; shift >= 0; shift -= 8) s.push_back(static_cast<char>((v >> shift) & 0xff));
-}
-
-void chunk(std::string& png, const char* type, const std::string& data) {
-    put32(png, static_cast<std::uint32_t>(data.size()));
-    std::string body = std::string(type, 4) + data;
-    png += body;
-    put32(png, static_cast<std::uint32_t>(
-                   crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
-}
-
-/// A valid-looking 16-bit grey PNG of width x height whose pixel data is a few zero rows.
-std::string bomb_png(std::uint32_t width, std::uint32_t height) {
-    std::string png = "\x89PNG\r\n\x1a\n";
-    std::string ihdr;
-    put32(ihdr, width);
-    put32(ihdr, height);
-    ihdr += std::string("\x10\x00\x00\x00\x00", 5);  // 16-bit grey, no interlace
-    chunk(png, "IHDR", ihdr);
-    std::string raw(2 * std::size_t{width} + 1, '\0');  // one zero row
-    std::vector<Bytef> z(compressBound(static_cast<uLong>(raw.size())));
-    uLongf n = static_cast<uLongf>(z.size());
-    compress(z.data(), &n, reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()));
-    chunk(png, "IDAT", std::string(reinterpret_cast<const char*>(z.data()), n));
-    chunk(png, "IEND", "");
-    return png;
 }
 
 // ---- regular files only --------------------------------------------------------------------

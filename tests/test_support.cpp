@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <fcntl.h>
@@ -91,6 +92,38 @@ std::vector<std::string> list_files(const fs::path& dir) {
         if (e.is_regular_file()) files.push_back(fs::relative(e.path(), dir).string());
     std::sort(files.begin(), files.end());
     return files;
+}
+
+namespace {
+
+void put32(std::string& s, std::uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8) s.push_back(static_cast<char>((v >> shift) & 0xff));
+}
+
+void chunk(std::string& png, const char* type, const std::string& data) {
+    put32(png, static_cast<std::uint32_t>(data.size()));
+    std::string body = std::string(type, 4) + data;
+    png += body;
+    put32(png, static_cast<std::uint32_t>(
+                   crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
+}
+
+}  // namespace
+
+std::string bomb_png(std::uint32_t width, std::uint32_t height) {
+    std::string png = "\x89PNG\r\n\x1a\n";
+    std::string ihdr;
+    put32(ihdr, width);
+    put32(ihdr, height);
+    ihdr += std::string("\x10\x00\x00\x00\x00", 5);  // 16-bit grey, no interlace
+    chunk(png, "IHDR", ihdr);
+    std::string raw(2 * std::size_t{width} + 1, '\0');  // one zero row
+    std::vector<Bytef> z(compressBound(static_cast<uLong>(raw.size())));
+    uLongf n = static_cast<uLongf>(z.size());
+    compress(z.data(), &n, reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()));
+    chunk(png, "IDAT", std::string(reinterpret_cast<const char*>(z.data()), n));
+    chunk(png, "IEND", "");
+    return png;
 }
 
 }  // namespace wul3d::test

@@ -1,6 +1,7 @@
 #pragma once
 // Shared helpers of the test suite: where the shipped samples are, temporary folders, and
 // running the wul3d command.
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -43,6 +44,11 @@ CommandResult run_command(const std::vector<std::string>& argv,
 
 /// Runs the wul3d command with `args` (no shell quoting needed), stdin from /dev/null.
 CommandResult run_cli(const std::vector<std::string>& args);
+
+/// A valid-looking 16-bit grey PNG of width x height whose pixel data is one zero row: a
+/// decompression bomb of a few hundred bytes, refused from its header or costing the whole
+/// image once decoded.
+std::string bomb_png(std::uint32_t width, std::uint32_t height);
 
 /// Every regular file under `dir`, relative paths, sorted.
 std::vector<std::string> list_files(const std::filesystem::path& dir);

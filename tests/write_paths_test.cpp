@@ -14,9 +14,11 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "test_support.hpp"
@@ -384,6 +386,93 @@ TEST(WritePaths, DuplicateTumTimestampIsRefused) {
                                          "--tum-camera", "kinect_v1"});
     expect_one_line(r, 2, {(seq / "depth.txt").string() + ":3", "timestamp 1.0", "line 2"});
     EXPECT_FALSE(fs::exists(tmp / "out"));
+}
+
+// ---- item 17: messages -------------------------------------------------------------------
+
+TEST(WritePaths, DepthScaleIsPrintedShort) {
+    // std::to_string printed 1e300 as 301 digits and 1e-300 as 0.000000.
+    TempDir tmp;
+    const fs::path frame = tmp / "f";
+    copy_frame(tabletop() / "image_0000", frame);
+    for (const auto& [value, shown] : std::vector<std::pair<std::string, std::string>>{
+             {"1e300", "1e+300"}, {"1e-300", "1e-300"}, {"2", "= 2:"}}) {
+        write_text(frame / "intrinsics.json",
+                   R"({"fx": 600, "fy": 600, "cx": 320, "cy": 240, "width": 640, "height": 480, "depth_scale_m_per_unit": )" +
+                       value + "}");
+        const CommandResult r = run_bounded({"run", frame.string(), "--out", (tmp / "out").string(), "-q"});
+        expect_one_line(r, 2, {"depth_scale_m_per_unit", shown});
+        EXPECT_LT(r.err.size(), 200u) << r.err;
+    }
+}
+
+TEST(WritePaths, NegativeMaxPixelsIsShownAsGiven) {
+    // -1 was shown as 18446744073709551615; 0x10 was taken as 16.
+    for (const std::string n : {"-1", "0x10", "1e6", "", "2000000000"}) {
+        const CommandResult r = run_bounded({"run", (tabletop() / "image_0000").string(), "--out",
+                                             "/nonexistent/out", "-q", "--max-pixels", n});
+        expect_one_line(r, 2, {"--max-pixels '" + n + "'"});
+        EXPECT_EQ(r.err.find("18446744073709551615"), std::string::npos) << r.err;
+    }
+}
+
+TEST(WritePaths, WordsWhereANumberBelongsAreNamedAsSuch) {
+    // CLI::Range said "Value 3abc not in range 0 to 50".
+    const std::string gt = (tabletop()).string();
+    CommandResult r = run_bounded({"eval", gt, gt, "--tolerance", "3abc"});
+    expect_one_line(r, 2, {"--tolerance", "'3abc' is not a whole number"});
+    r = run_bounded({"eval", gt, gt, "--tolerance", "2.5"});
+    expect_one_line(r, 2, {"--tolerance", "'2.5' is not a whole number"});
+    r = run_bounded({"eval", gt, gt, "--tolerance", "99"});
+    expect_one_line(r, 2, {"--tolerance", "not in range"});
+    r = run_bounded({"run", gt, "--out", "/nonexistent/out", "--frames", "2x"});
+    expect_one_line(r, 2, {"--frames", "'2x' is not a whole number"});
+    r = run_bounded({"export-fakenect", gt, "/nonexistent/dump", "--fps", "nan"});
+    expect_one_line(r, 2, {"--fps", "nan"});  // NaN passed CLI::Range
+}
+
+TEST(WritePaths, ViewOrbitMustBeFiniteDegrees) {
+    for (const std::string orbit : {"nan,1", "1e308,0", "0,inf", "400,0", "0,91"}) {
+        const CommandResult r = run_bounded({"view", (tabletop() / "image_0000").string(), "--orbit", orbit},
+                                            {{"DISPLAY", std::nullopt}, {"WAYLAND_DISPLAY", std::nullopt}});
+        if (r.err.find("built without viewer support") != std::string::npos) GTEST_SKIP() << r.err;
+        expect_one_line(r, 2, {"--orbit", orbit});  // before "no display"
+    }
+}
+
+TEST(WritePaths, TooFewPointsNamesTheFrame) {
+    // "k = 7 is larger than the 0 valid points" named no frame.
+    TempDir tmp;
+    const CommandResult r = run_bounded({"run", tabletop().string(), "--out", (tmp / "out").string(), "-q",
+                                         "--zmin", "100", "--zmax", "101"});
+    expect_one_line(r, 2, {"image_0000: k = 7 is larger than the 0 valid points"});
+    EXPECT_NE(read_json(tmp / "out" / "summary.json")["error"].get<std::string>().find("image_0000: k = 7"),
+              std::string::npos);
+}
+
+TEST(WritePaths, DepthSizeIsCheckedAgainstTheIntrinsicsBeforeDecoding) {
+    // With --max-pixels 2^30 a 32768 x 32768 depth.png beside a 640 x 480 intrinsics.json was
+    // decoded (11 s, 2.1 GB) before its size was compared.
+    TempDir tmp;
+    const fs::path frame = tmp / "f";
+    copy_frame(tabletop() / "image_0000", frame);
+    fs::remove(frame / "color.png");
+    write_text(frame / "depth.png", wul3d::test::bomb_png(32768, 32768));
+    const auto t0 = std::chrono::steady_clock::now();
+    CommandResult r = run_bounded({"run", frame.string(), "--out", (tmp / "out").string(), "-q",
+                                   "--max-pixels", "1073741824"});
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    expect_one_line(r, 2, {"depth.png is 32768x32768 but intrinsics.json says 640x480"});
+    EXPECT_LT(s, 5.0);  // 0.01 s; the decoding took 11 s
+    // The colour's header still speaks first: its size against the depth's is the hint
+    // for unregistered input.
+    wul3d::ColorImage small;
+    small.width = 4;
+    small.height = 2;
+    small.rgb.assign(4 * 2 * 3, 0);
+    wul3d::write_color_png((frame / "color.png").string(), small);
+    r = run_bounded({"run", frame.string(), "--out", (tmp / "out").string(), "-q", "--max-pixels", "1073741824"});
+    expect_one_line(r, 2, {"color.png is 4x2 but depth.png is 32768x32768", "--calibration"});
 }
 
 }  // namespace

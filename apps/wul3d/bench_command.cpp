@@ -126,7 +126,13 @@ void measure_one(const BenchOptions& o) {
     params.decimation = decimation_of(o);
     if (o.threads > 0) wul3d::set_num_threads(o.threads);
     Pipeline pipeline(params);
-    pipeline.process(frames.front());  // seeding is a one-off: not timed
+    try {
+        pipeline.process(frames.front());  // seeding is a one-off: not timed
+    } catch (const InputError& e) {  // as `run` says it: naming the frame
+        const std::string what = e.what(), name = frames.front().name;
+        if (what.rfind(name + ": ", 0) == 0) throw;
+        throw InputError(name + ": " + what);
+    }
     std::vector<double> ms;
     std::size_t points = 0;
     for (int pass = 0; pass < o.passes; ++pass)
@@ -274,21 +280,21 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--csv", opts->csv, "Also write the rows as CSV");
     cmd->add_option("--frames", opts->frames, "Distinct frames loaded")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(NumberIn(1, 1000));
     cmd->add_option("--passes", opts->passes, "Passes over the frames")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(NumberIn(1, 1000));
     cmd->add_option("--pipeline", opts->pipeline,
                     "objects: the default object pipeline; paper: the paper's steps only "
                     "(back-projection to eq. 9 colours)")
         ->capture_default_str();
     cmd->add_option("--segmenter", opts->segmenter, "geometric|kmeans|hybrid (default: hybrid)");
     cmd->add_option("--threads", opts->threads, "Worker threads, [1, 1024] (default: all cores)")
-        ->check(CLI::Range(0, wul3d::kMaxThreads));
+        ->check(NumberIn(0, wul3d::kMaxThreads));
     cmd->add_option("--decimate", opts->decimate,
                     "Run the stages on every N-th pixel in u and v, results at the input's size "
                     "(default: 2 with --pipeline objects, 1 with paper)")
-        ->check(CLI::Range(1, 8));
+        ->check(NumberIn(1, 8));
     add_max_pixels_option(cmd);
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");

@@ -288,13 +288,13 @@ void add_eval_command(CLI::App& app) {
                     "Ground-truth labels up to this value are background (9 for OSD's "
                     "label_parts.png, whose 1-9 are the table)")
         ->capture_default_str()
-        ->check(CLI::Range(0, 65535));
+        ->check(NumberIn(0, 65535));
     cmd->add_option("--only", opts->only,
                     "Score only frames whose name starts with this prefix (repeatable)");
     cmd->add_option("--tolerance", opts->tolerance_px,
                     "Boundary tolerance in pixels, [0, 50] (default: ceil(0.003 x image "
                     "diagonal), at most 50)")
-        ->check(CLI::Range(0, kMaxBoundaryTolerancePx));
+        ->check(NumberIn(0, kMaxBoundaryTolerancePx));
     add_max_pixels_option(cmd);
     cmd->add_option("--json", opts->json, "Write the summary and per-image scores as JSON");
     cmd->add_flag("--per-image", opts->per_image, "Print one line per image");

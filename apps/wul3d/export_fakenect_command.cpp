@@ -81,9 +81,9 @@ void add_export_fakenect_command(CLI::App& app) {
         ->required();
     cmd->add_option("--format", o->format, "auto|frames|tum|unregistered")->capture_default_str();
     cmd->add_option("--frames", o->max_frames, "Export the first N frames (default: all)")
-        ->check(CLI::Range(1, 1 << 30));
+        ->check(NumberIn(1, 1 << 30));
     cmd->add_option("--fps", o->fps, "Replay rate, frames per second")
-        ->check(CLI::Range(1.0, 120.0))->capture_default_str();
+        ->check(NumberIn(1.0, 120.0))->capture_default_str();
     add_max_pixels_option(cmd);
     cmd->callback([o]() { export_fakenect(*o); });
 }

@@ -88,7 +88,7 @@ void add_record_command(CLI::App& app) {
         ->required();
     cmd->add_option("-o,--out", o->out_dir, "Output folder (frame_NNNNNN/ per frame)")->required();
     cmd->add_option("--frames", o->max_frames, "Stop after N frames (default: Ctrl-C or the end)")
-        ->check(CLI::Range(1, 1 << 30));
+        ->check(NumberIn(1, 1 << 30));
     cmd->add_flag("--lossless", o->input.lossless,
                   "Capture waits for each frame to be written instead of dropping (replays)");
     cmd->add_flag("-q,--quiet", o->quiet, "No progress");

@@ -161,7 +161,7 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("-o,--out", opts->out_dir, "Output folder")->required();
     cmd->add_option("--frames", opts->max_frames,
                     "Stop after N frames (default: all; with --camera: until Ctrl-C or its end)")
-        ->check(CLI::Range(1, 1 << 30));
+        ->check(NumberIn(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_flag("--overlay", opts->overlay,
                   "Also write OUT/<frame>/overlay.png: the objects tinted, outlined and numbered "

@@ -65,12 +65,12 @@ void add_view_command(CLI::App& app) {
     cmd->add_option("--screenshot", o->screenshot,
                     "After --exit-after frames, write the window to this PNG and exit");
     cmd->add_option("--exit-after", o->exit_after, "Play N frames, then exit (0: until closed)")
-        ->check(CLI::Range(0, 1 << 30));
+        ->check(NumberIn(0, 1 << 30));
     cmd->add_option("--orbit", o->orbit,
                     "YAW,PITCH: degrees to turn the first 3D view from the sensor's (default 0,0)");
-    cmd->add_option("--width", o->width, "Window width, px")->check(CLI::Range(640, 8192))
+    cmd->add_option("--width", o->width, "Window width, px")->check(NumberIn(640, 8192))
         ->capture_default_str();
-    cmd->add_option("--height", o->height, "Window height, px")->check(CLI::Range(480, 8192))
+    cmd->add_option("--height", o->height, "Window height, px")->check(NumberIn(480, 8192))
         ->capture_default_str();
     cmd->callback([o]() {
         const ViewerConfig config = make_config(*o);
