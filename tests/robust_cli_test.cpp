@@ -33,41 +33,14 @@ using wul3d::test::run_command;
 using wul3d::test::sample_dir;
 using wul3d::test::TempDir;
 using wul3d::test::bomb_png;
+using wul3d::test::copy_frame;
+using wul3d::test::describe;
+using wul3d::test::expect_one_line;
+using wul3d::test::run_bounded;
+using wul3d::test::slurp;
+using wul3d::test::write_text;
 
 fs::path tabletop_frame() { return sample_dir() / "uois_tabletop" / "image_0000"; }
-
-/// wul3d with `args` under `timeout 60`: a hang ends as exit 124.
-CommandResult run_bounded(const std::vector<std::string>& args) {
-    std::vector<std::string> argv = {"timeout", "60", wul3d::test::cli_path().string()};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return run_command(argv);
-}
-
-std::string describe(const CommandResult& r) {
-    return "exit " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out +
-           "--- stderr ---\n" + r.err;
-}
-
-/// Exit `code`, and one error line on stderr (besides "wul3d: note:" lines) that contains
-/// every one of `words`.
-void expect_one_line(const CommandResult& r, int code, const std::vector<std::string>& words) {
-    EXPECT_EQ(r.exit_code, code) << describe(r);
-    std::vector<std::string> errors;
-    std::istringstream lines(r.err);
-    for (std::string line; std::getline(lines, line);)
-        if (line.rfind("wul3d: note:", 0) != 0) errors.push_back(line);
-    ASSERT_EQ(errors.size(), 1u) << describe(r);
-    for (const auto& w : words) EXPECT_NE(errors[0].find(w), std::string::npos) << w << "\n" << describe(r);
-}
-
-void copy_frame(const fs::path& src, const fs::path& dst) {
-    fs::create_directories(dst);
-    for (const auto& e : fs::directory_iterator(src)) fs::copy_file(e.path(), dst / e.path().filename());
-}
-
-void write_text(const fs::path& p, const std::string& text) {
-    std::ofstream(p, std::ios::binary) << text;
-}
 
 // ---- regular files only --------------------------------------------------------------------
 
@@ -216,11 +189,6 @@ TEST(RobustCli, BenchFailureIsOneLineWithTheChildsExitCode) {
 
 
 // ---- outputs never touch inputs or foreign files ------------------------------------------------
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 TEST(RobustCli, OutThatIsOrHoldsTheInputIsRefused) {
     TempDir tmp;

@@ -1,5 +1,6 @@
 #include "test_support.hpp"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -35,14 +36,40 @@ TempDir::~TempDir() {
     fs::remove_all(path_, ec);
 }
 
-namespace {
 std::string slurp(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
 }
-}  // namespace
+
+void write_text(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+void copy_frame(const fs::path& src, const fs::path& dst) {
+    fs::create_directories(dst);
+    for (const auto& e : fs::directory_iterator(src)) fs::copy_file(e.path(), dst / e.path().filename());
+}
+
+CommandResult run_bounded(const std::vector<std::string>& args, const std::vector<EnvChange>& env) {
+    std::vector<std::string> argv = {"timeout", "60", cli_path().string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv, env);
+}
+
+std::string describe(const CommandResult& r) {
+    return "exit " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out +
+           "--- stderr ---\n" + r.err;
+}
+
+void expect_one_line(const CommandResult& r, int code, const std::vector<std::string>& words) {
+    EXPECT_EQ(r.exit_code, code) << describe(r);
+    std::vector<std::string> errors;
+    std::istringstream lines(r.err);
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("wul3d: note:", 0) != 0) errors.push_back(line);
+    ASSERT_EQ(errors.size(), 1u) << describe(r);
+    for (const auto& w : words) EXPECT_NE(errors[0].find(w), std::string::npos) << w << "\n" << describe(r);
+}
 
 CommandResult run_command(const std::vector<std::string>& args,
                           const std::vector<EnvChange>& env) {
