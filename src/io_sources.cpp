@@ -321,16 +321,19 @@ std::vector<Stamped> read_tum_list(const fs::path& file) {
     return list;
 }
 
-/// Refuses two depth frames of one timestamp: both would be the frame of that name (OUT/<t>/),
-/// the second replacing the first unseen.
+/// Refuses one timestamp for two depth images: both would be the frame of that name
+/// (OUT/<t>/), the second replacing the first unseen. A line written again whole (the same
+/// timestamp and image) is the same frame again, and stays allowed (a long run of one
+/// small frame, as the memory tests make).
 void check_unique_stamps(const fs::path& file, const std::vector<Stamped>& list) {
-    std::unordered_map<std::string_view, int> first_line;
-    first_line.reserve(list.size());
+    std::unordered_map<std::string_view, const Stamped*> first;
+    first.reserve(list.size());
     for (const Stamped& s : list) {
-        const auto [it, added] = first_line.emplace(s.stamp, s.line);
-        if (!added)
+        const auto [it, added] = first.emplace(s.stamp, &s);
+        if (!added && it->second->file != s.file)
             throw InputError(file.string() + ":" + std::to_string(s.line) + ": timestamp " +
-                             s.stamp + " again (first on line " + std::to_string(it->second) +
+                             s.stamp + " again, for " + s.file + " (first on line " +
+                             std::to_string(it->second->line) + ", for " + it->second->file +
                              "): two frames of one name; remove one of them");
     }
 }

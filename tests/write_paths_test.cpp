@@ -355,8 +355,14 @@ TEST(WritePaths, DuplicateTumTimestampIsRefused) {
     write_text(seq / "depth.txt", "# depth\n1.0 depth/1.png\n1.0 depth/2.png\n");
     const CommandResult r = run_bounded({"run", seq.string(), "--out", (tmp / "out").string(), "-q",
                                          "--tum-camera", "kinect_v1"});
-    expect_one_line(r, 2, {(seq / "depth.txt").string() + ":3", "timestamp 1.0", "line 2"});
+    expect_one_line(r, 2, {(seq / "depth.txt").string() + ":3", "timestamp 1.0", "line 2",
+                           "depth/1.png", "depth/2.png"});
     EXPECT_FALSE(fs::exists(tmp / "out"));
+    // A line written again whole is the same frame again (the memory tests' long runs).
+    write_text(seq / "depth.txt", "1.0 depth/1.png\n1.0 depth/1.png\n");
+    const CommandResult again = run_bounded({"run", seq.string(), "--out", (tmp / "out").string(), "-q",
+                                             "--tum-camera", "kinect_v1"});
+    EXPECT_EQ(again.exit_code, 0) << describe(again);
 }
 
 // ---- item 17: messages -------------------------------------------------------------------
