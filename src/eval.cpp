@@ -6,7 +6,10 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <string>
+#include <unordered_map>
+#include <utility>
 
 #include "wul3d/error.hpp"
 
@@ -89,31 +92,29 @@ std::vector<Offset> disk(int r) {
     return d;
 }
 
-/// For every boundary pixel of `from` (object a) and every object b of `to` with a boundary
-/// pixel within the disk around it, adds 1 to hits[a * n_to + b]: the number of a's boundary
-/// pixels within tolerance of b's boundary, for all pairs at once. Each pixel counts once
-/// per b, so this equals |boundary(a) AND dilate(boundary(b), disk)|.
+/// For every boundary pixel of `from` whose object a has a partner b = partner[a] in `to`
+/// (-1: none), adds 1 to hits[a] when a boundary pixel of b lies within the disk around it:
+/// hits[a] = |boundary(a) AND dilate(boundary(b), disk)|, for the matched pairs only (the
+/// score needs no other pair, and a table of every pair grows as objects squared).
 void boundary_hits(const LabelImage& from, const Compact& cfrom, const std::vector<int>& bfrom,
-                   const LabelImage& to, const Compact& cto, const std::vector<Offset>& offsets,
-                   std::vector<std::int64_t>& hits) {
+                   const LabelImage& to, const Compact& cto, const std::vector<int>& partner,
+                   const std::vector<Offset>& offsets, std::vector<std::int64_t>& hits) {
     const int w = from.width, h = from.height;
-    const std::size_t n_to = static_cast<std::size_t>(cto.size());
     const std::uint16_t* lt = to.labels.data();
-    std::vector<int> stamp(n_to, -1);
+    hits.assign(partner.size(), 0);
     for (const int p : bfrom) {
         const int u = p % w, v = p / w;
-        const std::size_t row =
-            static_cast<std::size_t>(cfrom.index[from.labels[static_cast<std::size_t>(p)]]) * n_to;
+        const std::size_t a =
+            static_cast<std::size_t>(cfrom.index[from.labels[static_cast<std::size_t>(p)]]);
+        if (partner[a] < 0) continue;
+        const std::uint16_t lb = cto.ids[static_cast<std::size_t>(partner[a])];
         for (const Offset& o : offsets) {
             const int uu = u + o.du, vv = v + o.dv;
             if (uu < 0 || uu >= w || vv < 0 || vv >= h) continue;
-            const std::uint16_t lb = lt[static_cast<std::size_t>(vv) * w + uu];
-            if (lb == 0) continue;
-            const std::size_t b = static_cast<std::size_t>(cto.index[lb]);
-            if (stamp[b] == p) continue;  // b already counted for this pixel
+            if (lt[static_cast<std::size_t>(vv) * w + uu] != lb) continue;
             if (!is_boundary(lt, w, h, uu, vv)) continue;
-            stamp[b] = p;
-            ++hits[row + b];
+            ++hits[a];
+            break;  // this pixel counts once
         }
     }
 }
@@ -128,97 +129,181 @@ void set_all(ImageScore& s, double p, double r, double f, double detected_share)
     s.detected_share = detected_share;
 }
 
-/// Overlap: each object's pixels and every (ground truth, prediction) pair's common pixels,
-/// one pass over the image, and each pair's overlap F (the harmonic mean of tp / |p| and
-/// tp / |g|). Pairs index as g * np + p. Cost: O(pixels + np ng).
+/// A (ground truth, prediction) pair of object indices as one key: g << 16 | p.
+using PairKey = std::uint32_t;
+inline PairKey pair_key(int g, int p) {
+    return static_cast<PairKey>(g) << 16 | static_cast<PairKey>(p);
+}
+inline int key_g(PairKey k) { return static_cast<int>(k >> 16); }
+inline int key_p(PairKey k) { return static_cast<int>(k & 0xffffu); }
+
+/// Overlap: each object's pixels, and the common pixels of the (ground truth, prediction)
+/// pairs that have any, sorted by key: at most one entry per pixel, never np x ng (20,000
+/// objects on each side made that 12.5 GB). One pass over the image.
 struct OverlapTable {
-    std::vector<std::int64_t> size_p, size_g, tp;
+    std::vector<std::int64_t> size_p, size_g;
     std::int64_t all_p = 0, all_g = 0;
-    std::vector<double> f;
+    std::vector<std::pair<PairKey, std::int64_t>> pairs;  ///< (key, tp > 0), by key
+
+    std::int64_t tp(int g, int p) const {
+        const PairKey k = pair_key(g, p);
+        const auto it = std::lower_bound(pairs.begin(), pairs.end(), k,
+                                         [](const auto& e, PairKey x) { return e.first < x; });
+        return it != pairs.end() && it->first == k ? it->second : 0;
+    }
+    /// The overlap F of the pair: the harmonic mean of tp / |p| and tp / |g|.
+    double f(int g, int p, std::int64_t tp) const {
+        return 2.0 * static_cast<double>(tp) /
+               static_cast<double>(size_p[static_cast<std::size_t>(p)] +
+                                   size_g[static_cast<std::size_t>(g)]);
+    }
 };
 OverlapTable overlap_table(const LabelImage& pred, const Compact& cp, const LabelImage& gt, const Compact& cg) {
-    const int np = cp.size(), ng = cg.size();
-    const std::size_t npg = static_cast<std::size_t>(np) * static_cast<std::size_t>(ng);
     OverlapTable t;
-    t.size_p.assign(static_cast<std::size_t>(np), 0);
-    t.size_g.assign(static_cast<std::size_t>(ng), 0);
-    t.tp.assign(npg, 0);
+    t.size_p.assign(static_cast<std::size_t>(cp.size()), 0);
+    t.size_g.assign(static_cast<std::size_t>(cg.size()), 0);
+    std::unordered_map<PairKey, std::int64_t> common;
+    // Runs of one pair are counted locally: a map look-up per run, not per pixel.
+    PairKey run_key = 0;
+    std::int64_t run = 0;
     for (std::size_t q = 0; q < gt.labels.size(); ++q) {
         const std::uint16_t a = pred.labels[q], b = gt.labels[q];
         const int i = a ? cp.index[a] : -1;
         const int k = b ? cg.index[b] : -1;
         if (i >= 0) ++t.size_p[static_cast<std::size_t>(i)];
         if (k >= 0) ++t.size_g[static_cast<std::size_t>(k)];
-        if (i >= 0 && k >= 0) ++t.tp[static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i)];
+        if (i < 0 || k < 0) continue;
+        const PairKey key = pair_key(k, i);
+        if (run > 0 && key != run_key) {
+            common[run_key] += run;
+            run = 0;
+        }
+        run_key = key;
+        ++run;
     }
+    if (run > 0) common[run_key] += run;
     for (const auto n : t.size_p) t.all_p += n;
     for (const auto n : t.size_g) t.all_g += n;
-    t.f.assign(npg, 0.0);
-    for (int k = 0; k < ng; ++k)
-        for (int i = 0; i < np; ++i) {
-            const std::size_t e = static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i);
-            t.f[e] = 2.0 * static_cast<double>(t.tp[e]) /
-                     static_cast<double>(t.size_p[static_cast<std::size_t>(i)] +
-                                         t.size_g[static_cast<std::size_t>(k)]);
-        }
+    t.pairs.assign(common.begin(), common.end());
+    std::sort(t.pairs.begin(), t.pairs.end());
     return t;
 }
 
-/// Boundaries: the boundary pixels of both images, and for every pair the pixels of one's
-/// boundary within `tolerance_px` of the other's (hit_p[p * ng + g], hit_g[g * np + p]).
-/// Cost: O(boundary pixels x disk area).
-struct BoundaryTable {
-    std::vector<std::int64_t> hit_p, hit_g;
-    std::int64_t all_bp = 0, all_bg = 0;
-};
-BoundaryTable boundary_table(const LabelImage& pred, const Compact& cp, const LabelImage& gt, const Compact& cg,
-                             int tolerance_px) {
-    std::vector<int> bp, bg;
-    std::vector<std::int64_t> bcount_p, bcount_g;
-    boundary_pixels(pred, cp, bp, bcount_p);
-    boundary_pixels(gt, cg, bg, bcount_g);
-    BoundaryTable t;
-    for (const auto n : bcount_p) t.all_bp += n;
-    for (const auto n : bcount_g) t.all_bg += n;
-    const std::vector<Offset> offsets = disk(tolerance_px);
-    const std::size_t npg = static_cast<std::size_t>(cp.size()) * static_cast<std::size_t>(cg.size());
-    t.hit_p.assign(npg, 0);
-    t.hit_g.assign(npg, 0);
-    boundary_hits(pred, cp, bp, gt, cg, offsets, t.hit_p);
-    boundary_hits(gt, cg, bg, pred, cp, offsets, t.hit_g);
-    return t;
+/// Up to this many (ground truth x prediction) pairs the matching is one Hungarian over
+/// every pair, as it always was; above, one per group of objects that overlap (the pairs
+/// without a common pixel weigh 0 and change no score), each and all of them bounded.
+constexpr std::size_t kWholeMatchPairs = std::size_t{1} << 20;
+
+/// The matching that maximises the sum of overlap F: ground-truth index -> prediction
+/// index, -1 none (or a pair of F = 0, which scores as none).
+std::vector<int> best_matching(const OverlapTable& ot, int np, int ng) {
+    if (static_cast<std::size_t>(np) * static_cast<std::size_t>(ng) <= kWholeMatchPairs) {
+        std::vector<double> f(static_cast<std::size_t>(np) * static_cast<std::size_t>(ng), 0.0);
+        for (const auto& [key, tp] : ot.pairs)
+            f[static_cast<std::size_t>(key_g(key)) * static_cast<std::size_t>(np) +
+              static_cast<std::size_t>(key_p(key))] = ot.f(key_g(key), key_p(key), tp);
+        return hungarian_max(f, ng, np);
+    }
+    // Groups: the connected parts of the graph of pairs with common pixels (union-find over
+    // ground-truth nodes 0..ng-1 and prediction nodes ng..ng+np-1).
+    std::vector<int> parent(static_cast<std::size_t>(ng + np));
+    for (std::size_t n = 0; n < parent.size(); ++n) parent[n] = static_cast<int>(n);
+    const auto root = [&](int n) {
+        while (parent[static_cast<std::size_t>(n)] != n)
+            n = parent[static_cast<std::size_t>(n)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(n)])];
+        return n;
+    };
+    for (const auto& e : ot.pairs) {
+        const int a = root(key_g(e.first)), b = root(ng + key_p(e.first));
+        if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+    }
+    // Each group's objects, in increasing index (so in increasing label value).
+    std::map<int, std::pair<std::vector<int>, std::vector<int>>> groups;
+    for (int n = 0; n < ng + np; ++n) {
+        auto& [rows, cols] = groups[root(n)];
+        (n < ng ? rows : cols).push_back(n < ng ? n : n - ng);
+    }
+    std::size_t all_pairs = 0;
+    for (const auto& [id, g] : groups) {
+        const std::size_t pairs = g.first.size() * g.second.size();
+        all_pairs += pairs;
+        if (pairs > kMaxEvalGroupPairs || all_pairs > kMaxEvalMatchPairs)
+            throw InputError(
+                std::to_string(ng) + " ground-truth and " + std::to_string(np) +
+                " predicted objects overlap in " +
+                (pairs > kMaxEvalGroupPairs
+                     ? "a group of " + std::to_string(g.first.size()) + " x " +
+                           std::to_string(g.second.size()) + " objects"
+                     : "groups of more than " + std::to_string(kMaxEvalMatchPairs) + " pairs") +
+                ": more than eval matches (at most " + std::to_string(kMaxEvalGroupPairs) +
+                " pairs in a group, " + std::to_string(kMaxEvalMatchPairs) + " in an image)");
+    }
+    std::vector<int> match(static_cast<std::size_t>(ng), -1);
+    std::vector<double> f;
+    for (const auto& [id, g] : groups) {
+        const auto& [rows, cols] = g;
+        if (rows.empty() || cols.empty()) continue;  // an object overlapping none
+        f.assign(rows.size() * cols.size(), 0.0);
+        for (std::size_t r = 0; r < rows.size(); ++r)
+            for (std::size_t c = 0; c < cols.size(); ++c)
+                if (const std::int64_t tp = ot.tp(rows[r], cols[c]); tp > 0)
+                    f[r * cols.size() + c] = ot.f(rows[r], cols[c], tp);
+        const std::vector<int> m =
+            hungarian_max(f, static_cast<int>(rows.size()), static_cast<int>(cols.size()));
+        for (std::size_t r = 0; r < rows.size(); ++r)
+            if (m[r] >= 0) match[static_cast<std::size_t>(rows[r])] = cols[static_cast<std::size_t>(m[r])];
+    }
+    return match;
 }
 
 /// The scores of the matched pairs (`match`: ground truth -> prediction, -1 none) into `s`:
 /// its matches, detected objects, and the overlap and boundary precision, recall and F over
-/// all objects. Cost: O(ng).
-void score_matches(const OverlapTable& ot, const BoundaryTable& bt, const std::vector<int>& match,
-                   const Compact& cp, const Compact& cg, const EvalParams& params, ImageScore& s) {
+/// all objects. The boundaries: the boundary pixels of both images, and for each matched
+/// pair those of one within `tolerance_px` of the other's. Cost: O(boundary pixels x disk
+/// area).
+void score_matches(const OverlapTable& ot, const std::vector<int>& match, const LabelImage& pred,
+                   const Compact& cp, const LabelImage& gt, const Compact& cg,
+                   const EvalParams& params, ImageScore& s) {
     const int np = cp.size(), ng = cg.size();
-    std::int64_t tp_sum = 0, bp_sum = 0, bg_sum = 0;
+    std::vector<int> partner_p(static_cast<std::size_t>(np), -1), partner_g(static_cast<std::size_t>(ng), -1);
+    std::vector<std::int64_t> tps(static_cast<std::size_t>(ng), 0);
+    std::int64_t tp_sum = 0;
     for (int k = 0; k < ng; ++k) {
         const int i = match[static_cast<std::size_t>(k)];
         if (i < 0) continue;
-        const std::size_t e = static_cast<std::size_t>(k) * np + static_cast<std::size_t>(i);
         // F = 0 (no common pixel) is no match. The reference keeps such Hungarian pairs and
         // adds their boundary hits; which F = 0 pairs it picks is an arbitrary tie-break.
-        if (ot.tp[e] == 0) continue;
+        const std::int64_t tp = ot.tp(k, i);
+        if (tp == 0) continue;
+        partner_g[static_cast<std::size_t>(k)] = i;
+        partner_p[static_cast<std::size_t>(i)] = k;
         MatchedPair m;
         m.gt_id = cg.ids[static_cast<std::size_t>(k)];
         m.pred_id = cp.ids[static_cast<std::size_t>(i)];
-        m.true_positives = ot.tp[e];
-        m.overlap_f = ot.f[e];
+        m.true_positives = tp;
+        m.overlap_f = ot.f(k, i, tp);
         s.matches.push_back(m);
-        if (ot.f[e] > params.detected_f) ++s.detected;
-        tp_sum += ot.tp[e];
-        bp_sum += bt.hit_p[static_cast<std::size_t>(i) * ng + static_cast<std::size_t>(k)];
-        bg_sum += bt.hit_g[e];
+        if (m.overlap_f > params.detected_f) ++s.detected;
+        tp_sum += tp;
     }
+    std::vector<int> bp, bg;
+    std::vector<std::int64_t> bcount_p, bcount_g, hit_p, hit_g;
+    boundary_pixels(pred, cp, bp, bcount_p);
+    boundary_pixels(gt, cg, bg, bcount_g);
+    std::int64_t all_bp = 0, all_bg = 0;
+    for (const auto n : bcount_p) all_bp += n;
+    for (const auto n : bcount_g) all_bg += n;
+    const std::vector<Offset> offsets = disk(s.boundary_tolerance_px);
+    boundary_hits(pred, cp, bp, gt, cg, partner_p, offsets, hit_p);
+    boundary_hits(gt, cg, bg, pred, cp, partner_g, offsets, hit_g);
+    std::int64_t bp_sum = 0, bg_sum = 0;
+    for (const auto n : hit_p) bp_sum += n;
+    for (const auto n : hit_g) bg_sum += n;
     s.overlap_p = ratio(static_cast<double>(tp_sum), static_cast<double>(ot.all_p));
     s.overlap_r = ratio(static_cast<double>(tp_sum), static_cast<double>(ot.all_g));
     s.overlap_f = harmonic(s.overlap_p, s.overlap_r);
-    s.boundary_p = ratio(static_cast<double>(bp_sum), static_cast<double>(bt.all_bp));
-    s.boundary_r = ratio(static_cast<double>(bg_sum), static_cast<double>(bt.all_bg));
+    s.boundary_p = ratio(static_cast<double>(bp_sum), static_cast<double>(all_bp));
+    s.boundary_r = ratio(static_cast<double>(bg_sum), static_cast<double>(all_bg));
     s.boundary_f = harmonic(s.boundary_p, s.boundary_r);
     s.detected_share = static_cast<double>(s.detected) / ng;
 }
@@ -358,9 +443,8 @@ ImageScore score_image(const LabelImage& pred, const LabelImage& gt, const EvalP
 
     // Overlap, the best one-to-one matching by overlap F, then the boundaries.
     const OverlapTable ot = overlap_table(pred, cp, gt, cg);
-    const std::vector<int> match = hungarian_max(ot.f, ng, np);
-    const BoundaryTable bt = boundary_table(pred, cp, gt, cg, s.boundary_tolerance_px);
-    score_matches(ot, bt, match, cp, cg, params, s);
+    const std::vector<int> match = best_matching(ot, np, ng);
+    score_matches(ot, match, pred, cp, gt, cg, params, s);
     return s;
 }
 

@@ -2,6 +2,8 @@
 // Private to src/io_*.cpp: image readers that reuse the caller's buffers, so that a
 // FrameSource allocates nothing per frame once the first frame has been read.
 #include <cstdint>
+#include <cstdio>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,13 +27,28 @@ struct ImageScratch {
 void read_regular_file(const std::string& path, std::uint64_t max_bytes,
                        std::vector<unsigned char>& bytes);
 
-/// As read_depth_png / read_color_image / read_label_png, into `out` (buffers reused).
+/// Called with an image's width and height from its header, before its pixels are
+/// allocated: throws to refuse a size the caller already knows is wrong (a 32768 x 32768
+/// depth.png beside a 640 x 480 intrinsics.json is refused without its 2 GB).
+using HeaderCheck = std::function<void(int width, int height)>;
+
+/// As read_depth_png / read_color_image / read_label_png, into `out` (buffers reused);
+/// `check`, if given, sees the header's size first.
 void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageScratch& scratch,
-                         DepthImage& out);
-void read_color_image_into(const std::string& path, ImageScratch& scratch, ColorImage& out);
+                         DepthImage& out, const HeaderCheck& check = {});
+void read_color_image_into(const std::string& path, ImageScratch& scratch, ColorImage& out,
+                           const HeaderCheck& check = {});
 void read_label_png_into(const std::string& path, ImageScratch& scratch, LabelImage& out);
 
 /// "WxH".
 inline std::string size_str(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+/// A number for a message, short whatever its size ("1e+300", "1e-300", "0.001"), where
+/// std::to_string prints 300 digits or "0.000000".
+inline std::string number_str(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return text;
+}
 
 }  // namespace wul3d::detail

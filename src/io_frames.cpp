@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/output.hpp"
@@ -17,7 +18,7 @@ void write_intrinsics_json(const std::string& path, const PinholeIntrinsics& K,
                               {"cx", K.cx},         {"cy", K.cy},
                               {"width", K.width},   {"height", K.height},
                               {"depth_scale_m_per_unit", depth_scale_m_per_unit}};
-    write_text_file(path, j.dump(1) + "\n");
+    write_text_file(path, json_text(j, 1) + "\n");
 }
 
 void write_frame_folder(const std::string& dir, const RgbdFrame& frame) {

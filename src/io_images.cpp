@@ -24,6 +24,7 @@
 #include <stdexcept>
 
 #include "io_detail.hpp"
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/output.hpp"
@@ -630,7 +631,7 @@ float depth_scale(const std::string& path, const nlohmann::json& obj) {
     const double s = number(path, obj, "", "depth_scale_m_per_unit");
     // 1 um to 1 m per unit: 16-bit depth then reaches from 65 mm to 65 km.
     if (!(s >= 1e-6 && s <= 1.0)) {
-        throw InputError(path + ": key 'depth_scale_m_per_unit' = " + std::to_string(s) +
+        throw InputError(path + ": key 'depth_scale_m_per_unit' = " + detail::number_str(s) +
                          ": must be in [1e-6, 1] metres per unit");
     }
     return static_cast<float>(s);
@@ -721,13 +722,14 @@ void read_regular_file(const std::string& path, std::uint64_t max_bytes,
 }
 
 void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageScratch& s,
-                         DepthImage& out) {
+                         DepthImage& out, const HeaderCheck& check) {
     ImageFile file(path, s, false);
     const PixelFormat f = file.format();
     if (f.bits != 16 || f.channels != 1) {
         throw InputError(path + ": depth must be 16-bit single-channel PNG, got " + describe(f) +
                          " (8-bit depth has no known units)");
     }
+    if (check) check(static_cast<int>(file.width()), static_cast<int>(file.height()));
     out.data.resize(file.pixels());
     decode_or_clear(out, out.data, [&] {
         file.read(Layout::Gray16, reinterpret_cast<unsigned char*>(out.data.data()));
@@ -737,12 +739,14 @@ void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageS
     out.scale_m_per_unit = scale_m_per_unit;
 }
 
-void read_color_image_into(const std::string& path, ImageScratch& s, ColorImage& out) {
+void read_color_image_into(const std::string& path, ImageScratch& s, ColorImage& out,
+                           const HeaderCheck& check) {
     ImageFile file(path, s, true);
     const PixelFormat f = file.format();
     if (f.bits != 8 || (f.channels != 1 && f.channels != 3 && f.channels != 4)) {
         throw InputError(path + ": colour must be 8-bit grey, RGB or RGBA, got " + describe(f));
     }
+    if (check) check(static_cast<int>(file.width()), static_cast<int>(file.height()));
     out.rgb.resize(3 * file.pixels());
     decode_or_clear(out, out.rgb, [&] { file.read(Layout::Rgb8, out.rgb.data()); });
     out.width = static_cast<int>(file.width());
@@ -839,7 +843,7 @@ void write_calibration_json(const std::string& path, const StereoCalibration& ca
     j["color"] = intrinsics_to_json(calib.color);
     j["depth_to_color"] = {{"rotation", calib.rotation}, {"translation_m", calib.translation_m}};
     j["depth_scale_m_per_unit"] = float_for_json(calib.depth_scale_m_per_unit);
-    write_text_file(path, j.dump(2) + "\n");
+    write_text_file(path, json_text(j, 2) + "\n");
 }
 
 // ---- outputs ------------------------------------------------------------------------

@@ -3,8 +3,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
+#include <unordered_map>
 
 #include "io_detail.hpp"
 #include "wul3d/error.hpp"
@@ -105,13 +108,18 @@ FrameDirs find_frame_dirs(const std::string& path, const fs::path& root) {
     return found;
 }
 
-void check_colour_size(const fs::path& dir, const ColorImage& c, const DepthImage& d) {
-    if (c.width != d.width || c.height != d.height) {
-        throw InputError(dir.string() + ": color.png is " + size_str(c.width, c.height) +
-                         " but depth.png is " + size_str(d.width, d.height) +
+/// A frame folder's colour of w x h against its depth: from the colour's header, before
+/// its pixels are allocated.
+void check_colour_size(const fs::path& dir, int w, int h, int depth_w, int depth_h) {
+    if (w != depth_w || h != depth_h) {
+        throw InputError(dir.string() + ": color.png is " + size_str(w, h) +
+                         " but depth.png is " + size_str(depth_w, depth_h) +
                          "; give a calibration (--calibration) for unregistered input");
     }
 }
+
+/// Thrown by a header check to stop a read before its pixels; never leaves read().
+struct StopBeforePixels {};
 
 void clear_colour(ColorImage& c) {
     c.width = c.height = 0;
@@ -146,22 +154,62 @@ public:
         f.name = dirs_.names[i];
 
         // Colour and depth first: a size mismatch is most likely unregistered input, and
-        // then the hint matters more than a missing intrinsics.json.
-        detail::read_depth_png_into((dir / "depth.png").string(), 0.001f, depth_scratch_, f.depth);
+        // then the hint matters more than a missing intrinsics.json. Sizes come from the
+        // headers, before any pixel is allocated: a depth.png the intrinsics contradict is
+        // refused without decoding it (a 32768 x 32768 one took 2.1 GB and 11 s), after
+        // the colour's header has had its say.
+        const fs::path intr = dir / "intrinsics.json";
         const fs::path color = dir / "color.png";
+        std::optional<IntrinsicsFile> intr_file;  // read ahead, once, when it reads
+        std::optional<PinholeIntrinsics> known;   // the size the frame must have, if known
+        const char* intr_from = "intrinsics.json";
+        if (intrinsics_) {
+            if (intrinsics_->width != 0 || intrinsics_->height != 0) known = *intrinsics_;
+            intr_from = "the given intrinsics";
+        } else if (present(intr)) {
+            try {
+                intr_file = read_intrinsics_json(intr.string());
+                known = intr_file->intrinsics;
+            } catch (const std::exception&) {
+                // Said below, where it always was, once the images are read.
+            }
+        }
+        std::optional<std::pair<int, int>> contradicted;  // the depth's size, if not known's
+        try {
+            detail::read_depth_png_into((dir / "depth.png").string(), 0.001f, depth_scratch_,
+                                        f.depth, [&](int w, int h) {
+                                            if (!known || known->same_size(w, h)) return;
+                                            contradicted.emplace(w, h);
+                                            throw StopBeforePixels{};
+                                        });
+        } catch (const StopBeforePixels&) {
+        }
+        if (contradicted) {
+            const auto [w, h] = *contradicted;
+            if (present(color)) {
+                try {
+                    detail::read_color_image_into(color.string(), color_scratch_, f.color,
+                                                  [&](int cw, int ch) {
+                                                      check_colour_size(dir, cw, ch, w, h);
+                                                      throw StopBeforePixels{};
+                                                  });
+                } catch (const StopBeforePixels&) {
+                }
+            }
+            throw InputError(dir.string() + ": depth.png is " + size_str(w, h) + " but " +
+                             intr_from + " says " + size_str(known->width, known->height));
+        }
         if (present(color)) {
-            detail::read_color_image_into(color.string(), color_scratch_, f.color);
-            check_colour_size(dir, f.color, f.depth);
+            detail::read_color_image_into(color.string(), color_scratch_, f.color, [&](int w, int h) {
+                check_colour_size(dir, w, h, f.depth.width, f.depth.height);
+            });
         } else {
             clear_colour(f.color);
         }
 
-        const fs::path intr = dir / "intrinsics.json";
-        const char* intr_from = "intrinsics.json";
         if (intrinsics_) {
             // The override replaces the camera; the file, if present, still gives the units.
             f.intrinsics = *intrinsics_;
-            intr_from = "the given intrinsics";
             if (f.intrinsics.width == 0 && f.intrinsics.height == 0) {
                 f.intrinsics.width = f.depth.width;  // no size given: the frame's own
                 f.intrinsics.height = f.depth.height;
@@ -171,7 +219,7 @@ public:
                 f.depth.scale_m_per_unit = read_intrinsics_json(intr.string()).depth_scale_m_per_unit;
             }
         } else {
-            const IntrinsicsFile file = read_intrinsics_json(intr.string());
+            const IntrinsicsFile file = intr_file ? *intr_file : read_intrinsics_json(intr.string());
             f.intrinsics = file.intrinsics;
             f.depth.scale_m_per_unit = file.depth_scale_m_per_unit;
         }
@@ -210,23 +258,23 @@ public:
         item.is_raw = true;
         RawRgbdFrame& raw = item.raw;
         raw.name = dirs_.names[i];
-        detail::read_depth_png_into((dir / "depth.png").string(), calib_.depth_scale_m_per_unit,
-                                    depth_scratch_, raw.depth);
-        if (!calib_.depth.same_size(raw.depth.width, raw.depth.height)) {
-            throw InputError(dir.string() + ": depth.png is " +
-                             size_str(raw.depth.width, raw.depth.height) +
-                             " but the calibration's depth camera is " +
-                             size_str(calib_.depth.width, calib_.depth.height));
-        }
+        // Each size against the calibration's from the header, before the pixels.
+        detail::read_depth_png_into(
+            (dir / "depth.png").string(), calib_.depth_scale_m_per_unit, depth_scratch_, raw.depth,
+            [&](int w, int h) {
+                if (!calib_.depth.same_size(w, h))
+                    throw InputError(dir.string() + ": depth.png is " + size_str(w, h) +
+                                     " but the calibration's depth camera is " +
+                                     size_str(calib_.depth.width, calib_.depth.height));
+            });
         const fs::path color = dir / "color.png";
         if (present(color)) {
-            detail::read_color_image_into(color.string(), color_scratch_, raw.color);
-            if (!calib_.color.same_size(raw.color.width, raw.color.height)) {
-                throw InputError(dir.string() + ": color.png is " +
-                                 size_str(raw.color.width, raw.color.height) +
-                                 " but the calibration's colour camera is " +
-                                 size_str(calib_.color.width, calib_.color.height));
-            }
+            detail::read_color_image_into(color.string(), color_scratch_, raw.color, [&](int w, int h) {
+                if (!calib_.color.same_size(w, h))
+                    throw InputError(dir.string() + ": color.png is " + size_str(w, h) +
+                                     " but the calibration's colour camera is " +
+                                     size_str(calib_.color.width, calib_.color.height));
+            });
         } else {
             clear_colour(raw.color);
         }
@@ -245,6 +293,7 @@ struct Stamped {
     double t = 0;
     std::string stamp;  ///< as written in the file: the frame name
     std::string file;   ///< relative to the sequence folder
+    int line = 0;       ///< in its list
 };
 
 /// `rgb.txt` / `depth.txt`: "timestamp filename" lines, '#' comments, blank lines skipped.
@@ -266,9 +315,27 @@ std::vector<Stamped> read_tum_list(const fs::path& file) {
             throw InputError(path + ":" + std::to_string(lineno) +
                              ": expected 'timestamp filename', got '" + line + "'");
         }
+        s.line = lineno;
         list.push_back(std::move(s));
     }
     return list;
+}
+
+/// Refuses one timestamp for two depth images: both would be the frame of that name
+/// (OUT/<t>/), the second replacing the first unseen. A line written again whole (the same
+/// timestamp and image) is the same frame again, and stays allowed (a long run of one
+/// small frame, as the memory tests make).
+void check_unique_stamps(const fs::path& file, const std::vector<Stamped>& list) {
+    std::unordered_map<std::string_view, const Stamped*> first;
+    first.reserve(list.size());
+    for (const Stamped& s : list) {
+        const auto [it, added] = first.emplace(s.stamp, &s);
+        if (!added && it->second->file != s.file)
+            throw InputError(file.string() + ":" + std::to_string(s.line) + ": timestamp " +
+                             s.stamp + " again, for " + s.file + " (first on line " +
+                             std::to_string(it->second->line) + ", for " + it->second->file +
+                             "): two frames of one name; remove one of them");
+    }
 }
 
 struct TumPair {
@@ -320,7 +387,16 @@ public:
         f.name = pair.name;
         f.intrinsics = K_;
         // TUM RGB-D: "depth images are scaled by a factor of 5000".
-        detail::read_depth_png_into(pair.depth.string(), kTumDepthScale, depth_scratch_, f.depth);
+        // Sizes from the headers, before the pixels: against sized intrinsics, colour
+        // against depth.
+        detail::read_depth_png_into(pair.depth.string(), kTumDepthScale, depth_scratch_, f.depth,
+                                    [&](int w, int h) {
+                                        if ((K_.width != 0 || K_.height != 0) && !K_.same_size(w, h))
+                                            throw InputError(
+                                                pair.depth.string() + ": depth is " + size_str(w, h) +
+                                                " but the intrinsics (" + intrinsics_from_ +
+                                                ") are " + size_str(K_.width, K_.height));
+                                    });
         if (K_.width == 0 && K_.height == 0) {
             f.intrinsics.width = f.depth.width;  // given intrinsics without a size
             f.intrinsics.height = f.depth.height;
@@ -331,12 +407,12 @@ public:
                              size_str(f.depth.width, f.depth.height) + " but the intrinsics (" +
                              intrinsics_from_ + ") are " + size_str(K_.width, K_.height));
         }
-        detail::read_color_image_into(pair.color.string(), color_scratch_, f.color);
-        if (f.color.width != f.depth.width || f.color.height != f.depth.height) {
-            throw InputError(pair.color.string() + ": colour is " +
-                             size_str(f.color.width, f.color.height) + " but depth " +
-                             pair.depth.string() + " is " + size_str(f.depth.width, f.depth.height));
-        }
+        detail::read_color_image_into(pair.color.string(), color_scratch_, f.color, [&](int w, int h) {
+            if (w != f.depth.width || h != f.depth.height)
+                throw InputError(pair.color.string() + ": colour is " + size_str(w, h) +
+                                 " but depth " + pair.depth.string() + " is " +
+                                 size_str(f.depth.width, f.depth.height));
+        });
     }
 
     static constexpr float kTumDepthScale = 1.0f / 5000.0f;
@@ -357,6 +433,7 @@ std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& r
     }
     std::vector<Stamped> rgb = read_tum_list(root / "rgb.txt");
     std::vector<Stamped> depth = read_tum_list(root / "depth.txt");
+    check_unique_stamps(root / "depth.txt", depth);
     if (depth.empty()) throw InputError(path + ": no frames found (depth.txt lists none)");
     std::vector<TumPair> pairs = associate(root, std::move(depth), std::move(rgb), options.tum_max_dt_s);
     if (pairs.empty()) {

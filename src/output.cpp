@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/visualization.hpp"
@@ -204,7 +205,7 @@ std::string objects_json(const FrameResult& r, int selected_id) {
         const Plane& pl = r.plane.support;
         j["support_plane"] = {{"normal", {pl.nx, pl.ny, pl.nz}}, {"d_m", pl.d}};
     }
-    return j.dump(1) + "\n";
+    return json_text(j, 1) + "\n";
 }
 
 namespace {

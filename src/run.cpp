@@ -17,6 +17,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/objects.hpp"
@@ -155,7 +156,7 @@ public:
     FramesLog& operator=(const FramesLog&) = delete;
 
     void append(const nlohmann::json& line) {
-        const std::string text = line.dump() + "\n";
+        const std::string text = json_text(line) + "\n";
         std::size_t done = 0;
         while (done < text.size()) {
             const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
@@ -397,6 +398,10 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
             } catch (const Stopped&) {  // SIGINT/SIGTERM mid-frame: this frame is not written
                 s.stopped_by = "signal";
                 break;
+            } catch (const InputError& e) {  // each line names its frame ("k = 7 is larger...")
+                const std::string what = e.what();
+                if (what.rfind(name + ": ", 0) == 0) throw;
+                throw InputError(name + ": " + what);
             }
             const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
             if (!frame.has_color() && !said_depth_only) {
@@ -422,7 +427,15 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
         } catch (const std::exception&) {
         }
     }
-    obs.frames_done();
+    try {
+        obs.frames_done();  // e.g. a video that cannot be finished: an error like a frame's
+    } catch (const std::exception& e) {
+        if (!failed) {
+            failed = std::current_exception();
+            s.stopped_by = "error";
+            s.error = e.what();
+        }
+    }
 
     s.ms_per_frame_median = log.compute_ms.median();
     s.fps = s.ms_per_frame_median > 0 ? 1000.0 / s.ms_per_frame_median : 0.0;
@@ -438,7 +451,7 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     }
     try {
         write_text_file((out_dir / kSummaryFile).string(),
-                        summary_json(o, feed, s, log, selection).dump(2) + "\n");
+                        json_text(summary_json(o, feed, s, log, selection), 2) + "\n");
     } catch (const std::exception&) {
         if (!failed) throw;  // the first error is the one to report (a full disk, twice)
     }

@@ -50,11 +50,6 @@ std::string join(const std::vector<std::string>& args) {
     return s;
 }
 
-std::string describe(const CommandResult& r) {
-    return "exit " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out +
-           "--- stderr ---\n" + r.err;
-}
-
 /// Copies a frame folder (color.png, depth.png, intrinsics.json) to `dst`.
 void copy_frame(const fs::path& src, const fs::path& dst) {
     fs::create_directories(dst);

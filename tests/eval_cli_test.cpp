@@ -32,11 +32,6 @@ void write(const fs::path& path, const LabelImage& l) {
     wul3d::write_label_png(path.string(), l);
 }
 
-std::string describe(const CommandResult& r) {
-    return "exit " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out +
-           "--- stderr ---\n" + r.err;
-}
-
 int lines(const std::string& s) {
     int n = 0;
     for (char c : s) n += c == '\n';

@@ -1,7 +1,9 @@
 #include "test_support.hpp"
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <fcntl.h>
@@ -34,14 +36,40 @@ TempDir::~TempDir() {
     fs::remove_all(path_, ec);
 }
 
-namespace {
 std::string slurp(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
 }
-}  // namespace
+
+void write_text(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+void copy_frame(const fs::path& src, const fs::path& dst) {
+    fs::create_directories(dst);
+    for (const auto& e : fs::directory_iterator(src)) fs::copy_file(e.path(), dst / e.path().filename());
+}
+
+CommandResult run_bounded(const std::vector<std::string>& args, const std::vector<EnvChange>& env) {
+    std::vector<std::string> argv = {"timeout", "60", cli_path().string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv, env);
+}
+
+std::string describe(const CommandResult& r) {
+    return "exit " + std::to_string(r.exit_code) + "\n--- stdout ---\n" + r.out +
+           "--- stderr ---\n" + r.err;
+}
+
+void expect_one_line(const CommandResult& r, int code, const std::vector<std::string>& words) {
+    EXPECT_EQ(r.exit_code, code) << describe(r);
+    std::vector<std::string> errors;
+    std::istringstream lines(r.err);
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("wul3d: note:", 0) != 0) errors.push_back(line);
+    ASSERT_EQ(errors.size(), 1u) << describe(r);
+    for (const auto& w : words) EXPECT_NE(errors[0].find(w), std::string::npos) << w << "\n" << describe(r);
+}
 
 CommandResult run_command(const std::vector<std::string>& args,
                           const std::vector<EnvChange>& env) {
@@ -91,6 +119,38 @@ std::vector<std::string> list_files(const fs::path& dir) {
         if (e.is_regular_file()) files.push_back(fs::relative(e.path(), dir).string());
     std::sort(files.begin(), files.end());
     return files;
+}
+
+namespace {
+
+void put32(std::string& s, std::uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8) s.push_back(static_cast<char>((v >> shift) & 0xff));
+}
+
+void chunk(std::string& png, const char* type, const std::string& data) {
+    put32(png, static_cast<std::uint32_t>(data.size()));
+    std::string body = std::string(type, 4) + data;
+    png += body;
+    put32(png, static_cast<std::uint32_t>(
+                   crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
+}
+
+}  // namespace
+
+std::string bomb_png(std::uint32_t width, std::uint32_t height) {
+    std::string png = "\x89PNG\r\n\x1a\n";
+    std::string ihdr;
+    put32(ihdr, width);
+    put32(ihdr, height);
+    ihdr += std::string("\x10\x00\x00\x00\x00", 5);  // 16-bit grey, no interlace
+    chunk(png, "IHDR", ihdr);
+    std::string raw(2 * std::size_t{width} + 1, '\0');  // one zero row
+    std::vector<Bytef> z(compressBound(static_cast<uLong>(raw.size())));
+    uLongf n = static_cast<uLongf>(z.size());
+    compress(z.data(), &n, reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()));
+    chunk(png, "IDAT", std::string(reinterpret_cast<const char*>(z.data()), n));
+    chunk(png, "IEND", "");
+    return png;
 }
 
 }  // namespace wul3d::test

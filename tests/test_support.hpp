@@ -1,6 +1,7 @@
 #pragma once
 // Shared helpers of the test suite: where the shipped samples are, temporary folders, and
 // running the wul3d command.
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -43,6 +44,29 @@ CommandResult run_command(const std::vector<std::string>& argv,
 
 /// Runs the wul3d command with `args` (no shell quoting needed), stdin from /dev/null.
 CommandResult run_cli(const std::vector<std::string>& args);
+
+/// The wul3d command with `args` and `env` under `timeout 60`: a hang ends as exit 124
+/// instead of stalling the suite.
+CommandResult run_bounded(const std::vector<std::string>& args, const std::vector<EnvChange>& env = {});
+
+/// The exit code, stdout and stderr of `r`, for a failed expectation's message.
+std::string describe(const CommandResult& r);
+
+/// Expects exit `code`, and one error line on stderr (besides "wul3d: note:" lines) that
+/// contains every one of `words`.
+void expect_one_line(const CommandResult& r, int code, const std::vector<std::string>& words);
+
+/// The bytes of the file `p` ("" if it cannot be read).
+std::string slurp(const std::filesystem::path& p);
+/// Writes `text` as the whole of `p`.
+void write_text(const std::filesystem::path& p, const std::string& text);
+/// Copies the files of the frame folder `src` into `dst` (created).
+void copy_frame(const std::filesystem::path& src, const std::filesystem::path& dst);
+
+/// A valid-looking 16-bit grey PNG of width x height whose pixel data is one zero row: a
+/// decompression bomb of a few hundred bytes, refused from its header or costing the whole
+/// image once decoded.
+std::string bomb_png(std::uint32_t width, std::uint32_t height);
 
 /// Every regular file under `dir`, relative paths, sorted.
 std::vector<std::string> list_files(const std::filesystem::path& dir);

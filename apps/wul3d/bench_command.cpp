@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -18,10 +19,12 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "pipeline_options.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
 #include "wul3d/threads.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace {
@@ -47,7 +50,8 @@ int decimation_of(const BenchOptions& o) {
     return o.pipeline == "objects" ? PipelineParams{}.decimation : 1;
 }
 
-/// "native" or "WxH".
+/// "native" or "WxH", within the readers' image limit (--max-pixels, io.hpp): checked
+/// before anything is allocated (99999x99999 allocated for a minute, then bad_alloc).
 void parse_resolution(const std::string& text, int& w, int& h) {
     w = h = 0;
     if (text == "native") return;
@@ -55,6 +59,13 @@ void parse_resolution(const std::string& text, int& w, int& h) {
     std::istringstream in(text);
     if (!(in >> w >> x >> h) || x != 'x' || w <= 0 || h <= 0 || !in.eof())
         throw ParamError("--resolution '" + text + "': expected native or WxH, e.g. 1920x1080");
+    const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    if (static_cast<std::uint64_t>(w) > kMaxImageSide ||
+        static_cast<std::uint64_t>(h) > kMaxImageSide || pixels > max_image_pixels())
+        throw ParamError("--resolution '" + text + "': " + std::to_string(pixels) +
+                         " pixels, more than the largest image (--max-pixels " +
+                         std::to_string(max_image_pixels()) + ", sides at most " +
+                         std::to_string(kMaxImageSide) + ")");
 }
 
 /// Nearest-neighbour resampling of a registered frame to w x h, intrinsics scaled per axis:
@@ -115,7 +126,13 @@ void measure_one(const BenchOptions& o) {
     params.decimation = decimation_of(o);
     if (o.threads > 0) wul3d::set_num_threads(o.threads);
     Pipeline pipeline(params);
-    pipeline.process(frames.front());  // seeding is a one-off: not timed
+    try {
+        pipeline.process(frames.front());  // seeding is a one-off: not timed
+    } catch (const InputError& e) {  // as `run` says it: naming the frame
+        const std::string what = e.what(), name = frames.front().name;
+        if (what.rfind(name + ": ", 0) == 0) throw;
+        throw InputError(name + ": " + what);
+    }
     std::vector<double> ms;
     std::size_t points = 0;
     for (int pass = 0; pass < o.passes; ++pass)
@@ -168,7 +185,8 @@ std::string run_child(const BenchOptions& o, int k) {
                                          std::to_string(o.frames), "--passes",
                                          std::to_string(o.passes), "--pipeline", o.pipeline,
                                          "--threads", std::to_string(o.threads),
-                                         "--decimate", std::to_string(decimation_of(o))};
+                                         "--decimate", std::to_string(decimation_of(o)),
+                                         "--max-pixels", std::to_string(max_image_pixels())};
         if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
@@ -232,6 +250,7 @@ void run(const BenchOptions& o) {
         }
     }
     open_source(o.input, SourceOptions{});  // a bad input fails here, once, with its message
+    if (!o.csv.empty()) check_write_target(o.csv, WriteTarget::File, {o.input}, "--csv");
     const std::string header = "k,width,height,points,fps_median,ms_median,peak_rss_mb";
     std::vector<std::string> rows;
     std::cout << header << std::endl;
@@ -261,21 +280,22 @@ void add_bench_command(CLI::App& app) {
     cmd->add_option("--csv", opts->csv, "Also write the rows as CSV");
     cmd->add_option("--frames", opts->frames, "Distinct frames loaded")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(NumberIn(1, 1000));
     cmd->add_option("--passes", opts->passes, "Passes over the frames")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(NumberIn(1, 1000));
     cmd->add_option("--pipeline", opts->pipeline,
                     "objects: the default object pipeline; paper: the paper's steps only "
                     "(back-projection to eq. 9 colours)")
         ->capture_default_str();
     cmd->add_option("--segmenter", opts->segmenter, "geometric|kmeans|hybrid (default: hybrid)");
     cmd->add_option("--threads", opts->threads, "Worker threads, [1, 1024] (default: all cores)")
-        ->check(CLI::Range(0, wul3d::kMaxThreads));
+        ->check(NumberIn(0, wul3d::kMaxThreads));
     cmd->add_option("--decimate", opts->decimate,
                     "Run the stages on every N-th pixel in u and v, results at the input's size "
                     "(default: 2 with --pipeline objects, 1 with paper)")
-        ->check(CLI::Range(1, 8));
+        ->check(NumberIn(1, 8));
+    add_max_pixels_option(cmd);
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");
     cmd->callback([opts]() { run(*opts); });

@@ -14,10 +14,12 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "json_text.hpp"
 #include "pipeline_options.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/eval.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace fs = std::filesystem;
@@ -148,6 +150,8 @@ void run(const EvalOptions& o) {
         throw ParamError("--gt-background-max " + std::to_string(o.gt_background_max) +
                          ": must be in [0, 65535]");
     const std::vector<FramePair> frames = pair_frames(o);
+    // Before scoring: a refused --json costs no time, and replaces no prediction or label.
+    if (!o.json.empty()) check_write_target(o.json, WriteTarget::File, {o.pred, o.gt}, "--json");
 
     std::optional<SequenceScorer> sequence;
     if (o.temporal) sequence.emplace(params);
@@ -176,7 +180,7 @@ void run(const EvalOptions& o) {
         try {
             s = sequence ? sequence->add(pred, gt) : score_image(pred, gt, params);
         } catch (const InputError& e) {
-            throw InputError(f.name + ": " + e.what());
+            throw InputError(f.name + " (" + f.gt.string() + "): " + e.what());
         }
         if (o.per_image)
             std::cout << f.name << ": overlap P/R/F " << pct(s.overlap_p) << " "
@@ -256,7 +260,7 @@ void run(const EvalOptions& o) {
                            {"objects", objs}};
     }
     out["images"] = images;
-    if (!o.json.empty()) write_text_file(o.json, out.dump(2) + "\n");
+    if (!o.json.empty()) write_text_file(o.json, json_text(out, 2) + "\n");
     std::cout << std::flush;
 }
 
@@ -284,13 +288,13 @@ void add_eval_command(CLI::App& app) {
                     "Ground-truth labels up to this value are background (9 for OSD's "
                     "label_parts.png, whose 1-9 are the table)")
         ->capture_default_str()
-        ->check(CLI::Range(0, 65535));
+        ->check(NumberIn(0, 65535));
     cmd->add_option("--only", opts->only,
                     "Score only frames whose name starts with this prefix (repeatable)");
     cmd->add_option("--tolerance", opts->tolerance_px,
                     "Boundary tolerance in pixels, [0, 50] (default: ceil(0.003 x image "
                     "diagonal), at most 50)")
-        ->check(CLI::Range(0, kMaxBoundaryTolerancePx));
+        ->check(NumberIn(0, kMaxBoundaryTolerancePx));
     add_max_pixels_option(cmd);
     cmd->add_option("--json", opts->json, "Write the summary and per-image scores as JSON");
     cmd->add_flag("--per-image", opts->per_image, "Print one line per image");

@@ -12,6 +12,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/kinect_v1.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 
@@ -27,6 +28,7 @@ void export_fakenect(const ExportOptions& o) {
     SourceOptions so;
     so.format = parse_input_format(o.format);
     auto source = open_source(o.input, so);
+    check_write_target(o.dump_dir, WriteTarget::Folder, {o.input}, "DUMPDIR");
     const std::size_t n = o.max_frames ? std::min(o.max_frames, source->size()) : source->size();
     const StereoCalibration kinect = kinect_v1_calibration();
     FakenectDumpWriter dump(o.dump_dir, o.fps);
@@ -79,9 +81,9 @@ void add_export_fakenect_command(CLI::App& app) {
         ->required();
     cmd->add_option("--format", o->format, "auto|frames|tum|unregistered")->capture_default_str();
     cmd->add_option("--frames", o->max_frames, "Export the first N frames (default: all)")
-        ->check(CLI::Range(1, 1 << 30));
+        ->check(NumberIn(1, 1 << 30));
     cmd->add_option("--fps", o->fps, "Replay rate, frames per second")
-        ->check(CLI::Range(1.0, 120.0))->capture_default_str();
+        ->check(NumberIn(1.0, 120.0))->capture_default_str();
     add_max_pixels_option(cmd);
     cmd->callback([o]() { export_fakenect(*o); });
 }

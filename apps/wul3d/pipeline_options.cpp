@@ -1,5 +1,11 @@
 #include "pipeline_options.hpp"
 
+#include "cli.hpp"
+
+#include <charconv>
+#include <cstdlib>
+
+#include "wul3d/capture.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/parse.hpp"
 #include "wul3d/segmentation.hpp"
@@ -8,8 +14,19 @@
 namespace wul3d::cli {
 
 void add_max_pixels_option(CLI::App* cmd) {
-    cmd->add_option_function<std::uint64_t>(
-        "--max-pixels", [](const std::uint64_t& n) { set_max_image_pixels(n); },
+    // Read as text: an unsigned option took -1 as 18446744073709551615 in its message.
+    cmd->add_option_function<std::string>(
+        "--max-pixels",
+        [](const std::string& text) {
+            std::uint64_t n = 0;
+            const char* end = text.data() + text.size();
+            const auto [ptr, ec] = std::from_chars(text.data(), end, n);
+            if (text.empty() || ptr != end || ec != std::errc() || n < 1 ||
+                n > kMaxImagePixelsCeiling)
+                throw ParamError("--max-pixels '" + text + "': must be a whole number of pixels in [1, " +
+                                 std::to_string(kMaxImagePixelsCeiling) + "]");
+            set_max_image_pixels(n);
+        },
         "Largest image read, width x height (default 2^24 = 16777216; at most 2^30)");
 }
 
@@ -48,7 +65,7 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     cmd->add_option("--object-psi", o.object_psi,
                     "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
     cmd->add_option("--threads", o.threads, "Worker threads, [1, 1024] (default: all cores)")
-        ->check(CLI::Range(1, wul3d::kMaxThreads));
+        ->check(NumberIn(1, wul3d::kMaxThreads));
     cmd->add_option("--decimate", o.decimate,
                     "N in [1, 8]: run the stages on every N-th pixel in u and v (N^2 times fewer "
                     "points), results at the input's size (default 2; 1 with --preset paper)");
@@ -109,6 +126,19 @@ std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o) {
 
 void apply_threads(const PipelineOptions& o) {
     if (o.threads > 0) wul3d::set_num_threads(o.threads);
+}
+
+std::vector<std::string> input_paths(const PipelineOptions& o) {
+    std::vector<std::string> inputs;
+    if (!o.input.empty()) inputs.push_back(o.input);
+    if (!o.calibration.empty() && o.calibration != "kinect_v2") inputs.push_back(o.calibration);
+    if (!o.camera.empty()) {
+        const CameraSpec spec = parse_camera_spec(o.camera);
+        if (spec.backend == "openni2" && !spec.arg.empty()) inputs.push_back(spec.arg);
+        const char* fake = std::getenv("FAKENECT_PATH");
+        if (spec.backend == "freenect" && fake && *fake) inputs.emplace_back(fake);
+    }
+    return inputs;
 }
 
 }  // namespace wul3d::cli

@@ -51,4 +51,9 @@ std::optional<std::pair<int, int>> selected_pixel(const PipelineOptions& o);
 /// Applies --threads.
 void apply_threads(const PipelineOptions& o);
 
+/// The files and folders the command reads, for check_write_target (write_guard.hpp): the
+/// input, --calibration (not the kinect_v2 preset), an openni2:FILE.oni replay and, for
+/// freenect under fakenect, the dump of FAKENECT_PATH.
+std::vector<std::string> input_paths(const PipelineOptions& o);
+
 }  // namespace wul3d::cli

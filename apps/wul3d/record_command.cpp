@@ -11,9 +11,11 @@
 
 #include "cli.hpp"
 #include "frame_feed.hpp"
+#include "json_text.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/registration.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace fs = std::filesystem;
@@ -29,6 +31,8 @@ struct RecordOptions {
 
 void record(const RecordOptions& o) {
     if (o.input.camera.empty()) throw ParamError("record: --camera is required");
+    // Before the camera opens: a replay's own file or dump is never recorded over.
+    check_write_target(o.out_dir, WriteTarget::Folder, input_paths(o.input), "--out");
     install_stop_signals();
     FrameFeed feed(feed_options(o.input, SourceOptions{}), stop_requested);
     std::error_code ec;
@@ -65,7 +69,7 @@ void record(const RecordOptions& o) {
                               {"frames_captured", feed.captured()},
                               {"frames_dropped", feed.dropped()},
                               {"stopped_by", stopped_by}};
-    write_text_file((fs::path(o.out_dir) / "recording.json").string(), j.dump(2) + "\n");
+    write_text_file((fs::path(o.out_dir) / "recording.json").string(), json_text(j, 2) + "\n");
     std::cout << "wul3d: recorded " << written << " frames (" << feed.dropped()
               << " dropped) from " << feed.description() << " -> " << o.out_dir << std::endl;
     restore_signals();
@@ -84,7 +88,7 @@ void add_record_command(CLI::App& app) {
         ->required();
     cmd->add_option("-o,--out", o->out_dir, "Output folder (frame_NNNNNN/ per frame)")->required();
     cmd->add_option("--frames", o->max_frames, "Stop after N frames (default: Ctrl-C or the end)")
-        ->check(CLI::Range(1, 1 << 30));
+        ->check(NumberIn(1, 1 << 30));
     cmd->add_flag("--lossless", o->input.lossless,
                   "Capture waits for each frame to be written instead of dropping (replays)");
     cmd->add_flag("-q,--quiet", o->quiet, "No progress");

@@ -13,7 +13,9 @@
 #include "frame_feed.hpp"
 #include "pipeline_options.hpp"
 #include "video_writer.hpp"
+#include "wul3d/error.hpp"
 #include "wul3d/run.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 
@@ -67,15 +69,30 @@ public:
     void note(const std::string& text) override { std::cerr << "wul3d: note: " << text << "\n"; }
     void frame(const RunFrame& f) override {
         progress_.update(f.index + 1, f.total, f.fps);
-        if (video_)
-            video_->write(f.frame, f.result, f.selected, f.index,
-                          f.total ? f.total : f.index + 1,  // live without --frames: no end known
-                          f.fps, f.selected_object);
+        if (video_) {
+            try {
+                video_->write(f.frame, f.result, f.selected, f.index,
+                              f.total ? f.total : f.index + 1,  // live without --frames: no end known
+                              f.fps, f.selected_object);
+            } catch (...) {
+                video_.reset();  // its partial file goes; the run ends with this error
+                throw;
+            }
+        }
         objects_ += f.result.object_list.size();
     }
     void frames_done() override {
         progress_.finish();
-        if (video_) video_->close();
+        // The run loop records an error of close() in summary.json (and keeps the first
+        // error when the run had already failed).
+        if (!video_) return;
+        try {
+            video_->close();
+        } catch (...) {
+            video_.reset();  // its partial file goes
+            throw;
+        }
+        video_.reset();
     }
     void finished(const RunSummary& s) override {
         std::cout << std::fixed << std::setprecision(1) << "wul3d: " << s.frames << " frame"
@@ -102,7 +119,16 @@ struct SignalScope {
     SignalScope& operator=(const SignalScope&) = delete;
 };
 
+/// What can be known of --video before the first frame: a name FFmpeg writes a video
+/// under, and a target that is no input, link, folder or device (write_guard.hpp).
+void check_video_target(const RunCommandOptions& o) {
+    if (o.video.empty()) return;
+    check_video_name(o.video);
+    check_write_target(o.video, WriteTarget::File, input_paths(o.pipeline), "--video");
+}
+
 void run(const RunCommandOptions& o) {
+    check_video_target(o);  // before OUT is touched: a refused --video writes nothing
     RunOptions r;
     r.params = make_pipeline_params(o.pipeline);
     r.feed = feed_options(o.pipeline, make_source_options(o.pipeline));
@@ -136,7 +162,7 @@ void add_run_command(CLI::App& app) {
     cmd->add_option("-o,--out", opts->out_dir, "Output folder")->required();
     cmd->add_option("--frames", opts->max_frames,
                     "Stop after N frames (default: all; with --camera: until Ctrl-C or its end)")
-        ->check(CLI::Range(1, 1 << 30));
+        ->check(NumberIn(1, 1 << 30));
     cmd->add_flag("--ply", opts->ply, "Also write each frame's labelled cloud as binary PLY");
     cmd->add_flag("--overlay", opts->overlay,
                   "Also write OUT/<frame>/overlay.png: the objects tinted, outlined and numbered "

@@ -2,6 +2,7 @@
 #include "video_writer.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
@@ -98,6 +99,19 @@ void highlight_mask(const ColorImage& base, const std::vector<std::uint8_t>& mas
 }
 
 // ---- RunVideo ---------------------------------------------------------------------------
+
+void check_video_name(const fs::path& path) {
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    std::string known;
+    for (const char* e : kVideoExtensions) {
+        if (ext == e) return;
+        known += (known.empty() ? "" : ", ") + std::string(e);
+    }
+    throw ParamError("--video " + path.string() + ": " +
+                     (ext.empty() ? std::string("no extension") : "unknown extension " + ext) +
+                     "; a video is written as " + known);
+}
 
 namespace {
 
@@ -220,6 +234,11 @@ void RunVideo::write(const RgbdFrame& frame, const FrameResult& result,
     if (!impl_->writer) {
         // Even sizes: H.264 in yuv420p needs them.
         impl_->panel = cv::Size(result.colors.width & ~1, result.colors.height & ~1);
+        if (impl_->panel.width < 2 || impl_->panel.height < 2)
+            throw InputError(path_.string() + ": frame " + frame.name + " is " +
+                             std::to_string(result.colors.width) + "x" +
+                             std::to_string(result.colors.height) +
+                             ", too small for a video (at least 2x2)");
         const cv::Size size(3 * impl_->panel.width, impl_->panel.height);
         for (const char* codec : {"avc1", "mp4v"}) {
             impl_->writer =

@@ -33,6 +33,14 @@ inline constexpr std::uint8_t kSelectionOutline[3] = {255, 255, 255};
 
 // ---- the video --------------------------------------------------------------------------
 
+/// The extensions of the containers RunVideo writes (FFmpeg picks the container from it):
+/// .mp4, .m4v, .mov, .mkv, .avi.
+inline constexpr const char* kVideoExtensions[] = {".mp4", ".m4v", ".mov", ".mkv", ".avi"};
+
+/// Throws ParamError (one line, naming `path`) unless its extension is one of
+/// kVideoExtensions (any case): another name would fail only at the first frame.
+void check_video_name(const std::filesystem::path& path);
+
 /// Writes one video frame per pipeline frame: three panels of the frame's size side by side
 /// (colour | objects, tinted with their track ids and oriented 3D boxes | clusters, eq. 9),
 /// with the frame number and FPS in the first panel. The file plays at kVideoFps frames per second, H.264 (avc1) when FFmpeg has it,

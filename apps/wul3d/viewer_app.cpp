@@ -29,6 +29,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/objects.hpp"
 #include "wul3d/visualization.hpp"
+#include "wul3d/write_guard.hpp"
 
 namespace wul3d::cli {
 namespace {
@@ -932,6 +933,13 @@ void Viewer::draw_image(const char* title, ImageTexture& texture, const Rect& ar
 }
 
 void Viewer::take_screenshot(const std::string& path, bool scripted) {
+    try {
+        check_write_target(path, WriteTarget::File, cfg_.inputs, "screenshot");
+    } catch (const InputError& e) {
+        if (scripted) throw;
+        status_ = e.what();  // S in the window: said there, the viewer plays on
+        return;
+    }
     int w = 0, h = 0;
     glfwGetFramebufferSize(window_, &w, &h);
     write_color_png(path, read_framebuffer(w, h));

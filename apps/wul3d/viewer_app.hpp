@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
@@ -23,6 +24,7 @@ struct ViewerConfig {
                                                 ///< (u, v) of the first frame (selects and
                                                 ///< follows the object there)
     std::string screenshot;  ///< write the window here after exit_after frames, then exit
+    std::vector<std::string> inputs;  ///< what the view reads: no screenshot replaces them
     int exit_after = 0;      ///< frames to play before the screenshot and exit; 0 = until closed
     int width = 1600, height = 900;  ///< window size, screen pixels
     float orbit_yaw_deg = 0, orbit_pitch_deg = 0;  ///< first 3D view, turned from the sensor's

@@ -8,6 +8,7 @@
 ///
 /// Label 0 is background in both images; every other value is one object. Scores are
 /// fractions in [0, 1]; nothing here prints.
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -61,6 +62,14 @@ struct ImageScore {
     /// match), sorted by gt_id.
     std::vector<MatchedPair> matches;
 };
+
+/// The objects of an image pair are matched in groups that overlap (objects with no common
+/// pixel do not change the matching's score): at most this many (ground truth x prediction)
+/// pairs in one group, and in all the groups of an image. Beyond, score_image throws
+/// InputError before the matching allocates anything (a Hungarian over 20,000 x 20,000
+/// objects took 12.5 GB).
+inline constexpr std::size_t kMaxEvalGroupPairs = std::size_t{1} << 20;
+inline constexpr std::size_t kMaxEvalMatchPairs = std::size_t{1} << 22;
 
 /// Scores `pred` against `gt` (same size, else InputError). Overlap and boundary P/R/F of
 /// the one-to-one matching that maximises the sum of overlap F (Hungarian), and %>=75.

@@ -76,7 +76,8 @@ public:
     /// A remark for the user, one line (e.g. a frame without colour).
     virtual void note(const std::string& text) { (void)text; }
     virtual void frame(const RunFrame& f) { (void)f; }
-    /// No more frames will come; summary.json is not written yet.
+    /// No more frames will come; summary.json is not written yet. An error thrown here
+    /// ends the run as a frame's would (summary.json says it), unless one already did.
     virtual void frames_done() {}
     /// summary.json is written. A lost camera is thrown after this.
     virtual void finished(const RunSummary& summary) { (void)summary; }
