@@ -1,7 +1,8 @@
 #pragma once
 // A circle through 2D points: the rims of containers and the walls of round objects, on the
-// support plane (segmentation_rules.cpp). Header-only: the points come from a visitor, so the
-// callers map pixels to the plane without a copy, and the tests feed plain points.
+// support plane (segmentation/containers.cpp, segmentation/colour_cue.cpp). Header-only: the
+// points come from a visitor, so the callers map pixels to the plane without a copy, and the
+// tests feed plain points.
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>

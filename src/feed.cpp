@@ -2,6 +2,7 @@
 #include "wul3d/feed.hpp"
 
 #include "wul3d/error.hpp"
+#include "read_ahead.hpp"
 
 namespace wul3d {
 
@@ -19,8 +20,12 @@ FrameFeed::FrameFeed(const FeedOptions& o, std::function<bool()> stop)
     } else {
         if (o.lossless) throw ParamError("--lossless needs --camera");
         source_ = open_source(o.input, o.source);
+        if (o.read_ahead > 0)
+            ahead_ = std::make_unique<detail::ReadAhead>(*source_, source_->size(), o.read_ahead);
     }
 }
+
+FrameFeed::~FrameFeed() = default;
 
 const StereoCalibration* FrameFeed::calibration() const {
     return live_ ? live_->calibration() : source_->calibration();
@@ -38,7 +43,11 @@ FrameFeed::Status FrameFeed::poll(SourceItem& item, std::chrono::milliseconds ti
     if (stop_requested()) return Status::Stopped;
     if (!live_) {
         if (index_ >= source_->size()) return Status::End;
-        source_->read(index_, item);
+        if (ahead_) {
+            if (!ahead_->next(item)) return Status::End;
+        } else {
+            source_->read(index_, item);
+        }
         name_ = source_->name(index_++);
         got = true;
         return Status::Frame;

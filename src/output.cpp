@@ -225,6 +225,11 @@ void overlay_picture(const RgbdFrame& frame, const FrameResult& r, ColorImage& o
 
 void write_frame(const std::string& out_dir, const std::string& name, const Pipeline& pipeline,
                  const RgbdFrame& frame, const FrameResult& r, const FrameOutputs& extra) {
+    write_frame(out_dir, name, &pipeline.cloud(), frame, r, extra);
+}
+
+void write_frame(const std::string& out_dir, const std::string& name, const OrganizedCloud* cloud,
+                 const RgbdFrame& frame, const FrameResult& r, const FrameOutputs& extra) {
     check_frame_name(name);
     write_folder_atomic((fs::path(out_dir) / name).string(), [&](const std::string& dir) {
         const fs::path tmp_dir(dir);
@@ -243,8 +248,8 @@ void write_frame(const std::string& out_dir, const std::string& name, const Pipe
             overlay_picture(frame, r, picture);
             write_color_png((tmp_dir / "overlay.png").string(), picture);
         }
-        if (extra.ply && pipeline.cloud().size() == r.labels.labels.size()) {
-            write_ply((tmp_dir / "cloud.ply").string(), pipeline.cloud(), r.labels, r.colors);
+        if (extra.ply && cloud && cloud->size() == r.labels.labels.size()) {
+            write_ply((tmp_dir / "cloud.ply").string(), *cloud, r.labels, r.colors);
         } else if (extra.ply) {  // decimation: the results are at the input's size, the cloud not
             OrganizedCloud full;
             back_project(frame, full);

@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstring>
 #include <random>
+#include <thread>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -22,6 +23,7 @@
 #include "wul3d/output.hpp"
 #include "wul3d/stop.hpp"
 #include "wul3d/write_guard.hpp"
+#include "write_behind.hpp"
 
 namespace wul3d {
 namespace fs = std::filesystem;
@@ -244,9 +246,67 @@ nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const Ru
     summary["ms_per_frame_median"] = s.ms_per_frame_median;
     summary["fps"] = s.fps;
     summary["wall_s"] = s.wall_s;
+    summary["fps_end_to_end"] = s.end_to_end_fps;
     summary["peak_rss_mb"] = s.peak_rss_mb;
     if (selection.cluster) summary["selected_cluster"] = selection.cluster->cluster();
     return summary;
+}
+
+
+/// A processed frame on its way to disk (WriteBehind's job): what write_frame, frames.jsonl
+/// and the observer read, taken out of the pipeline so that the next frame can be processed
+/// while this one is written.
+struct PendingFrame {
+    std::string name;
+    SourceItem input;       // the frame as read (swapped in, not copied)
+    RgbdFrame registered;   // a raw frame's registration (copied: the pipeline keeps its own)
+    FrameResult result;     // the fields the outputs read (copied)
+    OrganizedCloud cloud;   // the stages' cloud, for cloud.ply; unused when `has_cloud` is false
+    bool has_cloud = false;
+    std::vector<std::uint8_t> cluster_mask, object_mask;
+    FrameOutputs outputs;   // its masks point into the two above
+    nlohmann::json line;    // frames.jsonl's line
+    double output_ms = 0;   // the writer's time
+
+    const RgbdFrame& frame() const { return input.is_raw ? registered : input.frame; }
+};
+
+/// Fills `p` with the frame just processed. Costs a copy of the result's images (a few MB at
+/// 640x480, reusing `p`'s buffers), against the PNG encoding it takes off the loop.
+void take_frame(PendingFrame& p, const std::string& name, SourceItem& item, const Pipeline& pipeline,
+                const FrameResult& r, const Selection& selection, const RunOptions& o) {
+    p.name = name;
+    std::swap(p.input, item);  // `item` gets p's old buffers for the next read
+    if (p.input.is_raw) p.registered = pipeline.registered();
+    FrameResult& c = p.result;  // not active, plane_classes, segments: no output reads them
+    c.labels = r.labels;
+    c.colors = r.colors;
+    c.objects = r.objects;
+    c.object_list = r.object_list;
+    c.active_points = r.active_points;
+    c.stats = r.stats;
+    c.plane = r.plane;
+    c.segment_stats = r.segment_stats;
+    c.times = r.times;
+    p.has_cloud = o.ply && pipeline.cloud().size() == r.labels.labels.size();
+    if (p.has_cloud) p.cloud = pipeline.cloud();
+    p.outputs = selection.outputs(o.ply, o.overlay);
+    if (p.outputs.selected) {
+        p.cluster_mask = *p.outputs.selected;
+        p.outputs.selected = &p.cluster_mask;
+    }
+    if (p.outputs.selected_object) {
+        p.object_mask = *p.outputs.selected_object;
+        p.outputs.selected_object = &p.object_mask;
+    }
+    p.line = frame_json(name, r);
+    if (selection.cluster) p.line["selected_pixels"] = selection.cluster->pixels();
+}
+
+/// Writer threads for a run: a quarter of the cores, 1 to 4 (a frame's outputs take about
+/// 1.5 times its processing on one core; more writers would take cores from the stages).
+int writer_threads() {
+    return std::clamp(static_cast<int>(std::thread::hardware_concurrency()) / 4, 1, 4);
 }
 
 }  // namespace
@@ -254,7 +314,9 @@ nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const Ru
 RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     RunObserver silent;
     RunObserver& obs = observer ? *observer : silent;
-    FrameFeed feed(o.feed, o.stop);
+    FeedOptions feed_options = o.feed;
+    feed_options.read_ahead = 2;  // the next frames decode while this one is processed
+    FrameFeed feed(feed_options, o.stop);
     check_out_apart_from_inputs(o);
     if (!feed.live()) {
         // Every name before the first frame: a run must not fail at frame 50,000 for it.
@@ -280,13 +342,49 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     FramesLog frames_log((out_dir / kFramesFile).string());
 
     RunSummary s;
+    const int writers = writer_threads();
+    detail::WriteBehind<PendingFrame> writes(
+        static_cast<std::size_t>(writers) + 2, writers, [&o](PendingFrame& p) {
+            const auto t0 = Clock::now();
+            write_frame(o.out_dir, p.name, p.has_cloud ? &p.cloud : nullptr, p.frame(), p.result,
+                        p.outputs);
+            p.output_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        });
+    // The oldest frame in flight, once written: its line in frames.jsonl, the observer, the
+    // count, on this thread and in frame order. False when none is (or, without `wait`, not
+    // yet). Rethrows its write's error.
+    bool write_failed = false;
+    auto commit = [&](bool wait) {
+        std::exception_ptr error;
+        const PendingFrame* p = writes.oldest(wait, error);
+        if (!p) return false;
+        writes.release();  // safe to read *p below: only next() refills a slot, on this thread
+        if (error) {
+            write_failed = true;
+            std::rethrow_exception(error);
+        }
+        log.add(p->result.times, p->output_ms);
+        frames_log.append(p->line);
+        const double fps = 1000.0 / std::max(1e-9, log.compute_ms.median());
+        obs.frame(RunFrame{p->name, s.frames, n_total, p->frame(), p->result, p->outputs.selected,
+                           p->outputs.selected_id, fps});
+        ++s.frames;
+        return true;
+    };
+
+    std::size_t taken = 0;      // frames processed and handed to the writers
     std::exception_ptr lost;    // DeviceLost: rethrown once the outputs are final
     std::exception_ptr failed;  // any other error: rethrown once summary.json is written
     try {
         for (;;) {
-            if (n_total && s.frames >= n_total) {
+            while (commit(false)) {}
+            if (n_total && taken >= n_total) {
                 s.stopped_by = feed.live() || n_total < feed.size() ? "frames" : "end";
                 break;
+            }
+            if (writes.full()) {
+                commit(true);
+                continue;
             }
             if (!feed.next_frame(item, s.stopped_by, lost)) break;
             const std::string name = feed.name();
@@ -300,32 +398,29 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
                 s.stopped_by = "signal";
                 break;
             }
-            const FrameResult& r = *result;
             const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
             if (!frame.has_color() && !said_depth_only) {
                 obs.note(name + " has no colour image; clustering on position and normals only");
                 said_depth_only = true;
             }
-            selection.update(r);
-
-            const auto t_out = Clock::now();
-            write_frame(o.out_dir, name, pipeline, frame, r, selection.outputs(o.ply, o.overlay));
-            log.add(r.times, std::chrono::duration<double, std::milli>(Clock::now() - t_out).count());
-            nlohmann::json f = frame_json(name, r);
-            if (selection.cluster) f["selected_pixels"] = selection.cluster->pixels();
-            frames_log.append(f);
-            const double fps = 1000.0 / std::max(1e-9, log.compute_ms.median());
-            obs.frame(RunFrame{name, s.frames, n_total, frame, r,
-                               selection.cluster ? &selection.cluster_mask : nullptr,
-                               selection.object_selected ? selection.object->label() : 0, fps});
-            ++s.frames;
+            selection.update(*result);
+            take_frame(writes.next(), name, item, pipeline, *result, selection, o);
+            writes.submit();
+            ++taken;
         }
+        while (commit(true)) {}
     } catch (const std::exception& e) {
         // A bad frame, a full disk: the frames before it are complete, and summary.json says
         // what ended the run.
         failed = std::current_exception();
         s.stopped_by = "error";
         s.error = e.what();
+        // The frames processed before a bad input frame are still written and listed; after
+        // a failed write, none is listed past it.
+        try {
+            while (!write_failed && commit(true)) {}
+        } catch (const std::exception&) {
+        }
     }
     obs.frames_done();
 
@@ -333,6 +428,7 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     s.fps = s.ms_per_frame_median > 0 ? 1000.0 / s.ms_per_frame_median : 0.0;
     s.peak_rss_mb = peak_rss_mb();
     s.wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
+    s.end_to_end_fps = s.wall_s > 0 ? static_cast<double>(s.frames) / s.wall_s : 0.0;
     if (lost) {
         try {
             std::rethrow_exception(lost);

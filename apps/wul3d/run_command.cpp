@@ -81,7 +81,8 @@ public:
         std::cout << std::fixed << std::setprecision(1) << "wul3d: " << s.frames << " frame"
                   << (s.frames == 1 ? "" : "s") << ", " << objects_ << " object"
                   << (objects_ == 1 ? "" : "s") << " in all, k = " << k_ << ": " << s.fps << " FPS ("
-                  << s.ms_per_frame_median << " ms/frame without disk I/O), peak "
+                  << s.ms_per_frame_median << " ms/frame without disk I/O), "
+                  << s.end_to_end_fps << " FPS end to end, peak "
                   << std::setprecision(0) << s.peak_rss_mb << " MB -> " << o_.out_dir
                   << std::endl;
     }

@@ -22,7 +22,14 @@ struct FeedOptions {
     std::string camera;     ///< a live camera, BACKEND[:ARG] (parse_camera_spec)
     bool lossless = false;  ///< camera only: capture waits for processing (replays, tests)
     SourceOptions source;   ///< how to read `input`
+    /// Recording only: frames read ahead on a thread of their own while the caller
+    /// processes the current one (0: each frame is read in next(), on the caller's thread).
+    std::size_t read_ahead = 0;
 };
+
+namespace detail {
+class ReadAhead;
+}
 
 class FrameFeed {
 public:
@@ -36,6 +43,9 @@ public:
     /// every 100 ms while a camera has none). Throws ParamError (both or neither of input
     /// and camera; --lossless without a camera) and what open_source / open_camera throw.
     explicit FrameFeed(const FeedOptions& options, std::function<bool()> stop = {});
+    ~FrameFeed();
+    FrameFeed(const FrameFeed&) = delete;
+    FrameFeed& operator=(const FrameFeed&) = delete;
 
     /// Blocks until the next frame, the end, or a stop request (polled every 100 ms).
     /// Throws DeviceLost when the camera disappears, InputError for a damaged recording.
@@ -67,6 +77,7 @@ private:
 
     std::unique_ptr<FrameSource> source_;
     std::unique_ptr<LiveSource> live_;
+    std::unique_ptr<detail::ReadAhead> ahead_;  // declared after source_: stops before it goes
     std::string input_;
     std::function<bool()> stop_;
     std::size_t index_ = 0;

@@ -75,5 +75,10 @@ struct FrameOutputs {
 void write_frame(const std::string& out_dir, const std::string& name, const Pipeline& pipeline,
                  const RgbdFrame& frame, const FrameResult& result,
                  const FrameOutputs& extra = {});
+/// The same with the cloud the stages ran on given directly (nullptr: cloud.ply is
+/// back-projected from `frame`), for a writer that no longer has the pipeline at hand.
+void write_frame(const std::string& out_dir, const std::string& name, const OrganizedCloud* cloud,
+                 const RgbdFrame& frame, const FrameResult& result,
+                 const FrameOutputs& extra = {});
 
 }  // namespace wul3d

@@ -60,6 +60,9 @@ struct RunSummary {
     double ms_per_frame_median = 0;  ///< the pipeline's time, no disk I/O
     double fps = 0;
     double wall_s = 0;
+    /// Frames a second of the whole run, reading and writing included (frames / wall_s):
+    /// what a user waits for. Reading ahead and writing behind overlap them with the work.
+    double end_to_end_fps = 0;
     double peak_rss_mb = 0;
 };
 

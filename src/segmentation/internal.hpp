@@ -1,7 +1,7 @@
 #pragma once
-// Private to src/segmentation*.cpp: the context every phase of segment_objects reads,
-// coordinates on the support plane, the union-find over segments, and the rules the driver
-// calls (segmentation_rules.cpp, segmentation_stacks.cpp, segmentation_occlusion.cpp).
+// Private to src/segmentation/ (not installed): the context every phase of segment_objects
+// reads, coordinates on the support plane, the union-find over segments, and the phases and
+// rules the driver (segmentation.cpp) calls, each defined in a file of its own.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -128,6 +128,15 @@ struct PlaneAxes {
     }
 };
 
+/// The points `for_pixels` visits (it calls its argument with each pixel) on the support
+/// plane, less `mean` (for the circle fit's conditioning): what fit_circle takes.
+template <class ForPixels>
+auto on_plane(const Ctx& x, const PlaneAxes& plane_xy, const Eigen::Vector2d& mean, ForPixels& for_pixels) {
+    return [&x, &plane_xy, &mean, &for_pixels](auto&& visit) {
+        for_pixels([&](std::size_t p) { visit(Eigen::Vector2d(plane_xy(x.c, p) - mean)); });
+    };
+}
+
 /// One region by breadth-first search from `seed` (the caller has marked it): every
 /// 4-neighbour q of a region pixel with is_open(q) and continuous depth is marked (mark(q))
 /// and joins. The region's pixels land in queue[0, size); returns the size. Shared by the
@@ -179,21 +188,80 @@ inline void relabel_to_roots(SegmentWorkspace& ws) {
         if (l) l = find_root(ws.parent, l);
 }
 
-// ---- the rules (segmentation_rules.cpp) ----------------------------------------------------
-// Each works on ws.label, segments numbered 1..n with gaps, and returns its count for
-// SegmentStats.
+// ---- the phases before the rules ---------------------------------------------------------
 
-/// What the container rule did: the joins, and the lone islands it kept as objects, which
-/// take labels n + 1 .. n + labels_added (with gaps).
-struct ContainerJoins {
-    int joins = 0;
-    int islands_kept = 0;
-    int labels_added = 0;
-};
+/// The normals of the crease tests (cuts.cpp): `normals` smoothed over normal_smooth_px into
+/// ws.smooth, or `normals` themselves when normal_smooth_px is 0.
+const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& normals,
+                                const std::vector<std::uint8_t>& classes, int W, int H, SegmentWorkspace& ws);
 
-/// Containers (SegmentParams, "Containers"): joins a container's inside, seen over its rim,
-/// to the container; with rim_islands, keeps the lone islands (keep_lone_islands).
-ContainerJoins join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
+/// The seeds into ws.cut (cuts.cpp): object pixels off concave creases, or with the kmeans
+/// segmenter off the boundaries of the paper's clusters (`clusters`, InputError when not the
+/// frame's). `has_normal`: the raw normals' validity. Sizes ws.cut, label, queue and dist to
+/// the frame. Cost: a few parallel passes over the pixels.
+void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& clusters, SegmentWorkspace& ws);
+
+/// The segments (components.cpp): connected components of the seeds into ws.label, 1..n,
+/// fragments under min_seed_points unlabelled again. Returns n.
+int seed_components(const Ctx& x, SegmentWorkspace& ws);
+
+/// Cut pixels, feet, pixels without a normal and dropped fragments join the segment they
+/// touch (up to reattach_px, where depth is continuous), then containers' insides, however
+/// wide (components.cpp). Returns the pixels added.
+std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws);
+
+/// The segments of min_points or more into `out`, renumbered 1..n (components.cpp). Returns n.
+int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out);
+
+// ---- the rules, in the driver's order ----------------------------------------------------
+
+/// A rule on segments: reads and writes ws.label (segments 1..n with gaps), numbers the
+/// segments it adds n + 1, ... and adds them to n, and counts what it did into `stats`.
+/// `support`: the support plane, nullptr when none was found (the rules that need one are
+/// run only with one, or do nothing without).
+using Rule = void (*)(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// The convexity merge (merge.cpp): joins segments that meet along a boundary that is mostly
+/// not concave. stats.merges.
+void merge_segments(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// Containers (containers.cpp; SegmentParams, "Containers"): joins a container's inside,
+/// seen over its rim, to the container; with rim_islands, keeps the lone islands
+/// (lone_islands.cpp). Nothing without a support. stats.containers, islands_kept.
+void join_containers(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// The colour cue (colour_cue.cpp; hybrid): splits segments in two by colour; ws.origin
+/// holds each label's segment before the cue. stats.color_splits, texture_splits (those
+/// between a texture and another material, SegmentParams::color_textures).
+void split_by_colour(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// The convexity merge again after the colour cue split anything (merge.cpp;
+/// SegmentParams::color_rejoin), between the parts of different segments that are one
+/// material. Adds to stats.merges.
+void rejoin_materials(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// Stacks (stacks.cpp; SegmentParams, "Stacks"; `support` not null): cuts a segment whose
+/// upward faces lie at two heights in two. stats.stack_splits.
+void split_stacks(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// Floor gaps (floor_gaps.cpp; SegmentParams::gap_max_px): small unlabelled patches beside a
+/// container's inside, enclosed by one segment, join it. stats.gaps_filled.
+void fill_floor_gaps(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// Occlusion (occlusion.cpp; SegmentParams, "Occlusion"): joins the two parts of a surface
+/// that a nearer object divides in view. stats.occluded.
+void join_occluded(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+/// Scope::Support (scope.cpp; docs/DESIGN.md, "Scope"; `support` not null): clears the
+/// labels of the segments the support does not hold. stats.support_scope, out_of_scope.
+void restrict_to_support(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+
+// ---- islands (lone_islands.cpp), for the container rule ------------------------------------
+
+/// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
+/// segment reached, of min_seed_points or more, become segments n + 1, ... for the rim
+/// test. Returns the islands added.
+int add_islands(const Ctx& x, SegmentWorkspace& ws, int n);
 
 /// Lone islands (SegmentParams::island_min_width_px): of the islands n + 1 .. n + islands in
 /// ws.label, those the rim test joined to nothing, keeps each that meets no segment across
@@ -202,28 +270,5 @@ ContainerJoins join_containers(const Ctx& x, const Plane& pl, SegmentWorkspace& 
 /// islands kept. Cost: a vectorized test per row, four neighbours of each island pixel, and
 /// a pass over the rows that hold islands.
 int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands);
-
-/// Floor gaps (SegmentParams::gap_max_px): small unlabelled patches beside a container's
-/// inside, enclosed by one segment, join it. Returns the points filled.
-std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws);
-
-/// Stacks (SegmentParams, "Stacks"; segmentation_stacks.cpp): cuts a segment whose upward
-/// faces lie at two heights in two, the upper object's part numbered n + 1, n + 2, ... in
-/// segment order. Returns the cuts.
-int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
-
-/// The colour cue (hybrid): splits segments in two by colour; the new parts are numbered
-/// n + 1, n + 2, ... in segment order; ws.origin holds each label's segment before the cue.
-/// Returns the splits; `by_material` gets those between a texture and another material
-/// (SegmentParams::color_textures).
-int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material);
-
-/// Occlusion (SegmentParams, "Occlusion"): joins the two parts of a surface that a nearer
-/// object divides in view. Returns the joins.
-int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n);
-
-/// Scope::Support (docs/DESIGN.md, "Scope"): clears the labels of the segments the support
-/// does not hold. Returns the segments of min_points or more left out.
-int restrict_to_support(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n);
 
 }  // namespace wul3d::detail

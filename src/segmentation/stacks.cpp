@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "segmentation_internal.hpp"
+#include "internal.hpp"
 
 namespace wul3d::detail {
 namespace {
@@ -262,9 +262,10 @@ int cut_layers(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_w
     return next - n;
 }
 
-}  // namespace
-
-int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+/// The stack rule over segments 1..n (with gaps): the layers of each segment's upward faces,
+/// where to cut, which walls go up with the upper object (hybrid), then the cuts. Returns
+/// the cuts.
+int split_by_height(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
     if (x.prm.stack_min_step_m <= 0) return 0;
     const int bins = static_cast<int>(std::ceil(x.prm.scope_max_height_m / kLayerBinM));
     count_layers(x, pl, ws, n, bins);
@@ -281,6 +282,13 @@ int split_stacks(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
         ws.wall_maps.assign(static_cast<std::size_t>(n) + 1, {});  // no maps
     }
     return cut_layers(x, pl, axes, sin_wall, ws, n);
+}
+
+}  // namespace
+
+void split_stacks(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+    stats.stack_splits = split_by_height(x, *support, ws, n);
+    n += stats.stack_splits;
 }
 
 }  // namespace wul3d::detail

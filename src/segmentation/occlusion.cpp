@@ -7,7 +7,7 @@
 #include <cstring>
 #include <vector>
 
-#include "segmentation_internal.hpp"
+#include "internal.hpp"
 
 namespace wul3d::detail {
 namespace {
@@ -125,8 +125,6 @@ void collect_lines(const Ctx& x, SegmentWorkspace& ws, float cos_max) {
     }
 }
 
-}  // namespace
-
 /// The occlusion rule (SegmentParams, "Occlusion"). Each line of evidence (collect_lines,
 /// cross_occluder) that lands on another segment b lying on a's plane says that a and b are
 /// one surface with the occluder before its middle. A pair joins with occluded_min_lines
@@ -134,7 +132,7 @@ void collect_lines(const Ctx& x, SegmentWorkspace& ws, float cos_max) {
 /// steps: one line's tolerance takes the sensor's noise, the mean takes two faces a little
 /// apart. In: ws.label (1..n with gaps). Out: ws.label with the pairs joined. Cost:
 /// collect_lines; a sort of the lines; a relabel pass when anything joined.
-int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n) {
+int join_across_occluders(const Ctx& x, SegmentWorkspace& ws, int n) {
     const SegmentParams& prm = x.prm;
     if (prm.occluded_min_lines <= 0 || n < 2) return 0;
     collect_lines(x, ws, std::cos(prm.occluded_max_deg * kDegToRad));
@@ -155,6 +153,12 @@ int join_occluded(const Ctx& x, SegmentWorkspace& ws, int n) {
     }
     if (joins > 0) relabel_to_roots(ws);
     return joins;
+}
+
+}  // namespace
+
+void join_occluded(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+    stats.occluded = join_across_occluders(x, ws, n);
 }
 
 }  // namespace wul3d::detail

@@ -1,0 +1,740 @@
+// The colour cue (the hybrid segmenter): two objects of two colours standing flush, front
+// and top faces coplanar, meet along no crease and no depth step, and only their colours
+// tell them apart. Each segment is split in two by 2-means under the paper's distance (eq.
+// 4, 6) with a colour-heavy alpha, and the split is kept only when the parts differ in
+// colour, are large and meet as two objects do (one side of the smaller part, or round a
+// compact piece), across a smooth surface or with a turn of colour, on a segment that does
+// not stand round (a can's label is print). Where 2-means follows a texture, the split is
+// judged between the segment's materials instead.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "../circle_fit.hpp"
+#include "internal.hpp"
+#include "wul3d/clustering.hpp"  // ClusterParams: the colour cue's alpha and delta
+
+namespace wul3d::detail {
+
+namespace {
+
+/// Counting sort of the segments' pixels by segment (background left out): segment l's
+/// pixels are ws.order[ws.offsets[l], ws.offsets[l + 1]), in raster order. Per fixed band of
+/// rows in parallel: counts per band, then each band writes from its own start (segment by
+/// segment, bands in order). In: ws.label (0..n). Cost: two parallel passes over the pixels,
+/// O(8 n) between them.
+void sort_pixels_by_segment(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const int W = x.W;
+    constexpr int kSortBands = 8;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    ws.remap.assign(kSortBands * L, 0);  // per band: counts, then write positions
+    const int H = x.H;
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kSortBands; ++band) {
+        int* const count = ws.remap.data() + static_cast<std::size_t>(band) * L;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
+        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p)
+            ++count[static_cast<std::size_t>(ws.label[p])];
+    }
+    ws.offsets.assign(L + 1, 0);  // segment l's pixels: order[offsets[l], offsets[l + 1])
+    int position = 0;
+    for (std::size_t l = 1; l < L; ++l) {
+        ws.offsets[l] = position;
+        for (int band = 0; band < kSortBands; ++band) {
+            int& slot = ws.remap[static_cast<std::size_t>(band) * L + l];
+            const int count = slot;
+            slot = position;
+            position += count;
+        }
+    }
+    ws.offsets[L] = position;
+    ws.order.resize(static_cast<std::size_t>(position));
+#pragma omp parallel for schedule(static)
+    for (int band = 0; band < kSortBands; ++band) {
+        int* const next = ws.remap.data() + static_cast<std::size_t>(band) * L;
+        const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
+        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p) {
+            const int l = ws.label[p];
+            if (l) ws.order[static_cast<std::size_t>(next[l]++)] = static_cast<int>(p);
+        }
+    }
+}
+
+int segment_size(const SegmentWorkspace& ws, int l) {
+    return ws.offsets[static_cast<std::size_t>(l) + 1] - ws.offsets[static_cast<std::size_t>(l)];
+}
+
+/// One plane, for the brightness step (judge_split): the normals a crease step either side
+/// of the boundary within this angle. The smallest that gains on the generated tune seeds
+/// (3 degrees left out their boxes' faces), well under the smooth test's 15, which took in
+/// a white bowl's lit and shaded sides on the RealSense frames (docs/ABLATION.md).
+constexpr float kStepPlaneDeg = 5.0f;
+
+/// The 2-means features of the segments' pixels, one plane each in segment order so that
+/// every pass over a segment reads contiguous memory.
+struct ColourFeatures {
+    const float* f[6];  ///< delta x, y, z, then alpha times the chromaticity r, g, b
+    int first;          ///< the position in ws.order of every plane's element 0
+};
+
+/// Gathers ColourFeatures into ws.feature, scaled by the paper's delta and alpha (eq. 4) so
+/// that a squared distance is a sum. Only the segments' pixels (order positions first..last)
+/// are gathered: plane q holds position i at f[q][i - first], sized by the object pixels, not
+/// the image. In: ws.order, ws.offsets. Cost: one parallel pass over the object pixels.
+ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWorkspace& ws, int n) {
+    const int first = ws.offsets[1], last = ws.offsets[static_cast<std::size_t>(n) + 1];
+    const std::size_t M = static_cast<std::size_t>(last - first);
+    ws.feature.resize(6 * M);
+    float* f[6];
+    for (int q = 0; q < 6; ++q) f[q] = ws.feature.data() + static_cast<std::size_t>(q) * M;
+    // The colour term is the chromaticity (chromaticity()): light falling on two faces of
+    // one box at other angles scales their colour and leaves it, so the two parts are two
+    // materials, not a lit face and a shaded one.
+#pragma omp parallel for schedule(static)
+    for (int i = first; i < last; ++i) {
+        const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(i)]);
+        f[0][i - first] = cp.delta * x.c.x[p];
+        f[1][i - first] = cp.delta * x.c.y[p];
+        f[2][i - first] = cp.delta * x.c.z[p];
+        float c[3];
+        chromaticity(x.c, p, c);
+        f[3][i - first] = cp.alpha * c[0];
+        f[4][i - first] = cp.alpha * c[1];
+        f[5][i - first] = cp.alpha * c[2];
+    }
+    return {{f[0], f[1], f[2], f[3], f[4], f[5]}, first};
+}
+
+/// The segments of this round (ws.to_try) large enough to split (2 x min_points), largest
+/// first, into ws.by_size: tried in parallel, no thread is left with a big one at the end.
+/// Cost: O(n log n).
+void order_by_size(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+    ws.by_size.clear();
+    for (int l = 1; l <= n; ++l)
+        if (ws.to_try[static_cast<std::size_t>(l)] && segment_size(ws, l) >= 2 * prm.min_points)
+            ws.by_size.push_back(l);
+    std::stable_sort(ws.by_size.begin(), ws.by_size.end(),
+                     [&](int a, int b) { return segment_size(ws, a) > segment_size(ws, b); });
+}
+
+/// The position among the m pixels of one segment's planes `f` farthest in colour from
+/// (r, g, b); the first on ties.
+int farthest_colour(const float* const* f, int m, double r, double g, double b) {
+    const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
+    int best = 0;
+    double bd = -1;
+    for (int i = 0; i < m; ++i) {
+        const double dr = cr[i] - r, dg = cg[i] - g, db = cb[i] - b;
+        const double d = dr * dr + dg * dg + db * db;
+        if (d > bd) { bd = d; best = i; }
+    }
+    return best;
+}
+
+/// The principal axis of a 3 x 3 covariance (unit length) and its variance, by power
+/// iteration from the axis of the largest diagonal entry. Cost: O(1).
+double principal_axis(const double (&cov)[3][3], double (&e)[3]) {
+    e[0] = e[1] = e[2] = 0;
+    e[cov[0][0] >= cov[1][1] && cov[0][0] >= cov[2][2] ? 0 : cov[1][1] >= cov[2][2] ? 1 : 2] = 1;
+    double variance = 0;
+    for (int it = 0; it < 20; ++it) {
+        double next[3];
+        for (int a = 0; a < 3; ++a) next[a] = cov[a][0] * e[0] + cov[a][1] * e[1] + cov[a][2] * e[2];
+        const double len = std::sqrt(next[0] * next[0] + next[1] * next[1] + next[2] * next[2]);
+        if (!(len > 0)) break;
+        for (int a = 0; a < 3; ++a) e[a] = next[a] / len;
+        variance = len;
+    }
+    return variance;
+}
+
+/// 2-means seeds for one segment (planes `f`, m pixels) in `cen`: the mean colour plus and
+/// minus one standard deviation along the colours' principal axis, both at the mean
+/// position. Seeds at the farthest colours (the pixel farthest from the mean, then the one
+/// farthest from it) let a few outlying pixels, the feet a segment took from the table or
+/// a line of mixed colour at an edge, pull 2-means into a part of their own, which the
+/// share test then rejects; they move the principal axis little (generated tune seeds
+/// 88.5 -> 89.8 Overlap F, docs/ABLATION.md). False, and no seeds, when the colour spread
+/// cannot hold parts `min_spread` apart (feature units). `total`: the planes' sums (in
+/// double, pixel order), which two_means needs too. Cost: three passes over the segment's
+/// planes.
+bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6], double (&total)[6]) {
+    double mean[6];
+    for (int q = 0; q < 6; ++q) {
+        total[q] = 0;
+        for (int i = 0; i < m; ++i) total[q] += f[q][i];
+        mean[q] = total[q] / m;
+    }
+    const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
+    // The parts' mean colours lie among the segment's colours, so they are at most the
+    // segment's colour diameter apart, at most twice the farthest colour from the mean:
+    // below the minimum distance no split can be kept.
+    {
+        const int a0 = farthest_colour(f, m, mean[3], mean[4], mean[5]);
+        const double dr = cr[a0] - mean[3], dg = cg[a0] - mean[4], db = cb[a0] - mean[5];
+        if (2 * std::sqrt(dr * dr + dg * dg + db * db) < min_spread) return false;
+    }
+    double cov[3][3] = {};
+    for (int i = 0; i < m; ++i) {
+        const double d[3] = {cr[i] - mean[3], cg[i] - mean[4], cb[i] - mean[5]};
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) cov[a][b] += d[a] * d[b];
+    }
+    double e[3];
+    const double sd = std::sqrt(principal_axis(cov, e) / m);
+    for (int q = 0; q < 6; ++q) {
+        const double step = q < 3 ? 0.0 : sd * e[q - 3];
+        cen[0][q] = static_cast<float>(mean[q] + step);
+        cen[1][q] = static_cast<float>(mean[q] - step);
+    }
+    return true;
+}
+
+/// 2-means (eq. 4 squared) on one segment's feature planes, m pixels, from the centres `cen`:
+/// side[i] gets pixel i's part, `cen` the parts' means and `count` their sizes (the last
+/// iteration's; a part may be empty). `total`: the planes' sums (seed_centres'); part 0's
+/// sums are the totals minus part 1's. Cost: at most 6 passes over the 6 planes, stopping
+/// when no pixel changes part; float sums per block of 1024, added up in double; no
+/// allocation.
+void two_means(const float* const* planes, int m, const double (&total)[6], std::uint8_t* side, float (&cen)[2][6],
+               int (&count)[2]) {
+    const float* f[6];  // a local copy: the stores to `side` cannot alias it
+    for (int q = 0; q < 6; ++q) f[q] = planes[q];
+    for (int it = 0; it < 6; ++it) {
+        // Nearer centre 1 than centre 0 (eq. 4 squared): |f - c1|^2 < |f - c0|^2, i.e.
+        // 2 f . (c0 - c1) < |c0|^2 - |c1|^2, a linear test per pixel.
+        float w[6], bias = 0;
+        for (int q = 0; q < 6; ++q) {
+            w[q] = 2.0f * (cen[0][q] - cen[1][q]);
+            bias += cen[0][q] * cen[0][q] - cen[1][q] * cen[1][q];
+        }
+        double sum1[6] = {};
+        int ones = 0, changed = 0;
+        constexpr int kBlock = 1024;  // float partial sums per block, added up in double
+        for (int i0 = 0; i0 < m; i0 += kBlock) {
+            const int i1 = std::min(m, i0 + kBlock);
+            float block[6] = {};
+            int block_ones = 0, block_changed = 0;
+            // The sides first, in a loop that vectorizes (one pixel per lane, each dot in
+            // the same order); then the sums, pixel after pixel as before (a float sum
+            // reordered would round otherwise).
+            for (int i = i0; i < i1; ++i) {
+                float dot = 0;
+                for (int q = 0; q < 6; ++q) dot += w[q] * f[q][i];
+                const std::uint8_t j = dot < bias;
+                block_changed += j != side[i];
+                side[i] = j;
+                block_ones += j;
+            }
+            // Part 1's pixels only: a pixel of part 0 would add 0 * f = +-0, which changes
+            // no sum (the features are finite).
+            for (int i = i0; i < i1; ++i)
+                if (side[i])
+                    for (int q = 0; q < 6; ++q) block[q] += f[q][i];
+            for (int q = 0; q < 6; ++q) sum1[q] += block[q];
+            ones += block_ones;
+            changed += block_changed;
+        }
+        count[1] = ones;
+        count[0] = m - ones;
+        if (count[0] == 0 || count[1] == 0) break;
+        for (int q = 0; q < 6; ++q) {
+            cen[1][q] = static_cast<float>(sum1[q] / count[1]);
+            cen[0][q] = static_cast<float>((total[q] - sum1[q]) / count[0]);
+        }
+        if (it > 0 && changed == 0) break;  // converged: further iterations repeat this one
+    }
+}
+
+/// Where the parts of a split segment meet.
+struct SplitBoundary {
+    int boundary = 0;       ///< 4-neighbour pairs inside the segment with different parts
+    int with_normals = 0;   ///< ... with normals a crease step away on either side
+    int smooth = 0;         ///< ... whose normals lie within color_max_crease_deg
+    int on_plane = 0;       ///< ... of those, on one plane (kStepPlaneDeg)
+    int steps[2] = {0, 0};  ///< ... of those, where part 0's side (steps[0]) or part 1's
+                            ///< is color_min_step times brighter a crease step away
+    int small_outline = 0;  ///< 4-neighbour pairs from the smaller part to anything else
+};
+
+/// Calls visit(q, du, dv) for each 4-neighbour q of pixel p to its right (du = 1) or below
+/// (dv = 1) that lies in segment l in another part (ws.part): each boundary pair inside the
+/// segment once. Cost: two lookups.
+template <class Visit>
+void for_part_boundary_pairs(const Ctx& x, const SegmentWorkspace& ws, int l, int p, Visit&& visit) {
+    const int W = x.W, u = p % W, v = p / W;
+    const std::uint8_t* const part = ws.part.data();
+    if (u + 1 < W && ws.label[static_cast<std::size_t>(p) + 1] == l && part[p + 1] != part[p]) visit(p + 1, 1, 0);
+    if (v + 1 < x.H && ws.label[static_cast<std::size_t>(p + W)] == l && part[p + W] != part[p]) visit(p + W, 0, 1);
+}
+
+/// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part), its
+/// brightness steps on one plane, and the smaller part's outline. Cost: one pass over the
+/// segment's pixels and their neighbours.
+SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
+                             std::uint8_t small_part, float cos_crease) {
+    const int W = x.W, s = x.prm.crease_step_px;
+    const std::uint8_t* const part = ws.part.data();
+    // One plane: within kStepPlaneDeg, and smooth whatever color_max_crease_deg says.
+    const float cos_plane = std::max(std::cos(kStepPlaneDeg * kDegToRad), cos_crease);
+    auto brightness = [&](int p) { return static_cast<float>(x.c.r[p] + x.c.g[p] + x.c.b[p]) + kDark; };
+    SplitBoundary sb;
+    for (int i = 0; i < m; ++i) {
+        const int p = px[i];
+        const int u = p % W, v = p / W;
+        if (part[p] == small_part) {
+            for (const int q : four_neighbours(p, u, v, W, x.H))
+                sb.small_outline += q < 0 || ws.label[q] != l || part[q] != small_part;
+        }
+        for_part_boundary_pairs(x, ws, l, p, [&](int q, int du, int dv) {
+            ++sb.boundary;
+            const int pu = u - s * du, pv = v - s * dv;
+            const int qu = u + du + s * du, qv = v + dv + s * dv;
+            if (pu < 0 || pv < 0 || qu >= W || qv >= x.H) return;
+            const int a = pv * W + pu, b = qv * W + qu;
+            if (!x.n.valid[a] || !x.n.valid[b]) return;
+            const float cos_ab = x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b];
+            sb.smooth += cos_ab >= cos_crease;
+            ++sb.with_normals;
+            // A step in brightness counts on one plane only (a lies on p's side, b on q's):
+            // light falls alike there, while a curved surface turns from it (a bowl's lit
+            // and shaded sides).
+            if (cos_ab < cos_plane) return;
+            ++sb.on_plane;
+            const float ia = brightness(a), ib = brightness(b);
+            sb.steps[part[p]] += ia >= x.prm.color_min_step * ib;
+            sb.steps[part[q]] += ib >= x.prm.color_min_step * ia;
+        });
+    }
+    return sb;
+}
+
+/// Whether the pixels px[0, m) of one segment stand round on the support pl: a quarter of
+/// them or more are walls (normals within color_round_deg of the plane), the walls lie on
+/// one upright circle (fit_circle on the plane, as the containers' rims: RMS within
+/// rim_max_residual_m at any depth, spanning rim_min_arc of the diameter, radius up to
+/// color_round_max_radius_m) and three quarters of them face within color_round_deg of its
+/// radii. A can, a bottle or a cup is one solid of revolution; two objects flush in view
+/// show flat faces. Cost: two passes and fit_circle's six over the m pixels.
+bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, const int* px, int m) {
+    const SegmentParams& prm = x.prm;
+    const float sin_wall = std::sin(prm.color_round_deg * kDegToRad);
+    auto for_walls = [&](auto&& visit) {
+        for (int i = 0; i < m; ++i) {
+            const auto p = static_cast<std::size_t>(px[i]);
+            if (faces_sideways(x, pl, p, sin_wall)) visit(p);
+        }
+    };
+    double walls = 0;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for_walls([&](std::size_t p) {
+        ++walls;
+        mean += plane_xy(x.c, p);
+    });
+    if (walls < 3 || 4 * walls < m) return false;
+    mean /= walls;
+    const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_walls));
+    const Eigen::Vector2d centre = fit.centre;
+    const double R = fit.radius;
+    if (!std::isfinite(R) || R > prm.color_round_max_radius_m) return false;
+    const double cos_radial = std::cos(prm.color_round_deg * kDegToRad);
+    // Residual, the walls' extent (the diagonal of their box on the plane) and how many
+    // face along a radius (either way: a cup's inside faces in).
+    double res = 0, radial = 0;
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::max()), hi = -lo;
+    for_walls([&](std::size_t p) {
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean - centre;
+        const double r = d.norm();
+        res += (r - R) * (r - R);
+        const Eigen::Vector3d nrm(x.n.nx[p], x.n.ny[p], x.n.nz[p]);
+        const Eigen::Vector2d n2(nrm.dot(plane_xy.e1), nrm.dot(plane_xy.e2));  // the normal on the plane
+        radial += std::fabs(n2.dot(d)) >= cos_radial * n2.norm() * r;
+        lo = lo.cwiseMin(d);
+        hi = hi.cwiseMax(d);
+    });
+    return std::sqrt(res / walls) <= prm.rim_max_residual_m && (hi - lo).norm() >= prm.rim_min_arc * 2 * R &&
+           4 * radial >= 3 * walls;
+}
+
+/// Boundary pairs on one plane that a brightness step needs: as many as the convexity
+/// merge tests.
+constexpr int kMinStepPairs = 6;
+
+/// What the colour cue's tests say of a split.
+enum class Verdict {
+    kKept,
+    kTexture,  ///< the boundary runs round many pieces: the parts follow a texture
+    kRejected,
+};
+
+/// The colour cue's tests (SegmentParams, "Colour cue") of a split of segment l: pixels
+/// px[0, m), parts in ws.part, part sizes `count` and means `cen` (feature units). Cost: one
+/// pass over the segment's pixels for the boundary; the round test's three more, on a
+/// support, when every other test passed.
+Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ClusterParams& cp,
+                    float cos_crease, const SegmentWorkspace& ws, int l, const int* px, int m, const int (&count)[2],
+                    const float (&cen)[2][6]) {
+    const SegmentParams& prm = x.prm;
+    const int small = std::min(count[0], count[1]);
+    if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m))
+        return Verdict::kRejected;
+    const float dr = (cen[0][3] - cen[1][3]) / cp.alpha, dg = (cen[0][4] - cen[1][4]) / cp.alpha,
+                db = (cen[0][5] - cen[1][5]) / cp.alpha;
+    const bool far_in_colour = std::sqrt(dr * dr + dg * dg + db * db) >= prm.color_min_distance;
+    if (!far_in_colour && !(prm.color_min_step > 1)) return Verdict::kRejected;
+    // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
+    // crease step away on either side tell a smooth surface from a fold.
+    const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
+    const SplitBoundary sb = split_boundary(x, ws, l, px, m, small_part, cos_crease);
+    // A contact between two objects is one side of the smaller one's outline, or, where the
+    // larger one encloses it in view (a box lying on a box, seen from above), the whole
+    // outline of a compact piece: 4 sqrt(pixels) for a square, 6 for a 6:1 rectangle. A
+    // split along a texture (stripes, checks, print) runs round most of each of its many
+    // pieces, far longer than either.
+    const bool one_side = static_cast<float>(sb.boundary) <= prm.color_max_boundary * static_cast<float>(sb.small_outline);
+    const bool compact = static_cast<double>(sb.boundary) <= prm.color_max_compact * std::sqrt(static_cast<double>(small));
+    if (!one_side && !compact) return Verdict::kTexture;
+    // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
+    // straddle its edge), or the parts must differ in chromaticity: light falling on two
+    // faces of one box at other angles scales their colour, it does not turn it, so
+    // across a fold (a flat box on another, flush boxes of two heights) only a change of
+    // material turns the mean colour by color_min_hue_deg. Or, either way, a step in
+    // brightness along the boundary where it crosses one plane: light falls alike on both
+    // sides there, so only a change of material (two flush boxes of one hue, a light and a
+    // dark one, which the chromaticity cannot tell apart) makes one side brighter, along
+    // most of the crossing, in one direction. Most: half the smooth crossing or more lies on
+    // one plane (a curved surface's does not: a white bowl's shaded floor, 6 of 52), and 70 %
+    // of that steps (DESIGN.md, "The brightness step").
+    const bool brightness_step = prm.color_min_step > 1 && sb.on_plane >= kMinStepPairs &&
+                                 2 * sb.on_plane >= sb.smooth &&
+                                 10 * std::max(sb.steps[0], sb.steps[1]) >= 7 * sb.on_plane;
+    if (!far_in_colour && !brightness_step) return Verdict::kRejected;
+    const bool across_smooth = sb.with_normals > 0 && 10 * sb.smooth >= 7 * sb.with_normals;
+    if (!across_smooth && !brightness_step) {
+        const float r0 = cen[0][3], g0 = cen[0][4], b0c = cen[0][5];
+        const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
+        const float dot = r0 * r1 + g0 * g1 + b0c * b1c;
+        const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
+        if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) return Verdict::kRejected;
+    }
+    // Last, as it is the rarest to fail: a round thing's colours are print.
+    if (support && prm.color_round_deg > 0 && stands_round(x, *plane_xy, *support, px, m)) return Verdict::kRejected;
+    return Verdict::kKept;
+}
+
+// ---- the colour cue's materials ------------------------------------------------------------
+//
+// 2-means follows a texture when one object of the segment is textured: stripes of two
+// colours beside a plain box put the stripes in two parts and the box with one of them.
+// More colours then: the texture's two, the plain one's, and one for the rest. Two colours
+// whose contact is far longer than any two objects' (they interleave) are one material; the
+// split is between the materials.
+
+/// Colours per segment when 2-means followed a texture: a textured object's two, a plain
+/// one's beside it, and one more for what fits none (mixed pixels along edges, a third
+/// colour). Chosen on the generated tune seeds: 3, 4 and 5 colours scored 92.8, 93.1 and
+/// 92.9 Overlap F, learnt from every pixel (docs/ABLATION.md, "Textures").
+constexpr int kTextureColours = 4;
+
+/// k-means learns the colours from at most this many pixels per colour (every stride-th
+/// pixel), then gives every pixel its nearest once: FAISS's Clustering subsamples its
+/// training set the same way (max_points_per_centroid, 256 by default).
+constexpr int kSamplesPerColour = 256;
+
+/// The centre nearest pixel i's features (eq. 4 squared): |f - c_k|^2 less |f|^2, i.e.
+/// |c_k|^2 - 2 f . c_k, from `w` = 2 c_k and `bias` = |c_k|^2. Branch-free, so that a loop
+/// over pixels vectorizes.
+inline std::uint8_t nearest_colour(const float* const* f, int i, const float (&w)[kTextureColours][6],
+                                   const float (&bias)[kTextureColours]) {
+    std::uint8_t best = 0;
+    float best_d = 0;
+    for (int k = 0; k < kTextureColours; ++k) {
+        float d = bias[k];
+        for (int q = 0; q < 6; ++q) d -= w[k][q] * f[q][i];
+        const bool nearer = k == 0 || d < best_d;
+        best_d = nearer ? d : best_d;
+        best = nearer ? static_cast<std::uint8_t>(k) : best;
+    }
+    return best;
+}
+
+/// k-means (eq. 4 squared, on the 2-means features `f` of the m pixels) with
+/// kTextureColours centres, seeded at the two 2-means parts' means `two` and then, one by
+/// one, at the colour farthest from the centres so far; learnt from every stride-th pixel
+/// (at most kSamplesPerColour per colour, copied together). cluster[i] gets pixel i's
+/// colour, `cen` and `count` the colours' means (of the samples) and sizes (of all pixels).
+/// Cost: at most 8 passes over the samples (the nearest colours vectorized), then one over
+/// the m pixels; 28 KB of stack, no allocation.
+void texture_colours(const float* const* f, int m, const float (&two)[2][6], std::uint8_t* cluster,
+                     float (&cen)[kTextureColours][6], int (&count)[kTextureColours]) {
+    constexpr int K = kTextureColours, kMaxSamples = kSamplesPerColour * kTextureColours;
+    const int stride = (m + kMaxSamples - 1) / kMaxSamples;
+    float samples[6][kMaxSamples];
+    std::uint8_t nearest[kMaxSamples];
+    int n = 0;
+    for (int i = 0; i < m; i += stride, ++n)
+        for (int q = 0; q < 6; ++q) samples[q][n] = f[q][i];
+    const float* const s[6] = {samples[0], samples[1], samples[2], samples[3], samples[4], samples[5]};
+    auto colour_distance = [&](int j, const float* c) {
+        float d = 0;
+        for (int q = 3; q < 6; ++q) d += (s[q][j] - c[q]) * (s[q][j] - c[q]);
+        return d;
+    };
+    for (int q = 0; q < 6; ++q) cen[0][q] = two[0][q], cen[1][q] = two[1][q];
+    float nearest_d[kMaxSamples];  // each sample's colour distance to the nearest centre so far
+    for (int j = 0; j < n; ++j) nearest_d[j] = std::min(colour_distance(j, cen[0]), colour_distance(j, cen[1]));
+    for (int k = 2; k < K; ++k) {
+        const int farthest = static_cast<int>(std::max_element(nearest_d, nearest_d + n) - nearest_d);
+        for (int q = 0; q < 6; ++q) cen[k][q] = s[q][farthest];
+        for (int j = 0; j < n; ++j) nearest_d[j] = std::min(nearest_d[j], colour_distance(j, cen[k]));
+    }
+    float w[K][6], bias[K];
+    auto set_weights = [&] {
+        for (int k = 0; k < K; ++k) {
+            bias[k] = 0;
+            for (int q = 0; q < 6; ++q) w[k][q] = 2 * cen[k][q], bias[k] += cen[k][q] * cen[k][q];
+        }
+    };
+    for (int it = 0; it < 8; ++it) {
+        set_weights();
+        int changed = 0;
+        for (int j = 0; j < n; ++j) {
+            const std::uint8_t k = nearest_colour(s, j, w, bias);
+            changed += it == 0 || nearest[j] != k;
+            nearest[j] = k;
+        }
+        float sum[K][6] = {};
+        int n_k[K] = {};
+        for (int j = 0; j < n; ++j) {
+            const int k = nearest[j];
+            ++n_k[k];
+            for (int q = 0; q < 6; ++q) sum[k][q] += s[q][j];
+        }
+        for (int k = 0; k < K; ++k)
+            if (n_k[k] > 0)
+                for (int q = 0; q < 6; ++q) cen[k][q] = sum[k][q] / static_cast<float>(n_k[k]);
+        if (changed == 0) break;
+    }
+    set_weights();
+    // Local copies of the plane pointers: a byte store may alias anything, and the loop
+    // would load them again for every pixel instead of vectorizing.
+    const float* const planes[6] = {f[0], f[1], f[2], f[3], f[4], f[5]};
+    for (int i = 0; i < m; ++i) cluster[i] = nearest_colour(planes, i, w, bias);
+    for (int k = 0; k < K; ++k) count[k] = 0;
+    for (int i = 0; i < m; ++i) ++count[cluster[i]];
+}
+
+/// The materials of segment l's colours (ws.part at its pixels px[0, m), sizes `count`):
+/// per pair of colours their contact, the 4-neighbour pairs between them, over the square
+/// root of the smaller's size. Above color_max_compact (longer than the outline of any
+/// compact piece) they interleave: one material. At most color_max_boundary x that (one side
+/// of a compact piece) they lie apart. Between the two the pair is neither: no split. True,
+/// with `material` (0 or 1 per colour), when the colours make exactly two materials. Cost:
+/// one pass over the segment's pixels.
+bool texture_materials(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
+                       const int (&count)[kTextureColours], std::uint8_t (&material)[kTextureColours]) {
+    constexpr int K = kTextureColours;
+    const SegmentParams& prm = x.prm;
+    const std::uint8_t* const part = ws.part.data();
+    int contact[K][K] = {};  // symmetric
+    for (int i = 0; i < m; ++i)
+        for_part_boundary_pairs(x, ws, l, px[i], [&](int q, int, int) {
+            ++contact[part[px[i]]][part[q]];
+            ++contact[part[q]][part[px[i]]];
+        });
+    int root[K];  // union-find over the colours
+    for (int k = 0; k < K; ++k) root[k] = k;
+    auto find = [&](int k) {
+        while (root[k] != k) k = root[k];
+        return k;
+    };
+    int materials = K;
+    auto join = [&](int a, int b) {
+        if (const int ra = find(a), rb = find(b); ra != rb) root[rb] = ra, --materials;
+    };
+    // A colour too small for an object (mixed pixels along an edge, a sticker) is part of
+    // the material it touches most.
+    auto tiny = [&](int k) { return count[k] < prm.min_points; };
+    for (int k = 0; k < K; ++k) {
+        if (!tiny(k)) continue;
+        int most = k == 0 ? 1 : 0;
+        for (int j = 0; j < K; ++j)
+            if (j != k && contact[k][j] > contact[k][most]) most = j;
+        join(most, k);
+    }
+    for (int a = 0; a < K; ++a)
+        for (int b = a + 1; b < K; ++b) {
+            if (tiny(a) || tiny(b)) continue;
+            const double c = contact[a][b];
+            const double unit = std::sqrt(static_cast<double>(std::min(count[a], count[b])));
+            if (c > prm.color_max_compact * unit) {
+                join(a, b);
+            } else if (c > prm.color_max_boundary * prm.color_max_compact * unit) {
+                return false;
+            }
+        }
+    if (materials != 2) return false;
+    const int first = find(0);
+    for (int k = 0; k < K; ++k) material[k] = find(k) == first ? 0 : 1;
+    return true;
+}
+
+/// Segment l's split into two materials, when 2-means followed a texture: texture_colours,
+/// texture_materials, then ws.part, side, `count` and `cen` say the materials (cen: their
+/// means). False, and ws.part not a split, when the colours are not two materials. Cost:
+/// texture_colours' passes and two more over the segment's pixels.
+bool split_by_materials(const Ctx& x, SegmentWorkspace& ws, int l, const int* px, const float* const* f, int m,
+                        std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+    float colour[kTextureColours][6];
+    int colour_count[kTextureColours];
+    texture_colours(f, m, cen, side, colour, colour_count);
+    for (const int c : colour_count)
+        if (c == 0) return false;
+    std::uint8_t* const part = ws.part.data();
+    for (int i = 0; i < m; ++i) part[px[i]] = side[i];
+    std::uint8_t material[kTextureColours];
+    if (!texture_materials(x, ws, l, px, m, colour_count, material)) return false;
+    double sum[2][6] = {};
+    count[0] = count[1] = 0;
+    for (int i = 0; i < m; ++i) {
+        const std::uint8_t j = material[side[i]];
+        side[i] = j;
+        part[px[i]] = j;
+        ++count[j];
+        for (int q = 0; q < 6; ++q) sum[j][q] += f[q][i];
+    }
+    // Each material large enough to be tried again (as order_by_size asks of a segment):
+    // grouping colours is weaker evidence than 2-means' own parts, and a print's block of
+    // min_points split off a box seen in two pieces on osd_mosd's learn18 (docs/ABLATION.md,
+    // "Textures").
+    if (std::min(count[0], count[1]) < 2 * x.prm.min_points) return false;
+    for (int j = 0; j < 2; ++j)
+        for (int q = 0; q < 6; ++q) cen[j][q] = static_cast<float>(sum[j][q] / count[j]);
+    return true;
+}
+
+/// How a segment was split by the colour cue (ws.split).
+enum Split : std::uint8_t { kNotSplit = 0, kSplitByColour = 1, kSplitByMaterial = 2 };
+
+/// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
+/// "Colour cue"); where 2-means followed a texture, the segment's materials
+/// (split_by_materials) and the same tests. Writes ws.part at the segment's pixels once
+/// 2-means ran. Cost: O(segment pixels) per 2-means iteration and for the boundary, the
+/// materials' passes when 2-means followed a texture; no allocation (called in parallel, one
+/// segment per call).
+Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
+                       const ClusterParams& cp, float cos_crease, SegmentWorkspace& ws, int l) {
+    const SegmentParams& prm = x.prm;
+    const int o = ws.offsets[static_cast<std::size_t>(l)];
+    const int* px = ws.order.data() + o;
+    const int m = segment_size(ws, l);
+    const float* f[6];  // the segment's features
+    for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
+    float cen[2][6];
+    double total[6];
+    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen, total)) return kNotSplit;
+    std::uint8_t* const side = ws.part_in_order.data() + o;
+    int count[2] = {0, 0};
+    two_means(f, m, total, side, cen, count);
+    std::uint8_t* part = ws.part.data();
+    for (int i = 0; i < m; ++i) part[px[i]] = side[i];
+    const Verdict verdict = judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen);
+    if (verdict == Verdict::kKept) return kSplitByColour;
+    // kTexture: both parts passed the share test, so both hold pixels.
+    if (verdict != Verdict::kTexture || !prm.color_textures || !split_by_materials(x, ws, l, px, f, m, side, cen, count))
+        return kNotSplit;
+    return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen) == Verdict::kKept
+               ? kSplitByMaterial
+               : kNotSplit;
+}
+
+/// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
+/// thread order), with the split segment's ws.origin. Returns the splits, and adds those by
+/// material to `by_material`. Cost: one pass over the split segments' pixels.
+int number_splits(SegmentWorkspace& ws, int n, int& by_material) {
+    int splits = 0, next = n;
+    for (int l = 1; l <= n; ++l) {
+        if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
+        by_material += ws.split[static_cast<std::size_t>(l)] == kSplitByMaterial;
+        const int id = ++next;
+        ws.origin[static_cast<std::size_t>(id)] = ws.origin[static_cast<std::size_t>(l)];
+        const int o = ws.offsets[static_cast<std::size_t>(l)];
+        const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
+        for (int i = 0; i < m; ++i) {
+            const std::size_t p = static_cast<std::size_t>(ws.order[static_cast<std::size_t>(o + i)]);
+            if (ws.part[p] == 1) ws.label[p] = id;
+        }
+        ++splits;
+    }
+    return splits;
+}
+
+/// One round of the colour cue over the segments marked in ws.to_try (1..n): tries to split
+/// each in two, then numbers part 1 of each split segment n + 1, n + 2, ... in segment order.
+/// Returns the splits, and adds those by material to `by_material`. Cost: a counting sort
+/// and a gather of the object pixels (parallel passes), then O(segment pixels) per 2-means
+/// iteration per segment tried, segments in parallel.
+int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
+    const SegmentParams& prm = x.prm;
+    sort_pixels_by_segment(x, ws, n);
+    // part is written for a segment's pixels before anything reads them: no clearing.
+    ws.part.resize(static_cast<std::size_t>(x.W) * x.H);
+    ws.part_in_order.resize(static_cast<std::size_t>(ws.offsets[static_cast<std::size_t>(n) + 1]));
+    ws.split.assign(static_cast<std::size_t>(n) + 1, kNotSplit);
+    ClusterParams cp;
+    cp.alpha = prm.color_alpha;
+    cp.delta = 1.0f - prm.color_alpha;
+    const ColourFeatures features = gather_features(x, cp, ws, n);
+    const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
+    std::optional<PlaneAxes> plane_xy;
+    if (support) plane_xy.emplace(*support);
+    // Each segment is tried on its own; split ids are given out in segment order afterwards
+    // so that the labels do not depend on the threads.
+    order_by_size(prm, ws, n);
+    const auto n_tried = static_cast<std::ptrdiff_t>(ws.by_size.size());
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::ptrdiff_t t = 0; t < n_tried; ++t) {
+        const int l = ws.by_size[static_cast<std::size_t>(t)];
+        const PlaneAxes* axes = plane_xy ? &*plane_xy : nullptr;
+        ws.split[static_cast<std::size_t>(l)] = try_colour_split(x, support, axes, features, cp, cos_crease, ws, l);
+    }
+    return number_splits(ws, n, by_material);
+}
+
+/// The colour cue: tries to split each segment in two by 2-means under the paper's distance
+/// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
+/// are large, and meet along one side of the smaller part or round a compact piece, across
+/// a smooth surface or with a turn of colour, and the segment does not stand round on the
+/// support (stands_round: a can's label is print). Where 2-means followed a texture, the
+/// same tests judge a split between the segment's materials (split_by_materials). A second
+/// round tries the two parts of each split segment again: three flush boxes of three colours
+/// need two cuts. In: ws.label (1..n with gaps). Out: ws.label with the new parts numbered
+/// n + 1, n + 2, ... (round 1's in segment order, then round 2's), and ws.origin, each
+/// label's segment before the cue; `by_material` counts the splits between materials. Cost:
+/// split_round once, twice when it split anything.
+int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
+    by_material = 0;
+    // Each label's segment before the cue; a round adds at most one label per segment.
+    ws.origin.resize(4 * static_cast<std::size_t>(n) + 1);
+    for (int l = 0; l <= n; ++l) ws.origin[static_cast<std::size_t>(l)] = l;
+    ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
+    const int first = split_round(x, support, ws, n, by_material);
+    if (first == 0) return 0;
+    // Round 2: the segments split in round 1 (part 0 kept their label) and their new parts.
+    // A third round split nothing more on the tune seeds (docs/ABLATION.md).
+    ws.to_try.assign(static_cast<std::size_t>(n + first) + 1, 0);
+    for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)] != kNotSplit;
+    for (int l = n + 1; l <= n + first; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
+    return first + split_round(x, support, ws, n + first, by_material);
+}
+
+}  // namespace
+
+void split_by_colour(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+    stats.color_splits = color_splits(x, support, ws, n, stats.texture_splits);
+    n += stats.color_splits;
+}
+
+}  // namespace wul3d::detail

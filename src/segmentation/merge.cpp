@@ -1,0 +1,128 @@
+// The convexity merge (LCCP's): segments that meet along a depth-continuous boundary that
+// is mostly not concave are one object. Noise cuts an object along creases it does not have
+// (a box's front face from its top, a tin's rim); two objects meet at a concave fold. After
+// the colour cue the merge runs again between the parts of different segments that are one
+// material (color_rejoin), as the cue may have parted what kept them apart.
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "internal.hpp"
+
+namespace wul3d::detail {
+namespace {
+
+/// Joins segments that touch along a boundary that is mostly not concave. Each 4-neighbour
+/// pair (p, q) of two segments with continuous depth is tested for a crease between the
+/// pixels a crease step away on either side, inside their own segments; the pair of
+/// segments (a, b) merges when enough pairs were tested, few were concave and may_join(a,
+/// b). Returns the merges. Cost: one pass over the pixels, a sort of the boundary pairs, one
+/// more pass to relabel when anything merged.
+template <class MayJoin>
+int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) {
+    const SegmentParams& prm = x.prm;
+    if (prm.merge_max_concave <= 0 || n < 2) return 0;
+    const int W = x.W, H = x.H, s = prm.crease_step_px;
+    ws.edges.clear();
+    const int* const label = ws.label.data();
+    // The pair (p, q = p + d) of segments a and b, q right of or below p.
+    auto boundary_pair = [&](int u, int v, int a, int b, const int (&d)[2]) {
+        const int p = v * W + u, q = p + d[0] + d[1] * W;
+        if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) return;
+        const int pu = u - s * d[0], pv = v - s * d[1];
+        const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
+        std::uint64_t tested = 0, concave = 0;
+        if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
+            const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
+            const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
+            if (label[pp] == a && label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
+                tested = 1;
+                concave = x.concavity(pp, qq) > prm.concavity;
+            }
+        }
+        const auto lo = static_cast<std::uint64_t>(std::min(a, b));
+        const auto hi = static_cast<std::uint64_t>(std::max(a, b));
+        ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+    };
+    static constexpr int kRight[2] = {1, 0}, kDown[2] = {0, 1};
+    for (int v = 0; v < H; ++v) {
+        const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
+        if (!row_has_label(row, 0, W)) continue;  // a row without labels has no pair
+        for (int u = 0; u < W; ++u) {
+            const int a = row[u];
+            if (a == 0) continue;
+            // Right, then down, as before; most neighbours are unlabelled or of segment a.
+            if (u + 1 < W && row[u + 1] != 0 && row[u + 1] != a) boundary_pair(u, v, a, row[u + 1], kRight);
+            if (v + 1 < H && row[u + W] != 0 && row[u + W] != a) boundary_pair(u, v, a, row[u + W], kDown);
+        }
+    }
+    std::sort(ws.edges.begin(), ws.edges.end());
+    reset_sets(ws.parent, n);
+    int merges = 0;
+    for (std::size_t i = 0; i < ws.edges.size();) {
+        const std::uint64_t key = ws.edges[i] >> 4;
+        int tested = 0, concave = 0;
+        for (; i < ws.edges.size() && (ws.edges[i] >> 4) == key; ++i) {
+            tested += static_cast<int>((ws.edges[i] >> 1) & 1);
+            concave += static_cast<int>(ws.edges[i] & 1);
+        }
+        const int a = static_cast<int>(key >> 30), b = static_cast<int>(key & ((1u << 30) - 1));
+        if (tested < prm.merge_min_boundary ||
+            static_cast<float>(concave) > prm.merge_max_concave * static_cast<float>(tested) || !may_join(a, b))
+            continue;
+        merges += join_sets(ws.parent, a, b);
+    }
+    if (merges > 0) relabel_to_roots(ws);
+    return merges;
+}
+
+}  // namespace
+
+void merge_segments(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+    stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
+}
+
+/// The convexity merge again after the colour cue (color_rejoin), between segments that
+/// came from different segments before it (ws.origin: what the cue parted stays parted)
+/// and are one material by the cue's measures: the chromaticities of their mean colours
+/// within color_min_distance and, with the brightness step on, their mean brightness within
+/// color_min_step. A box with another lying on it can come out of the crease cuts in two
+/// pieces, and the first merge kept them apart because the upper box's wall, a concave
+/// crease, ran along their boundary too; once the cue has made the upper box a segment of
+/// its own, the pieces' boundary is their own convex edge. Cost: one pass over the rows with
+/// labels for the segments' mean colours, then merge_convex's.
+void rejoin_materials(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+    const SegmentParams& prm = x.prm;
+    if (stats.color_splits == 0 || !prm.color_rejoin) return;
+    ws.material.assign(static_cast<std::size_t>(n) + 1, {0, 0, 0, 0});
+    for (int v = 0; v < x.H; ++v) {
+        const int* const row = ws.label.data() + static_cast<std::ptrdiff_t>(v) * x.W;
+        if (!row_has_label(row, 0, x.W)) continue;
+        for (int u = 0; u < x.W; ++u) {
+            if (row[u] == 0) continue;
+            const std::size_t p = static_cast<std::size_t>(v) * x.W + u;
+            std::array<double, 4>& m = ws.material[static_cast<std::size_t>(row[u])];
+            m[0] += x.c.r[p], m[1] += x.c.g[p], m[2] += x.c.b[p], m[3] += 1;
+        }
+    }
+    // The mean colour's chromaticity and brightness.
+    auto material = [&](int l, double (&c)[3]) {
+        const std::array<double, 4>& m = ws.material[static_cast<std::size_t>(l)];
+        const double r = m[0] / m[3], g = m[1] / m[3], b = m[2] / m[3];
+        chromaticity(r, g, b, c);
+        return r + g + b + kDark;
+    };
+    stats.merges += merge_convex(x, ws, n, [&](int a, int b) {
+        if (ws.origin[static_cast<std::size_t>(a)] == ws.origin[static_cast<std::size_t>(b)]) return false;
+        double ca[3], cb[3];
+        const double ba = material(a, ca), bb = material(b, cb);
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) d2 += (ca[k] - cb[k]) * (ca[k] - cb[k]);
+        if (d2 >= static_cast<double>(prm.color_min_distance) * prm.color_min_distance) return false;
+        const bool brightness_step = prm.color_min_step > 1 &&
+                                     std::max(ba, bb) >= static_cast<double>(prm.color_min_step) * std::min(ba, bb);
+        return !brightness_step;
+    });
+}
+
+}  // namespace wul3d::detail

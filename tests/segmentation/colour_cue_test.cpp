@@ -1,0 +1,273 @@
+// The colour cue (src/segmentation/colour_cue.cpp): flush objects parted by colour or
+// brightness, and what it leaves whole (one box, a printed cup, a striped box).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+
+#include "segment_scene.hpp"
+
+using namespace wul3d;
+using namespace wul3d::test;
+
+// Two boxes side by side, flush: front and top faces coplanar and touching. Geometry cannot
+// tell them apart; the colour cue (hybrid) can, because they differ in colour and meet along
+// a straight boundary across a flat surface.
+TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 7;
+    SceneBox red;
+    red.x = -0.075f;
+    red.z = 1.0f;
+    SceneBox blue = red;
+    blue.x = 0.075f;
+    blue.r = 30;
+    blue.g = 60;
+    blue.b = 220;
+    s.boxes = {red, blue};
+    std::vector<int> truth;
+    int a = 0, b = 0;
+    const LabelImage geo = segment(s, Segmenter::Geometric, truth);
+    dominant_share(geo.labels, truth, kTruthBox0, &a);
+    dominant_share(geo.labels, truth, kTruthBox0 + 1, &b);
+    EXPECT_EQ(a, b) << "geometry alone should not separate flush boxes (test premise)";
+
+    SegmentStats stats;
+    const LabelImage hyb = segment(s, Segmenter::Hybrid, truth, &stats);
+    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(a, b) << "the colour cue did not split the flush boxes";
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
+// Two flush boxes of one hue, a light one and a dark one: their chromaticities lie closer
+// than the colour cue's distance, so only the step in brightness where their contact
+// crosses the shared front and top planes tells the two materials apart.
+TEST(SegmentObjects, FlushBoxesOfOneHue_SeparatedByTheBrightnessStep) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 7;
+    const SceneBox light{.x = -0.075f, .z = 1.0f, .r = 200, .g = 120, .b = 60};
+    const SceneBox dark{.x = 0.075f, .z = 1.0f, .r = 80, .g = 65, .b = 20};
+    s.boxes = {light, dark};
+    std::vector<int> truth;
+    int a = 0, b = 0;
+    SegmentParams no_step;
+    no_step.color_min_step = 0;
+    const LabelImage without = segment(s, no_step, truth);
+    dominant_share(without.labels, truth, kTruthBox0, &a);
+    dominant_share(without.labels, truth, kTruthBox0 + 1, &b);
+    EXPECT_EQ(a, b) << "the chromaticity alone should not separate the boxes (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(s, SegmentParams{}, truth, &stats);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0, &a), 0.9);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + 1, &b), 0.9);
+    EXPECT_NE(a, 0);
+    EXPECT_NE(a, b) << "the brightness step did not split the flush boxes";
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
+// The colour cue leaves a box alone whose faces differ in shade: the colour boundary runs
+// along a convex edge, not across a flat surface.
+TEST(SegmentObjects, ColourCue_DoesNotSplitOneBox) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox box;
+    box.z = 1.0f;
+    s.boxes = {box};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
+    EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0), 0.95);
+    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.segments, 1);
+}
+
+// Two flush boxes of different colours and heights: the colour boundary runs up the front
+// faces and then along the lower box's top edge, a fold, so it is not "across a smooth
+// surface" for most of its length. The parts' colours differ in chromaticity, which shading
+// alone cannot do, and their boundary is one side of the smaller part: the colour cue
+// splits them.
+TEST(SegmentObjects, FlushBoxesOfTwoHeights_SeparatedAcrossTheFold) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 5;
+    SceneBox tall;
+    tall.x = -0.06f;
+    tall.z = 1.0f;
+    tall.w = 0.12f;
+    tall.h = 0.16f;
+    tall.d = 0.12f;
+    tall.r = 40; tall.g = 170; tall.b = 60;
+    SceneBox low = tall;
+    low.x = 0.06f;
+    low.h = 0.07f;
+    low.r = 220; low.g = 40; low.b = 160;
+    s.boxes = {tall, low};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage hyb = segment(s, Segmenter::Hybrid, truth, &stats);
+    expect_separate(hyb, truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the two boxes are one object");
+}
+
+// A flat box lying on a larger box of another colour, seen from above: the larger box's top
+// encloses the flat one in view, so their colour boundary is the flat box's whole outline,
+// not one side of it. It is short for the piece's area (a compact piece, not a texture),
+// and the colour cue splits them (color_max_compact).
+TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
+    Scene s = pitched_tabletop_scene();
+    // The base near the table's colour, as its feet are; the flat box lying on its top.
+    const SceneBox base{.z = 1.0f, .w = 0.26f, .h = 0.08f, .d = 0.24f, .r = 180, .g = 150, .b = 100};
+    const SceneBox flat{.z = 1.0f, .w = 0.12f, .h = 0.015f, .d = 0.1f, .lift = base.h, .r = 40, .g = 90, .b = 200};
+    s.boxes = {base, flat};
+    std::vector<int> truth;
+    const PlaneStage in = up_to_the_plane(s);
+    int a = 0, b = 0;
+    SegmentParams without;
+    without.color_max_compact = 0;
+    const LabelImage one = segment(in, without);
+    dominant_share(one.labels, in.truth, kTruthBox0, &a);
+    dominant_share(one.labels, in.truth, kTruthBox0 + 1, &b);
+    ASSERT_EQ(a, b) << "without the compact-piece test the two boxes should be one (test premise)";
+
+    SegmentStats stats;
+    const LabelImage two = segment(in, SegmentParams{}, &stats);
+    expect_separate(two, in.truth, kTruthBox0, kTruthBox0 + 1, 0.8, "the flat box was not split from the box it lies on");
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
+// A cup with a printed band round its outer wall: two colours on one solid of revolution,
+// as a can's or a bottle's label. The band is a compact piece the colour cue would cut off;
+// the cup's walls lie on one upright circle and face along its radii, so it stays one
+// object (color_round_deg).
+TEST(SegmentObjects, CupWithAPrintedBand_StaysOneObject) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 5;
+    s.cups = {SceneCup{.z = 0.9f, .radius = 0.045f, .h = 0.13f, .band_lo = 0.03f, .band_hi = 0.1f}};
+    const PlaneStage in = up_to_the_plane(s);
+    SegmentParams without;
+    without.color_round_deg = 0;
+    SegmentStats split_stats;
+    const LabelImage split = segment(in, without, &split_stats);
+    ASSERT_GE(split_stats.color_splits, 1) << "without the round test the band should be cut off (test premise)";
+    ASSERT_LT(dominant_share(split.labels, in.truth, kTruthCup0), 0.9) << "(test premise)";
+
+    SegmentStats stats;
+    const LabelImage one = segment(in, SegmentParams{}, &stats);
+    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_GE(dominant_share(one.labels, in.truth, kTruthCup0), 0.95) << "the printed cup was split";
+}
+
+// Three flush boxes of three colours in a row: one 2-means split cuts one box off, and the
+// second round splits the two that are left.
+TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 9;
+    s.boxes = {SceneBox{.x = -0.12f, .z = 1.0f, .w = 0.12f, .r = 210, .g = 40, .b = 40},
+               SceneBox{.x = 0.0f, .z = 1.0f, .w = 0.12f, .r = 40, .g = 180, .b = 60},
+               SceneBox{.x = 0.12f, .z = 1.0f, .w = 0.12f, .r = 40, .g = 60, .b = 220}};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
+    int id[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + i, &id[i]), 0.9) << "box " << i;
+        EXPECT_NE(id[i], 0) << "box " << i;
+    }
+    EXPECT_NE(id[0], id[1]);
+    EXPECT_NE(id[1], id[2]);
+    EXPECT_NE(id[0], id[2]);
+    EXPECT_EQ(stats.color_splits, 2);
+}
+
+// Two flush boxes of different colours, one with a small sticker of a third colour (under
+// 2 % of the pair) farther from each box's colour than they are from each other. 2-means
+// seeded at the farthest colours starts one part at the sticker and keeps it there (both
+// boxes are nearer the other seed), a part the share test rejects; seeded along the
+// colours' principal axis it finds the two boxes.
+TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 11;
+    // Muted colours: the sticker is farther from each than they are from each other.
+    s.boxes = {SceneBox{.x = -0.075f, .z = 1.0f, .r = 190, .g = 70, .b = 60},
+               SceneBox{.x = 0.075f, .z = 1.0f, .r = 60, .g = 80, .b = 190}};
+    PlaneStage in = up_to_the_plane(s);
+    // The sticker: a 6 x 6 px square of green in the middle of the red box's pixels.
+    long su = 0, sv = 0, n = 0;
+    for (int v = 0; v < in.cloud.height; ++v)
+        for (int u = 0; u < in.cloud.width; ++u)
+            if (in.truth[static_cast<std::size_t>(v) * in.cloud.width + u] == kTruthBox0) su += u, sv += v, ++n;
+    ASSERT_GT(n, 1000);
+    int painted = 0;
+    for (int v = static_cast<int>(sv / n) - 3; v < static_cast<int>(sv / n) + 3; ++v)
+        for (int u = static_cast<int>(su / n) - 3; u < static_cast<int>(su / n) + 3; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * in.cloud.width + u;
+            if (in.truth[p] != kTruthBox0) continue;
+            in.cloud.r[p] = 0; in.cloud.g[p] = 255; in.cloud.b[p] = 0;
+            ++painted;
+        }
+    ASSERT_GT(painted, 20);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the sticker hid the contact between the boxes");
+    EXPECT_EQ(stats.color_splits, 1);
+}
+
+namespace {
+/// Paints truth object `id`'s pixels with stripes of two colours, `period_m` wide, fixed on
+/// its surfaces (the stripes follow x + y + z of the points, as the generator's do).
+void paint_stripes(PlaneStage& in, int id, const std::uint8_t (&a)[3], const std::uint8_t (&b)[3], float period_m) {
+    for (std::size_t p = 0; p < in.truth.size(); ++p) {
+        if (in.truth[p] != id) continue;
+        const float t = (in.cloud.x[p] + in.cloud.y[p] + in.cloud.z[p]) / period_m;
+        const auto& c = static_cast<long>(std::floor(t)) % 2 == 0 ? a : b;
+        in.cloud.r[p] = c[0], in.cloud.g[p] = c[1], in.cloud.b[p] = c[2];
+    }
+}
+
+/// Two flush boxes, the left plain red, the right striped (blue and yellow, 2 cm).
+PlaneStage plain_and_striped_boxes() {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    s.boxes = {SceneBox{.x = -0.075f, .z = 1.0f}, SceneBox{.x = 0.075f, .z = 1.0f}};
+    PlaneStage in = up_to_the_plane(s);
+    paint_stripes(in, kTruthBox0 + 1, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    return in;
+}
+}  // namespace
+
+// A plain box flush beside a striped one: 2-means follows the stripes (its boundary runs
+// round every stripe) and the split is rejected; the segment's four colours make two
+// materials (the stripes' two interleave, the rest is the plain box's), and the split
+// between them is kept.
+TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
+    const PlaneStage in = plain_and_striped_boxes();
+    SegmentParams without;
+    without.color_textures = false;
+    SegmentStats stats;
+    const LabelImage one = segment(in, without, &stats);
+    int a = 0, b = 0;
+    dominant_share(one.labels, in.truth, kTruthBox0, &a);
+    dominant_share(one.labels, in.truth, kTruthBox0 + 1, &b);
+    ASSERT_EQ(a, b) << "2-means alone should not part the boxes (test premise)";
+    EXPECT_EQ(stats.color_splits, 0);
+
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the materials were not parted");
+    EXPECT_EQ(stats.color_splits, 1);
+    EXPECT_EQ(stats.texture_splits, 1);
+}
+
+// One striped box on its own: its stripes are one material, whatever four colours k-means
+// finds in them; nothing is split.
+TEST(SegmentObjects, StripedBox_StaysOneObject) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    s.boxes = {SceneBox{.z = 1.0f, .w = 0.25f}};
+    PlaneStage in = up_to_the_plane(s);
+    paint_stripes(in, kTruthBox0, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0), 0.95);
+    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.segments, 1);
+}

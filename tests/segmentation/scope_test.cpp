@@ -1,0 +1,171 @@
+// The scope (src/segmentation/scope.cpp): what the support holds stays, what it does not leaves.
+#include <gtest/gtest.h>
+
+#include "segment_scene.hpp"
+
+using namespace wul3d;
+using namespace wul3d::test;
+
+namespace {
+/// Moves the points whose truth id is `id` up, away from the support, by `m` metres: a box
+/// hanging over the table (the plane's classes stay as they were computed).
+void lift(PlaneStage& st, int id, float m) {
+    const Plane& pl = st.plane.support;
+    for (std::size_t p = 0; p < st.truth.size(); ++p) {
+        if (st.truth[p] != id) continue;
+        st.cloud.x[p] += m * pl.nx;
+        st.cloud.y[p] += m * pl.ny;
+        st.cloud.z[p] += m * pl.nz;
+    }
+}
+}  // namespace
+
+namespace {
+/// The pitched tabletop with two boxes 0.4 m apart, the second (blue) `h` tall and hanging
+/// `lift` over the table.
+Scene two_boxes_apart(float h, float lift) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox a, b;
+    a.x = -0.2f;
+    a.z = 1.0f;
+    b.x = 0.2f;
+    b.z = 1.0f;
+    b.h = h;
+    b.lift = lift;
+    b.b = 200;
+    s.boxes = {a, b};
+    return s;
+}
+}  // namespace
+
+// Two boxes apart on the table, the second hanging 10 cm over it (rendered so: the table
+// shows under it): it stands on nothing, touches nothing, and the table is seen under its
+// middle, so the support does not hold it. --scope scene keeps it.
+TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
+    PlaneStage st = up_to_the_plane(two_boxes_apart(SceneBox{}.h, 0.1f));
+    for (const Scope scope : {Scope::Support, Scope::Scene}) {
+        SCOPED_TRACE(scope_name(scope));
+        SegmentParams params;
+        params.scope = scope;
+        SegmentStats stats;
+        const LabelImage out = segment(st, params, &stats);
+        int ia = 0, ib = 0;
+        EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &ia), 0.9);
+        EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib), 0.9);
+        EXPECT_NE(ia, 0);
+        EXPECT_EQ(stats.support_scope, scope == Scope::Support);
+        if (scope == Scope::Support) {
+            EXPECT_EQ(ib, 0) << "the hanging box is an object";
+            EXPECT_EQ(stats.out_of_scope, 1);
+            EXPECT_EQ(stats.segments, 1);
+        } else {
+            EXPECT_NE(ib, 0);
+            EXPECT_EQ(stats.out_of_scope, 0);
+            EXPECT_EQ(stats.segments, 2);
+        }
+    }
+}
+
+// A box whose sides the sensor does not see (seen from steeply above, or in the shadow of a
+// structured-light sensor): its segment is its top alone, 15 cm over the table, standing on
+// nothing within scope_contact_m and touching nothing. Its foot is hidden, not seen: the
+// pixel of the support point under its middle shows no depth, so the support holds it.
+// (The hanging box above shows the table under its middle and stays out.)
+TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
+    PlaneStage st = up_to_the_plane(two_boxes_apart(0.15f, 0.0f));
+    const Plane& pl = st.plane.support;
+    float top = 0;
+    for (std::size_t p = 0; p < st.truth.size(); ++p)
+        if (st.truth[p] == kTruthBox0 + 1) top = std::max(top, pl.height(st.cloud.x[p], st.cloud.y[p], st.cloud.z[p]));
+    ASSERT_GT(top, 0.12f);
+    std::size_t unseen = 0;
+    for (std::size_t p = 0; p < st.truth.size(); ++p) {
+        if (st.truth[p] != kTruthBox0 + 1 || pl.height(st.cloud.x[p], st.cloud.y[p], st.cloud.z[p]) > top - 0.01f)
+            continue;
+        st.cloud.valid[p] = 0;
+        st.normals.valid[p] = 0;
+        st.classes[p] = kPlaneRemoved;
+        st.truth[p] = 0;  // unseen: the box is its top
+        ++unseen;
+    }
+    ASSERT_GT(unseen, 500u);  // the sides were in view, and are gone
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    int ia = 0, ib = 0;
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &ia), 0.9);
+    EXPECT_NE(ia, 0);
+    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib);
+    EXPECT_NE(ib, 0) << "the box seen without its sides was left out";
+    EXPECT_EQ(stats.out_of_scope, 0);
+    EXPECT_EQ(stats.segments, 2);
+}
+
+// On the far half of the table, the frame's right edge cuts a box and its left edge a board
+// standing upright (a wall's stand-in). The box shows its top: an object the frame cuts,
+// which stays. The board faces sideways: like a wall, it leaves the support's volume through
+// the frame's edge (scope_upright_share). With every segment counted at the frame's sides
+// (share 0, as before) the box leaves too.
+TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
+    Scene s = pitched_tabletop_scene();
+    s.table_half_width = 1.5f;
+    s.boxes = {SceneBox{.x = 0.62f, .z = 1.3f, .w = 0.3f, .h = 0.1f, .d = 0.2f},
+               SceneBox{.x = -0.65f, .z = 1.3f, .w = 0.3f, .h = 0.35f, .d = 0.02f, .r = 40, .g = 60, .b = 200}};
+    const PlaneStage st = up_to_the_plane(s);
+    const int W = 320;
+    bool box_at_edge = false, board_at_edge = false;
+    for (std::size_t p = 0; p < st.truth.size(); ++p) {
+        box_at_edge |= st.truth[p] == kTruthBox0 && static_cast<int>(p % W) == W - 1;
+        board_at_edge |= st.truth[p] == kTruthBox0 + 1 && p % W == 0;
+    }
+    ASSERT_TRUE(box_at_edge && board_at_edge) << "the frame should cut both (test premise)";
+    SegmentParams every;
+    every.scope_upright_share = 0;
+    int box = 0, board = 0;
+    const LabelImage before = segment(st, every);
+    dominant_share(before.labels, st.truth, kTruthBox0, &box);
+    ASSERT_EQ(box, 0) << "counting the frame's sides for every segment should leave the box out (test premise)";
+    SegmentParams no_edges;  // nothing leaves through its outline: the board is held
+    no_edges.scope_max_outside = 1;
+    const LabelImage held = segment(st, no_edges);
+    dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
+    ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &box), 0.9);
+    EXPECT_NE(box, 0) << "the box the frame cuts was left out";
+    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
+    EXPECT_EQ(board, 0) << "the upright board the frame cuts is an object";
+    EXPECT_EQ(stats.out_of_scope, 1);
+}
+
+// The same lift on a box that touches another in the image (a small box in front of a tall
+// one): it rests on a segment the support holds, as a box on a box or an object whose foot
+// another hides, and stays.
+TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox tall;
+    tall.x = 0.05f;
+    tall.z = 1.0f;
+    tall.w = 0.2f;
+    tall.h = 0.25f;
+    tall.d = 0.1f;
+    SceneBox small = tall;
+    small.x = 0.0f;
+    small.z = 0.9f;
+    small.w = 0.12f;
+    small.h = 0.1f;
+    small.d = 0.1f;
+    small.g = 200;
+    s.boxes = {tall, small};
+    PlaneStage st = up_to_the_plane(s);
+    lift(st, kTruthBox0, 0.1f);
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    int ia = 0, ib = 0;
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &ia), 0.9);
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib), 0.9);
+    EXPECT_NE(ia, 0) << "the box resting on a held one was left out";
+    EXPECT_NE(ib, 0);
+    EXPECT_EQ(stats.out_of_scope, 0);
+}
