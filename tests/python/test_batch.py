@@ -24,8 +24,8 @@ from distributed import Client, LocalCluster  # noqa: E402  (Debian's python3-di
 
 from wul3d import batch  # noqa: E402
 
-TIMING_KEYS = {"wall_s", "fps", "ms_per_frame_median", "stage_ms_median", "peak_rss_mb",
-               "per_frame", "input", "threads"}
+TIMING_KEYS = {"wall_s", "fps", "fps_end_to_end", "ms_per_frame_median", "stage_ms_median",
+               "peak_rss_mb", "per_frame", "input", "threads"}
 SAMPLE_SEQUENCES = ["pcl_kinect", "pcl_kinect/pairwise_seq", "uois_tabletop"]
 # Workers import the module just built.
 os.environ["PYTHONPATH"] = os.pathsep.join(
