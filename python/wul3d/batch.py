@@ -26,6 +26,7 @@ finished; docs/SCALE.md).
 """
 
 import argparse
+import asyncio
 import json
 import logging
 import os
@@ -464,6 +465,8 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
     staging = staging_root / f"{index}.{os.getpid()}.{uuid.uuid4().hex}"
     final = pathlib.Path(out_root) / rel_out
     start = time.monotonic()
+    ended = False
+    batch_fd = None
     try:
         if threads > 0:
             import wul3d
@@ -471,13 +474,19 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
             wul3d.set_num_threads(threads)
         if own_root:
             staging_root.mkdir()
-        # The batch's folder goes when the batch ends or is interrupted: then this try is
-        # not wanted (a task on a cluster's worker may outlive an interrupted batch).
+        # The batch's folder is renamed when the batch ends or is interrupted: then this
+        # try is not wanted (a task on a cluster's worker may outlive its batch), even where
+        # the run made the path again (it creates its output folder's parents).
         staging.mkdir()
+        # Held open: the folder's inode cannot be reused by a folder made again at its path.
+        batch_fd = os.open(staging_root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+        batch_folder = os.fstat(batch_fd)
         summary = _run(input_dir, str(staging), options)
         names = sorted(p.name for p in staging.iterdir() if p.is_dir())
         record["scores"] = _frame_scores(pathlib.Path(input_dir), staging, names) if score else []
-        if not staging_root.is_dir():
+        now = _lstat(staging_root)
+        if now is None or (now.st_dev, now.st_ino) != (batch_folder.st_dev, batch_folder.st_ino):
+            ended = True
             raise Refused("the batch ended before this sequence was done; not published")
         _check_write_target(final, "folder", [input_dir], "output folder")
         _no_link_on_the_way(pathlib.Path(out_root), final)
@@ -487,10 +496,12 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
         # wul3d.InputError is a ValueError; UnicodeError too
         record["error"] = _one_line(e)
     finally:
+        if batch_fd is not None:
+            os.close(batch_fd)
         if _lstat(staging) is not None:
             _remove_run_output(staging)
-        if own_root:
-            _remove_staging(staging_root)
+        if own_root or ended:
+            _remove_staging(staging_root)  # an ended batch's folder, made again by the run
         record["wall_s"] = time.monotonic() - start
     return record
 
@@ -720,7 +731,7 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
     own_client = client is None
     start = time.monotonic()
     records, futures = {}, {}
-    interrupted = None
+    interrupted = error = None
     try:
         if client is None:
             if scheduler:
@@ -770,16 +781,26 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
             if left is not None and left <= 0:
                 raise TimeoutError(f"wul3d.batch: {len(pending)} sequences unfinished after "
                                    f"{timeout_s} s")
+            lost = None
             try:  # short waits: a signal is seen within a fraction of a second
                 done, pending = wait(pending, timeout=0.2 if left is None else min(0.2, left),
                                      return_when="FIRST_COMPLETED")
             except DaskTimeoutError:
                 continue
+            except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001
+                # The scheduler lost or cancelled some (a connection dropped): those end
+                # here as failed, the others are waited for.
+                lost = f"{type(e).__name__}: {_one_line(e)}"
+                done = {f for f in pending if f.status != "pending"} or set(pending)
+                pending = pending - done
             for fut in sorted(done, key=lambda f: futures[f][0]):
                 rel_out, rel = futures[fut]
                 try:
-                    rec = fut.result()
-                except Exception as e:  # noqa: BLE001  (KilledWorker after too many deaths)
+                    if fut.status == "pending":
+                        raise RuntimeError(lost)
+                    rec = fut.result(timeout=10)
+                except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001  (KilledWorker
+                    # after too many deaths, a cancelled or lost task)
                     rec = _failed_record(rel_out, root / rel, f"{type(e).__name__}: {_one_line(e)}")
                 rec["sequence"], rec["input"] = text(rel_out), text(str(root / rel))
                 failed += rec["status"] != "ok"
@@ -800,6 +821,12 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
                     records[rel_outs[rel]] = dict(
                         _failed_record(rel_outs[rel], root / rel, None),
                         status="stopped" if index in started else "not_started")
+    except Exception as e:  # a scheduler out of reach, timeout_s: batch.json all the same
+        error = e
+        for rel in sequences:
+            if rel_outs[rel] not in records:
+                records[rel_outs[rel]] = _failed_record(
+                    rel_outs[rel], root / rel, f"not finished: {_one_line(e)}")
     finally:
         if own_client and client is not None:
             if interrupted is not None or signals.signum is not None:
@@ -809,10 +836,16 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
             client.close(timeout=5)
             if cluster is not None:
                 cluster.close(timeout=5)
-        # Every task is over (on a cluster, a task still running finds the folder gone and
-        # publishes nothing): what a killed worker was writing goes (its sequence was redone).
+        # Every task is over, or (on a cluster, or a client given) a task still running
+        # finds the folder renamed and publishes nothing, and its run fails at its next
+        # write. What a killed worker was writing goes (its sequence was redone).
+        ended = staging.with_name(staging.name + ".ended")
+        try:
+            os.rename(staging, ended)
+        except OSError:
+            ended = staging
         for _ in range(3):
-            if _remove_staging(staging):
+            if _remove_staging(ended):
                 break
             time.sleep(0.1)
     if interrupted is not None:  # finished, but the result was not collected: OUT says so
@@ -828,6 +861,8 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
     if interrupted is not None:
         report["interrupted_by"] = signal.Signals(interrupted).name
     _write_batch_json(out, report, inputs)
+    if error is not None:
+        raise error
     if interrupted is not None:
         t = report["totals"]
         line = (f"wul3d.batch: interrupted by {signal.Signals(interrupted).name}; "

@@ -380,3 +380,19 @@ def test_no_output_is_written_through_a_link_in_out(client, tmp_path):
     assert rec["sequence"] == "a/b" and rec["status"] == "failed", rec
     assert "symbolic link" in rec["error"]
     assert list(elsewhere.iterdir()) == []
+
+
+def test_batch_json_is_written_when_the_batch_gives_up(client, tmp_path):
+    root, out = tmp_path / "root", tmp_path / "out"
+    for i in range(4):
+        linked_sequence(root / f"s{i}")
+    with pytest.raises(TimeoutError):
+        batch.run_batch(root, out, client=client, threads_per_worker=1, progress=False,
+                        timeout_s=0.05)
+    report = json.loads((out / "batch.json").read_text())
+    assert report["totals"]["sequences"] == 4
+    assert all(s["status"] == "ok" or s["error"].startswith("not finished: ")
+               for s in report["sequences"])
+    time.sleep(3)  # the tasks still running find the batch gone and publish nothing
+    assert {p.name for p in out.iterdir() if p.name.startswith("s")} == \
+        {s["sequence"] for s in report["sequences"] if s["status"] == "ok"}
