@@ -23,7 +23,6 @@ import pathlib
 import random
 import shutil
 import signal
-import stat
 import sys
 import tempfile
 import time

@@ -40,6 +40,7 @@ import time
 import uuid
 
 STAGING_PREFIX = ".wul3d.staging-"  # OUT/.wul3d.staging-<pid>-<id>/: one batch's tries
+LIVE_MARKER = ".wul3d.live"  # in a staging folder while its batch runs
 OWN_PREFIX = ".wul3d."  # names wul3d keeps for itself in OUT (check_frame_name refuses them)
 BATCH_JSON = "batch.json"
 DONE_MARKER = "summary.json"  # written last by the run loop
@@ -237,18 +238,23 @@ def _lstat(path):
         return None
 
 
-def _foreign_in_frame_folder(d: pathlib.Path):
-    """The first entry of frame folder `d` that write_frame does not write, or None."""
+def _own_listing(d):
+    """(the entries of folder `d` by name, but for `.wul3d.*` temporaries, None), or
+    ([], why it cannot be listed)."""
     try:
         entries = sorted(os.scandir(d), key=lambda e: e.name)
     except OSError as e:
-        return f"{text(str(d))} ({e.strerror})"
+        return [], f"{text(str(d))} ({e.strerror})"
+    return [e for e in entries if not e.name.startswith(OWN_PREFIX)], None
+
+
+def _foreign_in_frame_folder(d: pathlib.Path):
+    """The first entry of frame folder `d` that write_frame does not write, or None."""
+    entries, why = _own_listing(d)
     for e in entries:
-        if e.name.startswith(OWN_PREFIX):
-            continue
         if e.name not in FRAME_OUTPUT_FILES or not e.is_file(follow_symlinks=False):
             return text(e.path)
-    return None
+    return why
 
 
 def foreign_entry(out_dir, nested=()):
@@ -256,14 +262,8 @@ def foreign_entry(out_dir, nested=()):
     the library's rule for an existing OUT (prepare_out_dir): summary.json and frames.jsonl
     as plain files, `.wul3d.*` temporaries, frame folders holding only frame outputs; and
     `nested`, the names of folders that hold other sequences' outputs of this batch."""
-    out_dir = pathlib.Path(out_dir)
-    try:
-        entries = sorted(os.scandir(out_dir), key=lambda e: e.name)
-    except OSError as e:
-        return f"{text(str(out_dir))} ({e.strerror})"
+    entries, why = _own_listing(out_dir)
     for e in entries:
-        if e.name.startswith(OWN_PREFIX):
-            continue
         if e.name in (DONE_MARKER, FRAMES_FILE):
             if not e.is_file(follow_symlinks=False):
                 return text(e.path)
@@ -275,7 +275,7 @@ def foreign_entry(out_dir, nested=()):
         what = _foreign_in_frame_folder(pathlib.Path(e.path))
         if what is not None:
             return what
-    return None
+    return why
 
 
 def _is_run_output(d: pathlib.Path) -> bool:
@@ -310,6 +310,14 @@ def _remove_run_output(d: pathlib.Path) -> bool:
         return False
 
 
+def _make_staging(staging: pathlib.Path):
+    """A batch's staging folder, with the marker that tells its tasks it is live."""
+    staging.mkdir()
+    fd = os.open(staging / LIVE_MARKER, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW
+                 | os.O_CLOEXEC, 0o644)
+    os.close(fd)
+
+
 def _remove_staging(staging: pathlib.Path) -> bool:
     """Removes a batch's staging folder: each task folder in it that holds only run outputs,
     then the folder if that emptied it. Returns whether it is gone."""
@@ -322,6 +330,8 @@ def _remove_staging(staging: pathlib.Path) -> bool:
     for e in entries:
         if e.is_dir(follow_symlinks=False):
             _remove_run_output(pathlib.Path(e.path))
+        elif e.name == LIVE_MARKER and e.is_file(follow_symlinks=False):
+            os.unlink(e.path)
     try:
         os.rmdir(staging)
         return True
@@ -473,14 +483,19 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
 
             wul3d.set_num_threads(threads)
         if own_root:
-            staging_root.mkdir()
-        # The batch's folder is renamed when the batch ends or is interrupted: then this
-        # try is not wanted (a task on a cluster's worker may outlive its batch), even where
-        # the run made the path again (it creates its output folder's parents).
-        staging.mkdir()
-        # Held open: the folder's inode cannot be reused by a folder made again at its path.
+            _make_staging(staging_root)
+        # The batch renames its folder when it ends or is interrupted: then this try is not
+        # wanted (a task on a cluster's worker may outlive its batch). The folder is held
+        # open (its inode cannot be reused) and must hold the batch's marker (a folder the
+        # run made again at the path, creating its output's parents, does not).
         batch_fd = os.open(staging_root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
         batch_folder = os.fstat(batch_fd)
+        try:
+            os.stat(LIVE_MARKER, dir_fd=batch_fd, follow_symlinks=False)
+        except FileNotFoundError:
+            ended = True
+            raise Refused("the batch ended before this sequence started") from None
+        staging.mkdir()
         summary = _run(input_dir, str(staging), options)
         names = sorted(p.name for p in staging.iterdir() if p.is_dir())
         record["scores"] = _frame_scores(pathlib.Path(input_dir), staging, names) if score else []
@@ -717,7 +732,7 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
         if e.name.startswith(STAGING_PREFIX) and e.is_dir(follow_symlinks=False):
             _remove_staging(pathlib.Path(e.path))
     staging = out / f"{STAGING_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
-    staging.mkdir()
+    _make_staging(staging)
 
     sequences = found.sequences
     rel_outs = {rel: str(output_dir(out, root, rel).relative_to(out)) for rel in sequences}

@@ -247,7 +247,7 @@ def test_scheduler_and_workers_as_processes_survive_a_killed_worker(tmp_path):
         killed = None
         deadline = time.monotonic() + 120
         while killed is None and time.monotonic() < deadline and runner.is_alive():
-            for d in (out.glob(batch.STAGING_PREFIX + "*/*") if out.is_dir() else []):
+            for d in (out.glob(batch.STAGING_PREFIX + "*/[0-9]*") if out.is_dir() else []):
                 pid = int(d.name.split(".")[-2])
                 os.kill(pid, signal.SIGKILL)
                 killed = (d.name.split(".")[0], pid)
