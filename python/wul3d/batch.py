@@ -8,27 +8,51 @@ same outputs as `wul3d run`), and writes OUT/<sequence path relative to ROOT>/ i
 of `wul3d run`, and OUT/batch.json with per-sequence and total figures and, where the
 frames carry label.png, the UOIS table.
 
-Nothing half-done: a task runs into a staging folder under OUT/.staging/ and renames it into
-place when complete; summary.json, written last, marks a finished sequence. A second run over
-the same OUT skips finished sequences and redoes the others. A task whose worker dies is
-retried by Dask on another worker; a sequence with bad input is reported with its one-line
-reason and the others go on. Exit code: 0 when every sequence succeeded, 1 when some failed,
-2 for bad arguments.
+Nothing half-done: a task runs into a staging folder under OUT/.wul3d.staging-<pid>-<id>/
+(one per batch) and moves it into place when complete; summary.json, written last, marks a
+finished sequence. A second run over the same OUT skips finished sequences and redoes the
+others. A task whose worker dies is retried by Dask on another worker; a sequence with bad
+input is reported with its one-line reason and the others go on.
+
+Nothing lost: OUT may not be ROOT, lie inside it or hold it (nor any folder a link under
+ROOT leads to): the library's guard refuses it before anything is written. The batch removes
+only what wul3d wrote: an existing OUT/<sequence> holding anything else fails that sequence
+(as `wul3d run` refuses such an OUT), unless --overwrite, which replaces wul3d's own files
+only. OUT is locked (flock) for the whole batch: one writer at a time.
+
+Exit code: 0 when every sequence succeeded, 1 when some failed, 2 for bad arguments (and a
+refused or locked OUT), 130 after SIGINT, 143 after SIGTERM (batch.json written with what
+finished; docs/SCALE.md).
 """
 
 import argparse
+import asyncio
 import json
+import logging
 import os
 import pathlib
-import shutil
+import signal
 import socket
+import stat
 import sys
+import threading
 import time
 import uuid
 
-STAGING = ".staging"
+STAGING_PREFIX = ".wul3d.staging-"  # OUT/.wul3d.staging-<pid>-<id>/: one batch's tries
+LIVE_MARKER = ".wul3d.live"  # in a staging folder while its batch runs
+OWN_PREFIX = ".wul3d."  # names wul3d keeps for itself in OUT (check_frame_name refuses them)
 BATCH_JSON = "batch.json"
 DONE_MARKER = "summary.json"  # written last by the run loop
+FRAMES_FILE = "frames.jsonl"
+# The files wul3d writes in a frame folder: the library's frame_output_files()
+# (src/output.cpp; tests/python/test_batch_hostile.py checks that they agree).
+FRAME_OUTPUT_FILES = frozenset({
+    "labels.png", "colors.png", "selected.png", "objects.png", "objects.json",
+    "selected_object.png", "cloud.ply", "overlay.png"})
+MAX_DEPTH = 64  # folders below ROOT that discovery descends (a path stays under PATH_MAX)
+EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+EXIT_SIGNAL_BASE = 128  # 130 after SIGINT, 143 after SIGTERM, as a shell reports them
 # Options of `wul3d run` that pass through (flag name -> wul3d.run keyword).
 RUN_OPTIONS = {
     "preset": str, "k": int, "alpha": float, "delta": float, "gamma": float, "psi": float,
@@ -40,14 +64,139 @@ RUN_OPTIONS = {
 RUN_FLAGS = {"no_plane", "ply", "overlay"}
 
 
+class BatchError(ValueError):
+    """A batch refused as a whole (OUT against the input, a locked OUT): one line, exit 2."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM stopped the batch. `report` is batch.json's content (written),
+    `signum` the signal, `line` the one line that says so."""
+
+    def __init__(self, signum, report, line):
+        super().__init__(line)
+        self.signum, self.report, self.line = signum, report, line
+
+
+def text(name) -> str:
+    """`name` as valid Unicode: bytes that are not UTF-8 (a str from os.fsdecode carries them
+    as lone surrogates) become \\xNN escapes, so that JSON and terminals take it."""
+    if isinstance(name, bytes):
+        return name.decode("utf-8", "backslashreplace")
+    try:
+        name.encode("utf-8")
+        return name
+    except UnicodeEncodeError:
+        return os.fsencode(name).decode("utf-8", "backslashreplace")
+
+
+def _one_line(e: BaseException) -> str:
+    msg = str(e).splitlines()[0] if str(e).strip() else type(e).__name__
+    return text(msg)
+
+
 # ---- discovery ----------------------------------------------------------------------------
 
-def _is_frame(d: pathlib.Path) -> bool:
-    return (d / "depth.png").is_file()
+def _stat(path):
+    """os.stat (links followed), or None where it fails (gone, a dangling link, a loop)."""
+    try:
+        return os.stat(path)
+    except (OSError, ValueError):
+        return None
 
 
-def _is_tum(d: pathlib.Path) -> bool:
-    return (d / "rgb.txt").is_file() and (d / "depth.txt").is_file()
+def _is_file(path) -> bool:
+    st = _stat(path)
+    return st is not None and stat.S_ISREG(st.st_mode)
+
+
+def _is_frame(d) -> bool:
+    return _is_file(os.path.join(d, "depth.png"))
+
+
+def _is_tum(d) -> bool:
+    return _is_file(os.path.join(d, "rgb.txt")) and _is_file(os.path.join(d, "depth.txt"))
+
+
+class Discovery:
+    """What discover found under a root: `sequences` (paths relative to the root, "/"
+    separated, "." for the root itself; str as os.fsdecode gives them), `links` (the folders
+    outside the walk that symbolic links led to: inputs too, which OUT must stay apart from)
+    and `unread` ((path, reason) of folders that could not be listed or were too deep)."""
+
+    def __init__(self, sequences, links, unread):
+        self.sequences, self.links, self.unread = sequences, links, unread
+
+
+def _discover(root) -> Discovery:
+    root = os.fsdecode(root)
+    st = _stat(root)
+    if st is None or not stat.S_ISDIR(st.st_mode):
+        raise FileNotFoundError(f"{text(root)}: no such folder")
+    if _is_tum(root) or _is_frame(root):
+        return Discovery(["."], [], [])
+    # Every folder is listed once, by (device, inode): a link back into the tree (a loop)
+    # or a second link to one folder adds nothing. Real folders first, then the folders
+    # links lead to, so that a sequence is named by its real path where it has one.
+    visited = {(st.st_dev, st.st_ino)}
+    found, links, unread = [], [], []
+    walk = [()]  # relative paths as tuples of names, real folders
+    deferred = []  # (relative path, key) of folders reached through a symbolic link
+
+    def listing(rel):
+        path = os.path.join(root, *rel)
+        try:
+            with os.scandir(path) as it:
+                entries = sorted(it, key=lambda e: e.name)
+        except OSError as e:
+            unread.append((rel, e.strerror or type(e).__name__))
+            return
+        subdirs = []
+        for e in entries:
+            if e.name.startswith("."):
+                continue
+            cst = _stat(e.path)
+            if cst is None or not stat.S_ISDIR(cst.st_mode):
+                continue
+            try:
+                is_link = e.is_symlink()
+            except OSError:
+                continue
+            subdirs.append((e.name, (cst.st_dev, cst.st_ino), is_link))
+        if _is_tum(path):
+            found.append(rel)
+            return
+        frames = {name for name, _, _ in subdirs if _is_frame(os.path.join(path, name))}
+        if frames:
+            found.append(rel)
+        for name, key, is_link in subdirs:
+            if name in frames:
+                continue
+            child = rel + (name,)
+            if is_link:
+                deferred.append((child, key))
+            elif key not in visited:
+                visited.add(key)
+                if len(child) > MAX_DEPTH:
+                    unread.append((child, f"deeper than {MAX_DEPTH} folders"))
+                else:
+                    walk.append(child)
+
+    while walk or deferred:
+        if walk:
+            listing(walk.pop())
+            continue
+        child, key = deferred.pop(0)
+        if key in visited:
+            continue
+        visited.add(key)
+        if len(child) > MAX_DEPTH:
+            unread.append((child, f"deeper than {MAX_DEPTH} folders"))
+            continue
+        links.append(os.path.realpath(os.path.join(root, *child)))
+        walk.append(child)
+    found.sort()
+    return Discovery(["/".join(rel) if rel else "." for rel in found], links,
+                     [("/".join(rel) or ".", why) for rel, why in sorted(unread)])
 
 
 def discover(root) -> list:
@@ -57,27 +206,13 @@ def discover(root) -> list:
     frames (depth.png) is one sequence of those frames, as `wul3d run FOLDER` reads it; root
     itself being one frame is a sequence of one. Other folders are searched further (a
     folder can hold frames and sequences of its own). Hidden folders are skipped.
+    Symbolic links to folders are followed, each folder once (by device and inode): a loop
+    back into the tree, or two links to one folder, find nothing twice; a sequence reached
+    both by its real path and through a link is named by its real path. Folders more than
+    MAX_DEPTH (64) below root, and folders that cannot be listed, are not searched (the
+    batch reports them). Names that are not UTF-8 come back as os.fsdecode gives them.
     """
-    root = pathlib.Path(root)
-    if not root.is_dir():
-        raise FileNotFoundError(f"{root}: no such folder")
-    if _is_tum(root) or _is_frame(root):
-        return ["."]
-    found = []
-
-    def walk(d: pathlib.Path):
-        children = sorted(c for c in d.iterdir() if c.is_dir() and not c.name.startswith("."))
-        if _is_tum(d):
-            found.append(d)
-            return
-        if any(_is_frame(c) for c in children):
-            found.append(d)
-        for c in children:
-            if not _is_frame(c):
-                walk(c)
-
-    walk(root)
-    return [str(p.relative_to(root)) if p != root else "." for p in found]
+    return _discover(root).sequences
 
 
 def output_dir(out, root, rel) -> pathlib.Path:
@@ -86,29 +221,205 @@ def output_dir(out, root, rel) -> pathlib.Path:
 
 
 def is_finished(out_dir: pathlib.Path) -> bool:
-    return (out_dir / DONE_MARKER).is_file()
+    """Whether summary.json, the run loop's last write, is there (a plain file)."""
+    try:
+        st = os.lstat(pathlib.Path(out_dir) / DONE_MARKER)
+    except OSError:
+        return False
+    return stat.S_ISREG(st.st_mode)
+
+
+# ---- what wul3d wrote -----------------------------------------------------------------------
+
+def _lstat(path):
+    try:
+        return os.lstat(path)
+    except OSError:
+        return None
+
+
+def _own_listing(d):
+    """(the entries of folder `d` by name, but for `.wul3d.*` temporaries, None), or
+    ([], why it cannot be listed)."""
+    try:
+        entries = sorted(os.scandir(d), key=lambda e: e.name)
+    except OSError as e:
+        return [], f"{text(str(d))} ({e.strerror})"
+    return [e for e in entries if not e.name.startswith(OWN_PREFIX)], None
+
+
+def _foreign_in_frame_folder(d: pathlib.Path):
+    """The first entry of frame folder `d` that write_frame does not write, or None."""
+    entries, why = _own_listing(d)
+    for e in entries:
+        if e.name not in FRAME_OUTPUT_FILES or not e.is_file(follow_symlinks=False):
+            return text(e.path)
+    return why
+
+
+def foreign_entry(out_dir, nested=()):
+    """The first thing in the sequence output `out_dir` that wul3d did not write, or None:
+    the library's rule for an existing OUT (prepare_out_dir): summary.json and frames.jsonl
+    as plain files, `.wul3d.*` temporaries, frame folders holding only frame outputs; and
+    `nested`, the names of folders that hold other sequences' outputs of this batch."""
+    entries, why = _own_listing(out_dir)
+    for e in entries:
+        if e.name in (DONE_MARKER, FRAMES_FILE):
+            if not e.is_file(follow_symlinks=False):
+                return text(e.path)
+            continue
+        if not e.is_dir(follow_symlinks=False):
+            return text(e.path)
+        if e.name in nested:
+            continue
+        what = _foreign_in_frame_folder(pathlib.Path(e.path))
+        if what is not None:
+            return what
+    return why
+
+
+def _is_run_output(d: pathlib.Path) -> bool:
+    """Whether `d` holds only what a run into it writes (a task's staging folder)."""
+    return _lstat(d) is not None and stat.S_ISDIR(_lstat(d).st_mode) and \
+        foreign_entry(d) is None
+
+
+def _remove_run_output(d: pathlib.Path) -> bool:
+    """Removes the folder `d` if it holds only what wul3d writes (foreign_entry's rule):
+    its files of those names, its frame folders, then itself. Anything else stays (and so
+    does `d`). Returns whether `d` is gone."""
+    if not _is_run_output(d):
+        return False
+    for e in list(os.scandir(d)):
+        try:
+            if e.is_dir(follow_symlinks=False):
+                for f in list(os.scandir(e.path)):
+                    if f.is_dir(follow_symlinks=False):  # a .wul3d.partial-* of a killed run
+                        _remove_run_output(pathlib.Path(f.path))
+                    elif f.name in FRAME_OUTPUT_FILES or f.name.startswith(OWN_PREFIX):
+                        os.unlink(f.path)
+                os.rmdir(e.path)
+            elif e.name in (DONE_MARKER, FRAMES_FILE) or e.name.startswith(OWN_PREFIX):
+                os.unlink(e.path)
+        except OSError:
+            pass
+    try:
+        os.rmdir(d)
+        return True
+    except OSError:
+        return False
+
+
+def _make_staging(staging: pathlib.Path):
+    """A batch's staging folder, with the marker that tells its tasks it is live."""
+    staging.mkdir()
+    fd = os.open(staging / LIVE_MARKER, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW
+                 | os.O_CLOEXEC, 0o644)
+    os.close(fd)
+
+
+def _remove_staging(staging: pathlib.Path) -> bool:
+    """Removes a batch's staging folder: each task folder in it that holds only run outputs,
+    then the folder if that emptied it. Returns whether it is gone."""
+    try:
+        entries = list(os.scandir(staging))
+    except FileNotFoundError:
+        return True
+    except OSError:
+        return False
+    for e in entries:
+        if e.is_dir(follow_symlinks=False):
+            _remove_run_output(pathlib.Path(e.path))
+        elif e.name == LIVE_MARKER and e.is_file(follow_symlinks=False):
+            os.unlink(e.path)
+    try:
+        os.rmdir(staging)
+        return True
+    except OSError:
+        return False
 
 
 # ---- one task -----------------------------------------------------------------------------
 
-def _publish(staging: pathlib.Path, final: pathlib.Path):
+class Refused(ValueError):
+    """A sequence's output would replace what wul3d did not write."""
+
+
+def _check_write_target(target, kind, inputs, flag):
+    from . import _wul3d
+
+    _wul3d._check_write_target(os.fsencode(target), kind, [os.fsencode(i) for i in inputs],
+                               flag)
+
+
+def _replace_file(entry: pathlib.Path, target: pathlib.Path):
+    """Moves `entry` to `target`, replacing a plain file there; a link, hard link, FIFO or
+    folder under the name is refused (the library's guard), not replaced."""
+    _check_write_target(target, "file", [], text(str(target)))
+    os.replace(entry, target)
+
+
+def _no_link_on_the_way(top: pathlib.Path, final: pathlib.Path):
+    """Refuses a symbolic link among the folders between OUT and `final` (OUT/a -> elsewhere
+    for the sequence a/b): outputs are never written through a link out of OUT."""
+    path = top
+    for part in final.relative_to(top).parts[:-1]:
+        path = path / part
+        st = _lstat(path)
+        if st is not None and stat.S_ISLNK(st.st_mode):
+            raise Refused(f"{text(str(path))}: is a symbolic link; the batch writes no output "
+                          "through one: move it away")
+
+
+def _publish(staging: pathlib.Path, final: pathlib.Path, nested=(), overwrite=False):
     """Moves a complete staging folder to `final`: one rename when `final` does not exist;
-    else (it holds a nested sequence's output, or an unfinished earlier try) entry by entry,
-    the marker last."""
+    else (it holds a nested sequence's output, or an unfinished earlier try) entry by entry
+    with the marker last, and in a frame folder file by file, only the files of
+    FRAME_OUTPUT_FILES: nothing wul3d did not write is removed or replaced. An existing
+    `final` holding anything else is Refused, unless `overwrite` (then what is foreign stays
+    where it is, beside the new outputs)."""
     final.parent.mkdir(parents=True, exist_ok=True)
-    try:
-        os.rename(staging, final)
-        return
-    except OSError:
-        if not final.is_dir():
-            raise
-    (final / DONE_MARKER).unlink(missing_ok=True)
-    entries = sorted(staging.iterdir(), key=lambda p: p.name == DONE_MARKER)
+    if _lstat(final) is None:
+        try:
+            os.rename(staging, final)
+            return
+        except OSError:
+            if _lstat(final) is None:
+                raise
+    st = _lstat(final)
+    if not stat.S_ISDIR(st.st_mode):  # a link (never followed) or a file
+        raise Refused(f"{text(str(final))}: exists and is not a folder wul3d wrote; "
+                      "move it away")
+    if not overwrite:
+        what = foreign_entry(final, nested)
+        if what is not None:
+            raise Refused(f"{text(str(final))}: holds what wul3d did not write ({what}); "
+                          "choose another --out, or --overwrite to replace only wul3d's "
+                          "own files there")
+    marker = final / DONE_MARKER
+    m = _lstat(marker)
+    if m is not None and stat.S_ISREG(m.st_mode):
+        marker.unlink()  # unfinished until the new marker is in place
+    entries = sorted(staging.iterdir(), key=lambda p: (p.name == DONE_MARKER, p.name))
     for entry in entries:
         target = final / entry.name
-        if target.is_dir() and not target.is_symlink():
-            shutil.rmtree(target)
-        os.replace(entry, target)
+        if not entry.is_dir() or entry.is_symlink():
+            _replace_file(entry, target)
+            continue
+        t = _lstat(target)
+        if t is None:
+            os.rename(entry, target)
+            continue
+        if not stat.S_ISDIR(t.st_mode):
+            raise Refused(f"{text(str(target))}: exists and is not a frame folder; move it away")
+        new = {f.name for f in entry.iterdir()}
+        for name in sorted(new):
+            _replace_file(entry / name, target / name)
+        for name in sorted(FRAME_OUTPUT_FILES - new):  # what an earlier run wrote, not this
+            old = _lstat(target / name)
+            if old is not None and stat.S_ISREG(old.st_mode):
+                (target / name).unlink()
+        entry.rmdir()
     staging.rmdir()
 
 
@@ -121,43 +432,91 @@ def _frame_scores(input_dir: pathlib.Path, out_dir: pathlib.Path, names):
         gt_path = input_dir / name / "label.png"
         if not gt_path.is_file():
             continue
-        s = wul3d.evaluate(wul3d.read_label_image(str(out_dir / name / "objects.png")),
-                           wul3d.read_label_image(str(gt_path)))
+        s = wul3d.evaluate(wul3d.read_label_image(os.fsencode(out_dir / name / "objects.png")),
+                           wul3d.read_label_image(os.fsencode(gt_path)))
         s.pop("matches")
-        s["frame"] = name
+        s["frame"] = text(name)
         scores.append(s)
     return scores
 
 
-def run_sequence_task(input_dir: str, out_root: str, rel_out: str, options: dict,
-                      threads: int, score: bool = True) -> dict:
-    """One Dask task: `wul3d run` of one sequence into OUT/<rel_out>, staged and renamed.
-
-    Returns the sequence's record for batch.json. Bad input is caught and reported (status
-    "failed", error = the one-line reason); anything else (a dying worker) is Dask's to retry.
-    """
+def _run(input_dir: str, out: str, options: dict) -> dict:
+    """wul3d.run; with the paths as bytes where they are not UTF-8 (the binding takes bytes,
+    and wul3d.run would make "b'...'" of them)."""
     import wul3d
+    from . import _wul3d
 
-    record = {"sequence": rel_out, "input": input_dir, "worker": _worker_name(),
+    if text(input_dir) == input_dir and text(out) == out:
+        return wul3d.run(input_dir, out, **options)
+    return _wul3d._run(os.fsencode(input_dir), os.fsencode(out), dict(options))
+
+
+def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
+                      score: bool = True, staging_root=None, nested=(), overwrite=False,
+                      index=0) -> dict:
+    """One Dask task: `wul3d run` of one sequence into OUT/<rel_out>, staged and moved.
+
+    Paths may be str or bytes (bytes keep names that are not UTF-8 intact through Dask).
+    `staging_root` is the batch's staging folder (a new OUT/.wul3d.staging-* folder of this
+    task when None); the task's try runs in `<index>.<pid>.<random>` inside it. `nested`:
+    the names of folders in OUT/<rel_out> that hold other sequences' outputs.
+    Returns the sequence's record for batch.json. Bad input, or an existing output holding
+    what wul3d did not write, is caught and reported (status "failed", error = the one-line
+    reason); anything else (a dying worker) is Dask's to retry.
+    """
+    input_dir, out_root, rel_out = (os.fsdecode(p) for p in (input_dir, out_root, rel_out))
+    record = {"sequence": text(rel_out), "input": text(input_dir), "worker": _worker_name(),
               "status": "failed", "error": None, "frames": 0, "fps": 0.0, "wall_s": 0.0}
+    own_root = staging_root is None
+    staging_root = pathlib.Path(out_root) / (
+        f"{STAGING_PREFIX}{os.getpid()}-{uuid.uuid4().hex}" if own_root
+        else os.fsdecode(staging_root))
     # The worker's pid in the name: who is writing it (the fault tests kill that process).
-    staging = (pathlib.Path(out_root) / STAGING /
-               f"{rel_out.replace('/', '__')}.{os.getpid()}.{uuid.uuid4().hex}")
+    staging = staging_root / f"{index}.{os.getpid()}.{uuid.uuid4().hex}"
     final = pathlib.Path(out_root) / rel_out
     start = time.monotonic()
+    ended = False
+    batch_fd = None
     try:
         if threads > 0:
+            import wul3d
+
             wul3d.set_num_threads(threads)
-        staging.mkdir(parents=True)
-        summary = wul3d.run(input_dir, str(staging), **options)
+        if own_root:
+            _make_staging(staging_root)
+        # The batch renames its folder when it ends or is interrupted: then this try is not
+        # wanted (a task on a cluster's worker may outlive its batch). The folder is held
+        # open (its inode cannot be reused) and must hold the batch's marker (a folder the
+        # run made again at the path, creating its output's parents, does not).
+        batch_fd = os.open(staging_root, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+        batch_folder = os.fstat(batch_fd)
+        try:
+            os.stat(LIVE_MARKER, dir_fd=batch_fd, follow_symlinks=False)
+        except FileNotFoundError:
+            ended = True
+            raise Refused("the batch ended before this sequence started") from None
+        staging.mkdir()
+        summary = _run(input_dir, str(staging), options)
         names = sorted(p.name for p in staging.iterdir() if p.is_dir())
         record["scores"] = _frame_scores(pathlib.Path(input_dir), staging, names) if score else []
-        _publish(staging, final)
+        now = _lstat(staging_root)
+        if now is None or (now.st_dev, now.st_ino) != (batch_folder.st_dev, batch_folder.st_ino):
+            ended = True
+            raise Refused("the batch ended before this sequence was done; not published")
+        _check_write_target(final, "folder", [input_dir], "output folder")
+        _no_link_on_the_way(pathlib.Path(out_root), final)
+        _publish(staging, final, nested, overwrite)
         record.update(status="ok", frames=summary["frames"], fps=summary["fps"])
-    except (ValueError, OSError, RuntimeError) as e:  # wul3d.InputError is a ValueError
-        record["error"] = str(e).splitlines()[0] if str(e) else type(e).__name__
+    except (ValueError, OSError, RuntimeError, TypeError) as e:
+        # wul3d.InputError is a ValueError; UnicodeError too
+        record["error"] = _one_line(e)
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        if batch_fd is not None:
+            os.close(batch_fd)
+        if _lstat(staging) is not None:
+            _remove_run_output(staging)
+        if own_root or ended:
+            _remove_staging(staging_root)  # an ended batch's folder, made again by the run
         record["wall_s"] = time.monotonic() - start
     return record
 
@@ -169,6 +528,33 @@ def _worker_name() -> str:
         return get_worker().address
     except (ImportError, ValueError):
         return f"{socket.gethostname()}:{os.getpid()}"
+
+
+class IgnoreStopSignals:
+    """A Dask worker plugin for the batch's local workers: they ignore SIGINT and SIGTERM.
+    Ctrl-C (and a service manager's SIGTERM) reach the whole process group; the batch, not
+    each worker with a traceback, handles them, and then ends the workers itself. (A plugin,
+    not a preload: it is applied to restarted workers too.)"""
+
+    name = "wul3d-ignore-stop-signals"
+
+    def setup(self, worker):  # noqa: ARG002
+        if threading.current_thread() is threading.main_thread():
+            for s in (signal.SIGINT, signal.SIGTERM):
+                signal.signal(s, signal.SIG_IGN)
+
+
+def _end_local_workers(cluster):
+    """SIGKILL to the LocalCluster's worker processes, not restarted: a task running C++
+    for minutes would otherwise hold the cluster's close (Dask waits for it, then kills)."""
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        try:
+            nanny.auto_restart = False
+            pid = nanny.process.pid if nanny.process is not None else None
+            if pid:
+                os.kill(pid, signal.SIGKILL)
+        except (AttributeError, OSError):
+            pass
 
 
 # ---- the batch ----------------------------------------------------------------------------
@@ -207,14 +593,80 @@ def _uois_table(records):
             "per_sequence": {r["sequence"]: _wul3d._summarize(r["scores"]) for r in scored}}
 
 
+class _Signals:
+    """SIGINT and SIGTERM, while the batch runs (in the main thread only): the first one is
+    recorded (the batch stops at its next check, within a fraction of a second) and silences
+    Dask's logging of the shutdown; a second one ends the process at once."""
+
+    def __init__(self):
+        self.signum = None
+        self._old = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for s in (signal.SIGINT, signal.SIGTERM):
+                self._old[s] = signal.signal(s, self._handle)
+        return self
+
+    def _handle(self, signum, frame):  # noqa: ARG002
+        if self.signum is not None:
+            os._exit(EXIT_SIGNAL_BASE + signum)
+        self.signum = signum
+        _quiet_dask()
+
+    def __exit__(self, *exc):
+        for s, old in self._old.items():
+            signal.signal(s, old)
+        return False
+
+
+def _quiet_dask():
+    """No more log lines from Dask: it reports the workers being closed as errors."""
+    for name in ("distributed", "tornado", "asyncio", "bokeh"):
+        logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+
+def _write_batch_json(out: pathlib.Path, report: dict, inputs):
+    """OUT/batch.json, through the library's guard (a plain file or none there; not an input)
+    and a new temporary (O_EXCL, never a link followed) renamed over it. Every string is
+    valid Unicode: names that are not UTF-8 are escaped (text)."""
+    target = out / BATCH_JSON
+    _check_write_target(target, "file", inputs, BATCH_JSON)
+    tmp = out / f"{OWN_PREFIX}tmp-batch-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    data = (json.dumps(report, indent=2, ensure_ascii=False) + "\n").encode("utf-8")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, target)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _clean_strings(value):
+    """`value` with every str made valid Unicode (text)."""
+    if isinstance(value, str):
+        return text(value)
+    if isinstance(value, dict):
+        return {_clean_strings(k): _clean_strings(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean_strings(v) for v in value]
+    return value
+
+
 def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, options=None,
-              retries=1, progress=True, client=None, timeout_s=None, score=True) -> dict:
+              retries=1, progress=True, client=None, timeout_s=None, score=True,
+              overwrite=False) -> dict:
     """Runs every sequence under `root` (discover) into `out` on Dask; returns batch.json's
     content, also written to OUT/batch.json.
 
     Args:
         root: the dataset folder.
-        out: the output folder (shared by every worker).
+        out: the output folder (shared by every worker). It may not be `root`, lie inside it
+            or hold it, nor any folder a link under `root` leads to (BatchError, before
+            anything is written); it is locked for the whole batch (BatchError when another
+            batch or run holds it).
         scheduler: a Dask scheduler's address ("tcp://host:8786"); None starts a LocalCluster.
         workers: worker processes of the LocalCluster (default: one per 2 cores).
         threads_per_worker: wul3d threads in each task (default: cores // workers locally,
@@ -226,115 +678,274 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
         timeout_s: give up waiting after this many seconds (TimeoutError); None: no limit.
         score: False skips the UOIS table (scoring a 640x480 frame costs more than
             processing it, docs/SCALE.md).
+        overwrite: as `wul3d run --overwrite`: an existing OUT/<sequence> holding files
+            wul3d did not write is written anyway, replacing only wul3d's own files there
+            (without it, that sequence fails and nothing of it is touched).
+
+    Raises BatchError (a ValueError) for a refused or locked OUT, Interrupted (a
+    KeyboardInterrupt) after SIGINT or SIGTERM in the main thread, once batch.json is
+    written with what finished.
     """
     from distributed import Client, LocalCluster, wait
+    from distributed.utils import TimeoutError as DaskTimeoutError
 
-    root = pathlib.Path(root).resolve()
-    out = pathlib.Path(out).resolve()
-    options = dict(options or {})
     from . import _wul3d
 
+    options = dict(options or {})
     _wul3d._check_run_options(options)  # a bad option fails once, here, not in every task
-    sequences = discover(root)
+    out_given = os.fspath(out)
+    root = pathlib.Path(os.path.realpath(root))
+    try:
+        # Before anything is read or written: OUT apart from ROOT (however spelt).
+        _check_write_target(out_given, "folder", [root], "--out")
+        found = _discover(root)
+        inputs = [str(root)] + found.links  # the folders links lead to are inputs too
+        _check_write_target(out_given, "folder", inputs, "--out")
+        if _lstat(pathlib.Path(out_given) / BATCH_JSON) is not None:
+            _check_write_target(pathlib.Path(out_given) / BATCH_JSON, "file", inputs,
+                                BATCH_JSON)
+    except _wul3d.InputError as e:
+        raise BatchError(_one_line(e)) from None
+    out = pathlib.Path(os.path.realpath(out_given))
     out.mkdir(parents=True, exist_ok=True)
-    shutil.rmtree(out / STAGING, ignore_errors=True)  # tries of an interrupted batch
+    try:
+        lock = _wul3d._OutputLock(os.fsencode(out))  # one writer of OUT for the whole batch
+    except _wul3d.InputError as e:
+        raise BatchError(_one_line(e)) from None
+    try:
+        with _Signals() as signals:
+            return _run_locked(root, out, found, inputs, signals, scheduler, workers,
+                               threads_per_worker, options, retries, progress, client,
+                               timeout_s, score, overwrite, Client, LocalCluster, wait,
+                               DaskTimeoutError)
+    finally:
+        del lock
+
+
+def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_per_worker,
+                options, retries, progress, client, timeout_s, score, overwrite, Client,
+                LocalCluster, wait, DaskTimeoutError):
+    from . import _wul3d
+
+    _wul3d._remove_stale_temporaries(os.fsencode(out))  # of a run killed mid-write
+    for e in sorted(os.scandir(out), key=lambda e: e.name):  # of a batch killed mid-way
+        if e.name.startswith(STAGING_PREFIX) and e.is_dir(follow_symlinks=False):
+            _remove_staging(pathlib.Path(e.path))
+    staging = out / f"{STAGING_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
+    _make_staging(staging)
+
+    sequences = found.sequences
+    rel_outs = {rel: str(output_dir(out, root, rel).relative_to(out)) for rel in sequences}
+    all_outs = set(rel_outs.values())
+
+    def nested_names(rel_out):
+        prefix = rel_out + "/"
+        return sorted({o[len(prefix):].split("/")[0] for o in all_outs if o.startswith(prefix)})
 
     cluster = None
     own_client = client is None
-    if client is None:
-        if scheduler:
-            client = Client(scheduler, timeout="30s")
-        else:
-            cores = os.cpu_count() or 1
-            workers = workers or max(1, cores // 2)
-            threads_per_worker = threads_per_worker or max(1, cores // workers)
-            # One task per worker at a time: a task's own threads use the cores.
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=":0")
-            client = Client(cluster)
     start = time.monotonic()
     records, futures = {}, {}
+    interrupted = error = None
     try:
-        for rel in sequences:
-            rel_out = str(output_dir(out, root, rel).relative_to(out))
-            if is_finished(out / rel_out):
-                records[rel_out] = _finished_record(root / rel, out / rel_out, rel_out, score)
+        if client is None:
+            if scheduler:
+                client = Client(scheduler, timeout="30s")
+            else:
+                cores = os.cpu_count() or 1
+                workers = workers or max(1, cores // 2)
+                threads_per_worker = threads_per_worker or max(1, cores // workers)
+                # One task per worker at a time: a task's own threads use the cores. The
+                # workers ignore SIGINT and SIGTERM (IgnoreStopSignals): the batch handles
+                # them.
+                cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=":0")
+                client = Client(cluster)
+                client.register_worker_plugin(IgnoreStopSignals())
+        start = time.monotonic()
+        for index, rel in enumerate(sequences):
+            if signals.signum is not None:
+                break
+            rel_out = rel_outs[rel]
+            final = out / rel_out
+            if is_finished(final):
+                records[rel_out] = _finished_record(root / rel, final, rel_out, score)
                 continue
-            fut = client.submit(run_sequence_task, str(root / rel), str(out), rel_out, options,
-                                threads_per_worker or 0, score,
-                                key=f"wul3d-{rel_out}-{uuid.uuid4().hex}",
+            what = None if overwrite or _lstat(final) is None else foreign_entry(
+                final, nested_names(rel_out))
+            if what is not None:
+                records[rel_out] = _failed_record(
+                    rel_out, root / rel,
+                    f"{text(str(final))}: holds what wul3d did not write ({what}); choose "
+                    "another --out, or --overwrite to replace only wul3d's own files there")
+                continue
+            fut = client.submit(run_sequence_task, os.fsencode(root / rel), os.fsencode(out),
+                                os.fsencode(rel_out), options, threads_per_worker or 0, score,
+                                os.fsencode(staging), nested_names(rel_out), overwrite, index,
+                                key=f"wul3d-{index}-{uuid.uuid4().hex}",  # ASCII: Dask's keys
                                 retries=retries, pure=False)
-            futures[fut] = rel_out
+            futures[fut] = (rel_out, rel)
         bar = _Progress(len(sequences), progress)
         for _ in records:
             bar.step()
-        failed = 0
+        failed = sum(r["status"] == "failed" for r in records.values())
         pending = set(futures)
         deadline = None if timeout_s is None else time.monotonic() + timeout_s
-        while pending:
+        while pending and signals.signum is None:
             left = None if deadline is None else deadline - time.monotonic()
             if left is not None and left <= 0:
                 raise TimeoutError(f"wul3d.batch: {len(pending)} sequences unfinished after "
                                    f"{timeout_s} s")
-            done, pending = wait(pending, timeout=left, return_when="FIRST_COMPLETED")
-            for fut in sorted(done, key=lambda f: futures[f]):
-                rel_out = futures[fut]
+            lost = None
+            try:  # short waits: a signal is seen within a fraction of a second
+                done, pending = wait(pending, timeout=0.2 if left is None else min(0.2, left),
+                                     return_when="FIRST_COMPLETED")
+            except DaskTimeoutError:
+                continue
+            except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001
+                # The scheduler lost or cancelled some (a connection dropped): those end
+                # here as failed, the others are waited for.
+                lost = f"{type(e).__name__}: {_one_line(e)}"
+                done = {f for f in pending if f.status != "pending"} or set(pending)
+                pending = pending - done
+            for fut in sorted(done, key=lambda f: futures[f][0]):
+                rel_out, rel = futures[fut]
                 try:
-                    rec = fut.result()
-                except Exception as e:  # noqa: BLE001  (KilledWorker after too many deaths)
-                    rec = {"sequence": rel_out, "status": "failed", "worker": None,
-                           "frames": 0, "fps": 0.0, "wall_s": 0.0,
-                           "error": f"{type(e).__name__}: "
-                                    f"{str(e).splitlines()[0] if str(e) else ''}"}
+                    if fut.status == "pending":
+                        raise RuntimeError(lost)
+                    rec = fut.result(timeout=10)
+                except (Exception, asyncio.CancelledError) as e:  # noqa: BLE001  (KilledWorker
+                    # after too many deaths, a cancelled or lost task)
+                    rec = _failed_record(rel_out, root / rel, f"{type(e).__name__}: {_one_line(e)}")
+                rec["sequence"], rec["input"] = text(rel_out), text(str(root / rel))
                 failed += rec["status"] != "ok"
                 records[rel_out] = rec
                 bar.step(failed)
         bar.finish()
-        # Every task is over: what a killed worker was writing goes (its sequence was redone).
-        shutil.rmtree(out / STAGING, ignore_errors=True)
+        if signals.signum is not None and len(records) < len(sequences):
+            interrupted = signals.signum
+            started = set()
+            for e in os.scandir(staging):  # a task's try folder: "<index>.<pid>.<random>"
+                head = e.name.split(".", 1)[0]
+                if head.isdigit():
+                    started.add(int(head))
+            if pending:
+                client.cancel(list(pending), force=True)
+            for index, rel in enumerate(sequences):
+                if rel_outs[rel] not in records:
+                    records[rel_outs[rel]] = dict(
+                        _failed_record(rel_outs[rel], root / rel, None),
+                        status="stopped" if index in started else "not_started")
+    except Exception as e:  # a scheduler out of reach, timeout_s: batch.json all the same
+        error = e
+        for rel in sequences:
+            if rel_outs[rel] not in records:
+                records[rel_outs[rel]] = _failed_record(
+                    rel_outs[rel], root / rel, f"not finished: {_one_line(e)}")
     finally:
-        if own_client:
-            client.close()
+        if own_client and client is not None:
+            if interrupted is not None or signals.signum is not None:
+                _quiet_dask()
+                if cluster is not None:
+                    _end_local_workers(cluster)
+            client.close(timeout=5)
             if cluster is not None:
-                cluster.close()
+                cluster.close(timeout=5)
+        # Every task is over, or (on a cluster, or a client given) a task still running
+        # finds the folder renamed and publishes nothing, and its run fails at its next
+        # write. What a killed worker was writing goes (its sequence was redone).
+        ended = staging.with_name(staging.name + ".ended")
+        try:
+            os.rename(staging, ended)
+        except OSError:
+            ended = staging
+        for _ in range(3):
+            if _remove_staging(ended):
+                break
+            time.sleep(0.1)
+    if interrupted is not None:  # finished, but the result was not collected: OUT says so
+        for rel_out, rec in records.items():
+            if rec["status"] in ("stopped", "not_started") and is_finished(out / rel_out):
+                rel = next(r for r, o in rel_outs.items() if o == rel_out)
+                done = _finished_record(root / rel, out / rel_out, rel_out, False)
+                records[rel_out] = dict(done, status="ok")
     wall_s = time.monotonic() - start
-    ordered = [records[k] for k in sorted(records)]
+    names = sorted(records)
+    report = _report(root, out, options, scheduler, cluster, names,
+                     [records[k] for k in names], found, wall_s)
+    if interrupted is not None:
+        report["interrupted_by"] = signal.Signals(interrupted).name
+    _write_batch_json(out, report, inputs)
+    if error is not None:
+        raise error
+    if interrupted is not None:
+        t = report["totals"]
+        line = (f"wul3d.batch: interrupted by {signal.Signals(interrupted).name}; "
+                f"{t['succeeded'] + t['skipped']} sequences finished, {t['stopped']} stopped, "
+                f"{t['not_started']} not started; {t['failed']} failed "
+                f"-> {text(str(out / BATCH_JSON))}")
+        raise Interrupted(interrupted, report, line)
+    return report
+
+
+def _failed_record(rel_out, input_dir, error):
+    return {"sequence": text(rel_out), "input": text(str(input_dir)), "worker": None,
+            "status": "failed", "error": error, "frames": 0, "fps": 0.0, "wall_s": 0.0}
+
+
+def _report(root, out, options, scheduler, cluster, names, ordered, found, wall_s):
+    """batch.json's content; `names` are the sequences' output paths (as os.fsdecode gives
+    them), `ordered` their records, in that order."""
     frames = sum(r["frames"] for r in ordered if r["status"] in ("ok", "skipped"))
     done_now = sum(r["frames"] for r in ordered if r["status"] == "ok")
+    sequences = []
+    for name, r in zip(names, ordered):
+        rec = _clean_strings({k: v for k, v in r.items() if k != "scores"})
+        raw = os.fsencode(name) if text(name) != name else None
+        if raw is not None:  # the name's bytes, where it is not UTF-8
+            rec["sequence_hex"] = raw.hex()
+        sequences.append(rec)
     report = {
-        "root": str(root),
-        "out": str(out),
-        "options": options,
+        "root": text(str(root)),
+        "out": text(str(out)),
+        "options": _clean_strings(options),
         "scheduler": scheduler or ("local" if cluster is not None else "client"),
         "totals": {
             "sequences": len(ordered),
             "succeeded": sum(r["status"] == "ok" for r in ordered),
             "skipped": sum(r["status"] == "skipped" for r in ordered),
             "failed": sum(r["status"] == "failed" for r in ordered),
+            "stopped": sum(r["status"] == "stopped" for r in ordered),
+            "not_started": sum(r["status"] == "not_started" for r in ordered),
             "frames": frames,
             "frames_this_run": done_now,
             "wall_s": wall_s,
             "fps": done_now / wall_s if wall_s > 0 else 0.0,
         },
-        "sequences": [{k: v for k, v in r.items() if k != "scores"} for r in ordered],
+        "sequences": sequences,
     }
+    if found.unread:
+        report["not_searched"] = [{"folder": text(p), "reason": text(why)}
+                                  for p, why in found.unread]
     uois = _uois_table(ordered)
     if uois is not None:
-        report["uois"] = uois
-    tmp = out / f".{BATCH_JSON}.tmp-{os.getpid()}"
-    tmp.write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")
-    os.replace(tmp, out / BATCH_JSON)
+        report["uois"] = _clean_strings(uois)
     return report
 
 
 def _finished_record(input_dir, out_dir, rel_out, score):
     """batch.json's record of a sequence a previous run finished (its scores recomputed)."""
-    with open(out_dir / DONE_MARKER, encoding="utf-8") as f:
-        summary = json.load(f)
-    names = sorted(p.name for p in out_dir.iterdir() if p.is_dir() and (out_dir / p.name / "objects.png").is_file())
-    return {"sequence": rel_out, "input": str(input_dir), "worker": None, "status": "skipped",
-            "error": None, "frames": summary.get("frames", 0), "fps": summary.get("fps", 0.0),
-            "wall_s": 0.0,
+    try:
+        with open(out_dir / DONE_MARKER, encoding="utf-8", errors="replace") as f:
+            summary = json.load(f)
+    except (OSError, ValueError) as e:  # skipped all the same: its figures are unknown
+        summary = {"error": f"{DONE_MARKER}: {_one_line(e)}"}
+    names = sorted(p.name for p in out_dir.iterdir()
+                   if p.is_dir() and (out_dir / p.name / "objects.png").is_file())
+    return {"sequence": text(rel_out), "input": text(str(input_dir)), "worker": None,
+            "status": "skipped", "error": summary.get("error") if "frames" not in summary
+            else None, "frames": summary.get("frames", 0),
+            "fps": summary.get("fps", 0.0), "wall_s": 0.0,
             "scores": _frame_scores(pathlib.Path(input_dir), out_dir, names) if score else []}
 
 
@@ -363,12 +974,26 @@ def _parser():
     run.add_argument("--no-plane", action="store_true", help="as `wul3d run --no-plane`")
     run.add_argument("--ply", action="store_true", help="as `wul3d run --ply`")
     run.add_argument("--overlay", action="store_true", help="as `wul3d run --overlay`")
+    p.add_argument("--overwrite", action="store_true",
+                   help="as `wul3d run --overwrite`: write into an OUT/<sequence> that holds "
+                        "files wul3d did not write, replacing only wul3d's own files there")
     return p
 
 
 def main(argv=None) -> int:
+    try:
+        return _main(argv)
+    except Interrupted as e:
+        print(e.line, file=sys.stderr)
+        return EXIT_SIGNAL_BASE + e.signum
+    except KeyboardInterrupt:  # before the batch's own handling began (or after it)
+        print("wul3d.batch: interrupted by SIGINT before any sequence started", file=sys.stderr)
+        return EXIT_SIGNAL_BASE + signal.SIGINT
+
+
+def _main(argv) -> int:
     parser = _parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args([os.fsdecode(a) for a in argv] if argv is not None else None)
     for name in ("workers", "threads_per_worker"):
         value = getattr(args, name)
         if value is not None and value < 1:
@@ -379,18 +1004,20 @@ def main(argv=None) -> int:
         report = run_batch(args.root, args.out, scheduler=args.scheduler, workers=args.workers,
                            threads_per_worker=args.threads_per_worker, options=options,
                            retries=args.retries, progress=not args.quiet,
-                           score=not args.no_score)
+                           score=not args.no_score, overwrite=args.overwrite)
     except (FileNotFoundError, ValueError, OSError) as e:
-        print(f"wul3d.batch: {e}", file=sys.stderr)
-        return 2
+        print(f"wul3d.batch: {_one_line(e)}", file=sys.stderr)
+        return EXIT_USAGE
     t = report["totals"]
+    for r in report.get("not_searched", []):
+        print(f"wul3d.batch: {r['folder']}: not searched ({r['reason']})", file=sys.stderr)
     for r in report["sequences"]:
         if r["status"] == "failed":
             print(f"wul3d.batch: {r['sequence']}: {r['error']}", file=sys.stderr)
     print(f"wul3d.batch: {t['succeeded']} sequences done, {t['skipped']} already done, "
           f"{t['failed']} failed; {t['frames_this_run']} frames in {t['wall_s']:.1f} s "
           f"({t['fps']:.1f} FPS) -> {report['out']}/{BATCH_JSON}")
-    return 0 if t["failed"] == 0 else 1
+    return EXIT_OK if t["failed"] == 0 else EXIT_FAILED
 
 
 if __name__ == "__main__":

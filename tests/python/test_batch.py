@@ -24,8 +24,8 @@ from distributed import Client, LocalCluster  # noqa: E402  (Debian's python3-di
 
 from wul3d import batch  # noqa: E402
 
-TIMING_KEYS = {"wall_s", "fps", "ms_per_frame_median", "stage_ms_median", "peak_rss_mb",
-               "per_frame", "input", "threads"}
+TIMING_KEYS = {"wall_s", "fps", "fps_end_to_end", "ms_per_frame_median", "stage_ms_median",
+               "peak_rss_mb", "per_frame", "input", "threads"}
 SAMPLE_SEQUENCES = ["pcl_kinect", "pcl_kinect/pairwise_seq", "uois_tabletop"]
 # Workers import the module just built.
 os.environ["PYTHONPATH"] = os.pathsep.join(
@@ -89,7 +89,7 @@ def test_local_cluster_outputs_equal_wul3d_run(client, reference, tmp_path):
     for seq in SAMPLE_SEQUENCES:
         assert_same_as_reference(tmp_path / seq, reference / seq)
     assert json.loads((tmp_path / "batch.json").read_text()) == report
-    assert not (tmp_path / batch.STAGING).exists()
+    assert not staging_folders(tmp_path)
     assert "uois" not in report  # no label.png in the samples
 
 
@@ -97,11 +97,11 @@ def test_resume_skips_finished_and_redoes_unfinished(client, reference, tmp_path
     batch.run_batch(SAMPLES, tmp_path, client=client, threads_per_worker=1, progress=False,
                     timeout_s=300)
     # An interrupted batch: one sequence lost its marker (summary.json, written last) and a
-    # frame folder; a try left a staging folder behind.
+    # frame folder; a killed batch left its staging folder with a try's partial output.
     (tmp_path / "uois_tabletop" / "summary.json").unlink()
     shutil.rmtree(tmp_path / "uois_tabletop" / "image_0005")
-    stale = tmp_path / batch.STAGING / "uois_tabletop.1.dead"
-    stale.mkdir(parents=True)
+    stale = tmp_path / f"{batch.STAGING_PREFIX}1-dead"
+    shutil.copytree(tmp_path / "uois_tabletop" / "image_0000", stale / "2.1.dead" / "image_0000")
     finished = tmp_path / "pcl_kinect" / "pairwise_seq" / "capture0003" / "labels.png"
     before = finished.stat().st_mtime_ns
     report = batch.run_batch(SAMPLES, tmp_path, client=client, threads_per_worker=1,
@@ -114,6 +114,10 @@ def test_resume_skips_finished_and_redoes_unfinished(client, reference, tmp_path
     assert not stale.exists()
     for seq in SAMPLE_SEQUENCES:
         assert_same_as_reference(tmp_path / seq, reference / seq)
+
+
+def staging_folders(out: pathlib.Path):
+    return sorted(p.name for p in out.iterdir() if p.name.startswith(batch.STAGING_PREFIX))
 
 
 def make_root_with_bad_sequence(root: pathlib.Path):
@@ -243,8 +247,7 @@ def test_scheduler_and_workers_as_processes_survive_a_killed_worker(tmp_path):
         killed = None
         deadline = time.monotonic() + 120
         while killed is None and time.monotonic() < deadline and runner.is_alive():
-            staging = out / batch.STAGING
-            for d in (staging.iterdir() if staging.is_dir() else []):
+            for d in (out.glob(batch.STAGING_PREFIX + "*/[0-9]*") if out.is_dir() else []):
                 pid = int(d.name.split(".")[-2])
                 os.kill(pid, signal.SIGKILL)
                 killed = (d.name.split(".")[0], pid)
@@ -266,7 +269,7 @@ def test_scheduler_and_workers_as_processes_survive_a_killed_worker(tmp_path):
                            "--decimate", 1, "--threads", 1)
             assert proc.returncode == 0, proc.stderr
             assert_same_as_reference(out / seq, ref / seq)
-        assert not (out / batch.STAGING).exists()  # the killed try's folder is gone too
+        assert not staging_folders(out)  # the killed try's folder is gone too
     finally:
         procs.stop()
 
