@@ -459,45 +459,488 @@ def occluded(parts, o, d, t_max):
     return blocked
 
 
-def render(seed, width=640, height=480, truth=None):
-    """The frame of `seed`: colour, depth (mm), labels, intrinsics. `truth`, a dict, gets the
-    exact depth (`z`, metres), each pixel's world point (`world`), its part's label before
-    the visibility rule (`raw_labels`) and each label's kind of group (`kinds`, label ->
-    build_scene's kind), for the tests and eval/kinds.py."""
-    rng = np.random.default_rng(seed)
-    kind_of = {}
-    parts, (L, D, _) = build_scene(rng, np.random.default_rng([seed, 1]), kind_of)
-    pos, Rc = camera(rng, L, D)
-    s = width / 640.0
-    f, cx, cy = FOCAL * s, (width - 1) / 2.0, (height - 1) / 2.0
-    u, v = np.meshgrid(np.arange(width), np.arange(height))
-    rays_cam = np.stack([(u - cx) / f, (v - cy) / f, np.ones_like(u, dtype=float)], axis=-1).reshape(-1, 3)
-    d_world = rays_cam @ Rc  # camera -> world (rows of Rc are the camera axes)
-    d_norm = d_world / np.linalg.norm(d_world, axis=1, keepdims=True)
-    t, idx, n = cast(parts, pos, d_norm)
-    hit = t < INF
-    P = pos + np.where(hit[:, None], t[:, None], 0) * d_norm
-    z = (P - pos) @ Rc[2]  # depth along the optical axis
+# ---------------------------------------------------------------------------------------
+# More primitives for the pile and floor families: a sphere (fruit, balls) and any
+# primitive turned and moved (a can or a bottle lying on its side).
+# ---------------------------------------------------------------------------------------
+class Sphere:
+    def __init__(self, c, r):
+        self.c, self.r = np.asarray(c, float), float(r)
 
-    # Colour: each part's material, Lambert shading from a light above and a little behind
-    # the camera, plus ambient; a little sensor noise.
-    light = np.array([0.3, -0.5, 1.0])
-    light /= np.linalg.norm(light)
-    col = np.zeros((len(d_norm), 3))
-    labels = np.zeros(len(d_norm), np.int32)
-    for i, (_, lab, mat) in enumerate(parts):
-        m = idx == i
-        if not m.any():
+    def bound(self):
+        return self.c, self.r
+
+    def intersect(self, o, d):
+        w = o - self.c
+        b = d @ w
+        c = w @ w - self.r * self.r
+        disc = b * b - c
+        sq = np.sqrt(np.maximum(disc, 0))
+        t1, t2 = -b - sq, -b + sq
+        t = np.where(disc >= 0, np.where(t1 > 1e-6, t1, np.where(t2 > 1e-6, t2, INF)), INF)
+        p = o + np.where(t[:, None] < INF, t[:, None], 0) * d
+        n = (p - self.c) / self.r
+        return t, n
+
+
+class Posed:
+    """A primitive built in its own frame, placed at c with rotation R (columns: its axes in
+    the world). Directions stay unit length, so t is the world's."""
+
+    def __init__(self, prim, c, R):
+        self.prim, self.c, self.R = prim, np.asarray(c, float), np.asarray(R, float)
+
+    def bound(self):
+        b = self.prim.bound()
+        return None if b is None else (self.c + self.R @ b[0], b[1])
+
+    def intersect(self, o, d):
+        t, n = self.prim.intersect((o - self.c) @ self.R, d @ self.R)
+        return t, n @ self.R.T
+
+
+def speckled(rng):
+    """A carpet's material: two close colours in small cells, hashed from the cell's position."""
+    base = rng.uniform(40, 200, 3)
+    return {"kind": "speckle", "a": base, "b": np.clip(base + rng.uniform(-45, 45, 3), 0, 255),
+            "scale": rng.uniform(0.004, 0.012)}
+
+
+def shade_any(mat, p):
+    """shade(), and the carpet's speckle (tabletop never draws it)."""
+    if mat["kind"] == "speckle":
+        s = mat["scale"]
+        h = np.sin(np.floor(p[:, 0] / s) * 12.9898 + np.floor(p[:, 1] / s) * 78.233) * 43758.5453
+        m = (h - np.floor(h)) < 0.5
+        return np.where(m[:, None], mat["b"], np.broadcast_to(mat["a"], p.shape))
+    return shade(mat, p)
+
+
+# ---------------------------------------------------------------------------------------
+# Objects of the pile and floor families, placed on a support at height z0: each an item
+# with its parts, its footprint on the support (a convex polygon, x y) and, for a box
+# standing on its base, the top a stack may stand on.
+# ---------------------------------------------------------------------------------------
+def rect(cx, cy, hx, hy, yaw):
+    c, s = np.cos(yaw), np.sin(yaw)
+    loc = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+    return loc @ np.array([[c, s], [-s, c]]) + [cx, cy]
+
+
+def disk(cx, cy, r):
+    a = np.arange(12) * np.pi / 6
+    rr = r / np.cos(np.pi / 12)  # circumscribed: a polygon that does not cut the circle
+    return np.stack([cx + rr * np.cos(a), cy + rr * np.sin(a)], axis=1)
+
+
+def overlap(a, b):
+    """Whether two convex polygons overlap (separating axis test; touching is no overlap)."""
+    for poly in (a, b):
+        e = np.roll(poly, -1, axis=0) - poly
+        for nx, ny in np.stack([-e[:, 1], e[:, 0]], axis=1):
+            pa, pb = a @ [nx, ny], b @ [nx, ny]
+            if pa.max() <= pb.min() + 1e-9 or pb.max() <= pa.min() + 1e-9:
+                return False
+    return True
+
+
+def inside(poly, region):
+    """Whether all of poly lies in the convex region (a counter-clockwise polygon)."""
+    e = np.roll(region, -1, axis=0) - region
+    for (x0, y0), (ex, ey) in zip(region, e):
+        if ((poly[:, 0] - x0) * ey - (poly[:, 1] - y0) * ex > 1e-9).any():
+            return False
+    return True
+
+
+def new_object(rng, prints, z0, allow_lying=True):
+    """One YCB-like object centred at x = y = 0 on a support at height z0: a box (standing or
+    lying flat), a can, a bottle (body, shoulder, neck, cap), a fruit-like sphere or a can or
+    bottle lying on its side. Returns the item: kind, a `make(x, y)` that gives its parts,
+    its footprint at the origin, and for boxes their half sizes and yaw."""
+    kinds = ["box", "can", "bottle", "sphere", "lying"] if allow_lying else ["box", "can", "bottle", "sphere"]
+    w = np.array([4, 2, 1.5, 1.5, 1.0])[:len(kinds)]
+    kind = str(rng.choice(kinds, p=w / w.sum()))
+    mat = material(rng)
+    if kind == "box":
+        dims = np.sort(rng.uniform(0.015, 0.09, 3))
+        if rng.random() < 0.5:            # standing on its smallest face or lying on its largest
+            hx, hy, hz = dims[1], dims[0], dims[2]
+        else:
+            hx, hy, hz = dims[2], dims[1], dims[0]
+        yaw = rng.uniform(0, np.pi)
+        return {"kind": kind, "foot": rect(0, 0, hx, hy, yaw), "h": (hx, hy, hz), "yaw": yaw, "top": z0 + 2 * hz,
+                "make": lambda x, y: [(Box([x, y, z0 + hz], yaw_matrix(yaw), [hx, hy, hz]), mat)]}
+    if kind == "can":
+        r, h = rng.uniform(0.025, 0.05), rng.uniform(0.06, 0.15)
+        m = mat
+        if prints.random() < LABELLED:
+            m = with_label(prints, mat, h)
+            m["z0"] += z0
+            m["z1"] += z0
+        return {"kind": kind, "foot": disk(0, 0, r), "r": r, "height": h,
+                "make": lambda x, y: [(Cone(x, y, z0, z0 + h, r, r), m)]}
+    if kind == "bottle":
+        r, hb = rng.uniform(0.025, 0.045), rng.uniform(0.08, 0.16)
+        rn, hs, hn = r * rng.uniform(0.3, 0.5), rng.uniform(0.02, 0.05), rng.uniform(0.02, 0.05)
+        cap = material(rng, textured=False)
+        m = mat
+        if prints.random() < LABELLED:
+            m = with_label(prints, mat, hb)
+            m["z0"] += z0
+            m["z1"] += z0
+        return {"kind": kind, "foot": disk(0, 0, r), "r": r, "height": hb + hs + hn + 0.015,
+                "make": lambda x, y: [(Cone(x, y, z0, z0 + hb, r, r), m),
+                                      (Cone(x, y, z0 + hb, z0 + hb + hs, r, rn), mat),
+                                      (Cone(x, y, z0 + hb + hs, z0 + hb + hs + hn, rn, rn), mat),
+                                      (Cone(x, y, z0 + hb + hs + hn, z0 + hb + hs + hn + 0.015, rn * 1.2,
+                                            rn * 1.2), cap)]}
+    if kind == "sphere":
+        r = rng.uniform(0.025, 0.06)
+        return {"kind": kind, "foot": disk(0, 0, r), "r": r,
+                "make": lambda x, y: [(Sphere([x, y, z0 + r], r), mat)]}
+    r, length = rng.uniform(0.025, 0.045), rng.uniform(0.08, 0.2)
+    yaw = rng.uniform(0, np.pi)
+    # The axis along the world's x turned by yaw: local z (the cone's axis) -> world.
+    c, s = np.cos(yaw), np.sin(yaw)
+    R = np.array([[0, -s, c], [0, c, s], [-1, 0, 0.0]])
+    return {"kind": kind, "foot": rect(0, 0, length / 2, r, yaw),
+            "make": lambda x, y: [(Posed(Cone(0, 0, -length / 2, length / 2, r, r), [x, y, z0 + r], R), mat)]}
+
+
+def lean_on(rng, box_item, z0):
+    """A thin box (a packet, a board) or a bottle leaning on one side face of a standing box,
+    its foot on the support: returns (parts, footprint) or None."""
+    (bx, by), (hx, hy, hz), yaw = box_item["at"], box_item["h"], box_item["yaw"]
+    R = yaw_matrix(yaw)
+    axis = int(rng.integers(0, 2))
+    sign = rng.choice([-1, 1])
+    nf = R[:, axis] * sign                      # the face's outward normal (horizontal)
+    half_face = (hx, hy)[axis]
+    H = 2 * hz                                  # the box's height above the support
+    phi = rng.uniform(0.2, 0.5)                 # tilt from the vertical, towards the face
+    up = np.array([0, 0, 1.0])
+    a_dir = -np.sin(phi) * nf + np.cos(phi) * up    # up the leaning object
+    b_dir = np.cos(phi) * nf + np.sin(phi) * up     # through it, outwards
+    t_dir = np.cross(up, nf)
+    offset = rng.uniform(-0.5, 0.5) * (hy, hx)[axis]
+    face = np.array([bx, by, z0]) + nf * half_face + t_dir * offset
+    mat = material(rng)
+    if rng.random() < 0.6:
+        length, thick, width = rng.uniform(0.08, 0.22), rng.uniform(0.008, 0.025), rng.uniform(0.03, 0.08)
+        # Its inner face's top corner on the box's face, or its inner face on the box's top edge.
+        x0 = min(length * np.sin(phi), H * np.tan(phi))
+        corner = face + nf * x0                 # the inner bottom edge, on the support
+        centre = corner + a_dir * length / 2 + b_dir * thick / 2
+        Rl = np.stack([b_dir, t_dir, a_dir], axis=1)
+        if np.linalg.det(Rl) < 0:
+            Rl[:, 1] = -Rl[:, 1]
+        prim = Box(centre, Rl, [thick / 2, width / 2, length / 2])
+        corners = centre + (np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]) *
+                            [thick / 2, width / 2, length / 2]) @ Rl.T
+    else:
+        r, length = rng.uniform(0.025, 0.04), rng.uniform(0.12, 0.22)
+        # The bottom rim rests on the support; the top rim on the face, or the side on the top edge.
+        if length * np.cos(phi) <= H:
+            xb = length * np.sin(phi) + r * np.cos(phi)
+        else:
+            xb = ((H - r * np.sin(phi)) * np.sin(phi) + r) / np.cos(phi)
+        base = face + nf * xb + up * r * np.sin(phi)
+        centre = base + a_dir * length / 2
+        Rl = np.stack([b_dir, t_dir, a_dir], axis=1)
+        if np.linalg.det(Rl) < 0:
+            Rl[:, 1] = -Rl[:, 1]
+        prim = Posed(Cone(0, 0, -length / 2, length / 2, r, r), centre, Rl)
+        ring = np.array([[np.cos(q) * r, np.sin(q) * r, e * length / 2] for q in np.arange(8) * np.pi / 4
+                         for e in (-1, 1)])
+        corners = centre + ring @ Rl.T
+    if corners[:, 2].min() < z0 - 1e-6:
+        return None
+    return [(prim, mat)], hull(corners[:, :2])
+
+
+def hull(pts):
+    """The convex hull of 2-D points, counter-clockwise (monotone chain)."""
+    pts = sorted(map(tuple, np.round(pts, 9)))
+
+    def half(seq):
+        out = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1]) -
+                                     (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0:
+                out.pop()
+            out.append(p)
+        return out
+    lower, upper = half(pts), half(pts[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def place_pile(rng, prints, n, z0, region, centre, spread, touch, items, kind_of, parts, label):
+    """n objects on the support at height z0 inside `region` (a convex polygon): the first
+    near `centre`, each next one slid against an object already there (share `touch`) until
+    it touches it or another, else dropped at a free spot within `spread`. Then leans on
+    some standing boxes and stacks two or three high on others. Appends to items, parts and
+    kind_of; returns the last label used."""
+    placed = 0
+    tries = 0
+    ground = [it for it in items if it["z0"] == z0]
+    while placed < n and tries < 10 * n + 20:
+        tries += 1
+        obj = new_object(rng, prints, z0)
+        foot = obj["foot"]
+        at = None
+        if ground and rng.random() < touch:
+            anchor = ground[int(rng.integers(0, len(ground)))]
+            theta = rng.uniform(0, 2 * np.pi)
+            u = np.array([np.cos(theta), np.sin(theta)])
+            prev = None
+            for d in np.arange(0.0, 0.4, 0.004):
+                p = np.array(anchor["at"]) + d * u
+                if not any(overlap(foot + p, it["foot"]) for it in items):
+                    prev = d
+                    break
+            if prev is not None and prev > 0:
+                lo, hi = prev - 0.004, prev      # touching: the last overlap .. the first free
+                for _ in range(8):
+                    mid = (lo + hi) / 2
+                    if any(overlap(foot + np.array(anchor["at"]) + mid * u, it["foot"]) for it in items):
+                        lo = mid
+                    else:
+                        hi = mid
+                gap = 0.0 if rng.random() < 0.75 else rng.uniform(0.002, 0.015)
+                at = np.array(anchor["at"]) + (hi + gap) * u
+        else:
+            at = np.array(centre) + rng.uniform(-spread, spread, 2)
+        if at is None or not inside(foot + at, region) or any(overlap(foot + at, it["foot"]) for it in items):
             continue
-        col[m] = shade(mat, P[m])
-        labels[m] = lab
-    lam = np.clip(n @ light, 0, 1)
-    facing = np.clip(-(n * d_norm).sum(axis=1), 0, 1)
-    col = col * (0.45 + 0.45 * lam[:, None] + 0.1 * facing[:, None])
-    col += rng.normal(0, 2.0, col.shape)
-    col[~hit] = 0
-    color = np.clip(col, 0, 255).astype(np.uint8).reshape(height, width, 3)
+        label += 1
+        placed += 1
+        kind_of[label] = obj["kind"]
+        for prim, mat in obj["make"](*at):
+            parts.append((prim, label, mat))
+        item = {"kind": obj["kind"], "foot": foot + at, "at": at, "z0": z0, "label": label,
+                "h": obj.get("h"), "yaw": obj.get("yaw"), "top": obj.get("top"), "busy": False}
+        items.append(item)
+        ground.append(item)
+    # Leaning on a standing box's side.
+    for it in [g for g in ground if g["kind"] == "box" and g["h"][2] >= 0.03 and not g["busy"]]:
+        if rng.random() < 0.3:
+            got = lean_on(rng, it, z0)
+            if got is None:
+                continue
+            lparts, foot = got
+            others = [o for o in items if o is not it]
+            if not inside(foot, region) or any(overlap(foot, o["foot"]) for o in others):
+                continue
+            label += 1
+            kind_of[label] = "lean"
+            for prim, mat in lparts:
+                parts.append((prim, label, mat))
+            items.append({"kind": "lean", "foot": foot, "at": foot.mean(axis=0), "z0": z0, "label": label,
+                          "h": None, "yaw": None, "top": None, "busy": True})
+            it["busy"] = True
+    # Stacks: a smaller box (or a can) on a box's top, sometimes a third on that.
+    for it in [g for g in ground if g["kind"] == "box" and not g["busy"]]:
+        it["busy"] = True       # looked at once: a later call stacks nothing more on it
+        below = it
+        for level in range(2):
+            if rng.random() >= (0.45 if level == 0 else 0.35):
+                break
+            (hx, hy, hz), yaw = below["h"], below["yaw"]
+            top = below["top"]
+            R2 = yaw_matrix(yaw)
+            if rng.random() < 0.75:
+                ux, uy = hx * rng.uniform(0.5, 0.95), hy * rng.uniform(0.5, 0.95)
+                uz = rng.uniform(0.012, 0.06)
+                off = R2 @ np.array([rng.uniform(-1, 1) * (hx - ux), rng.uniform(-1, 1) * (hy - uy), 0])
+                c = np.array(below["at"]) + off[:2]
+                label += 1
+                kind_of[label] = "stack"
+                parts.append((Box([c[0], c[1], top + uz], R2, [ux, uy, uz]), label, material(rng)))
+                below = {"at": c, "h": (ux, uy, uz), "yaw": yaw, "top": top + 2 * uz}
+            else:
+                r = min(hx, hy) * rng.uniform(0.6, 0.95)
+                if r < 0.02:
+                    break
+                h = rng.uniform(0.05, 0.12)
+                label += 1
+                kind_of[label] = "stack"
+                parts.append((Cone(below["at"][0], below["at"][1], top, top + h, r, r), label, material(rng)))
+                break
+    return label
 
+
+def look_at(target, dist, elevation, azimuth, rng):
+    """A camera `dist` from target, `elevation` above the horizontal (pi/2: straight down),
+    its heading `azimuth` from the world's +y; right is horizontal, so straight down works."""
+    h = np.array([np.sin(azimuth), np.cos(azimuth), 0.0])
+    pos = target - h * dist * np.cos(elevation) + np.array([0, 0, dist * np.sin(elevation)])
+    fwd = (target - pos) / dist
+    right = np.array([np.cos(azimuth), -np.sin(azimuth), 0.0])
+    down = np.cross(fwd, right)
+    roll = rng.normal(0, 0.03)
+    cr, sr = np.cos(roll), np.sin(roll)
+    right, down = cr * right + sr * down, -sr * right + cr * down
+    return pos, np.stack([right, down, fwd])
+
+
+def build_pile(rng, prints, kind_of):
+    """OCID-like: 5-20 small objects in a pile on a table, touching, leaning and stacked two or
+    three high, seen from 0.8-1.5 m at 40-90 degrees (looking down); the table top at z = 0."""
+    parts = []
+    table_h = rng.uniform(0.70, 0.78)
+    L, D = rng.uniform(1.4, 2.2), rng.uniform(0.9, 1.3)
+    wood = material(rng, textured=False)
+    wood["a"] = np.array([rng.uniform(150, 225), rng.uniform(110, 170), rng.uniform(60, 120)])
+    parts.append((Box([0, 0, -0.015], np.eye(3), [L / 2, D / 2, 0.015]), 0, wood))
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            parts.append((Box([sx * (L / 2 - 0.05), sy * (D / 2 - 0.05), -table_h / 2 - 0.015],
+                              np.eye(3), [0.025, 0.025, table_h / 2 - 0.015]), 0, wood))
+    parts.append((Plane([0, 0, 1], -table_h), 0, material(rng)))
+    parts.append((Plane([0, -1, 0], -(D / 2 + rng.uniform(0.0, 0.6))), 0, material(rng, textured=False)))
+    n = int(rng.integers(5, 21))
+    centre = np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)])
+    region = rect(0, 0, L / 2 - 0.03, D / 2 - 0.03, 0.0)
+    items = []
+    n_ground = max(3, int(round(n * rng.uniform(0.65, 0.85))))
+    label = place_pile(rng, prints, n_ground, 0.0, region, centre, 0.12, 0.85, items, kind_of, parts, 0)
+    for _ in range(3):          # stacks and leans fell short of n: more on the table
+        if label >= n:
+            break
+        label = place_pile(rng, prints, n - label, 0.0, region, centre, 0.12, 0.85, items, kind_of, parts, label)
+    # Drop the objects past n (stacks and leans may add a few).
+    keep = [(p, (lab if lab <= n else 0), m) for p, lab, m in parts if lab <= n]
+    for lab in list(kind_of):
+        if lab > n:
+            del kind_of[lab]
+    target = np.array([centre[0], centre[1], 0.03]) + np.append(rng.uniform(-0.08, 0.08, 2), 0)
+    pos, Rc = look_at(target, rng.uniform(0.8, 1.5), np.radians(rng.uniform(40, 90)), rng.uniform(-0.5, 0.5), rng)
+    return keep, pos, Rc
+
+
+def build_floor(rng, prints, kind_of):
+    """Objects on the floor (z = 0) or a carpet, and on a low board or tray lying on it; the
+    floor, the carpet, the board or tray, the walls and a cabinet are background."""
+    parts = []
+    floor_mat = material(rng)
+    parts.append((Plane([0, 0, 1], 0.0), 0, floor_mat))
+    back = rng.uniform(0.8, 2.0)
+    wall = material(rng, textured=False)
+    parts.append((Plane([0, -1, 0], -back), 0, wall))
+    side = rng.choice([-1, 1]) * rng.uniform(0.9, 2.0)
+    parts.append((Plane([-np.sign(side), 0, 0], -abs(side)), 0, wall))
+    if rng.random() < 0.5:
+        parts.append((Box([rng.uniform(-0.8, 0.8), back - 0.22, 0.4], np.eye(3), [0.4, 0.2, 0.4]), 0,
+                      material(rng)))
+    ground_z = 0.0
+    region = rect(0, 0, 1.2, min(back, 1.2) - 0.25, 0.0)
+    if rng.random() < 0.7:
+        cl, cd, ch = rng.uniform(0.6, 1.3), rng.uniform(0.5, 0.9), rng.uniform(0.004, 0.012)
+        cc = np.array([rng.uniform(-0.2, 0.2), rng.uniform(-0.2, 0.1)])
+        parts.append((Box([cc[0], cc[1], ch / 2], yaw_matrix(0), [cl, cd, ch / 2]), 0,
+                      speckled(rng) if rng.random() < 0.6 else material(rng, textured=True)))
+        ground_z = ch
+        region = rect(cc[0], cc[1], cl - 0.02, cd - 0.02, 0.0)
+    # The board or the tray.
+    bl, bd = rng.uniform(0.2, 0.4), rng.uniform(0.15, 0.3)
+    bh = rng.uniform(0.01, 0.03)
+    byaw = rng.uniform(-0.4, 0.4)
+    bc = np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1)])
+    Rb = yaw_matrix(byaw)
+    board_mat = material(rng, textured=False)
+    if rng.random() < 0.5:
+        board_mat["a"] = rng.uniform(200, 245) * np.ones(3)   # a white board, as YCB-Video's
+    parts.append((Box([bc[0], bc[1], ground_z + bh / 2], Rb, [bl, bd, bh / 2]), 0, board_mat))
+    top = ground_z + bh
+    inner_l, inner_d = bl - 0.01, bd - 0.01
+    if rng.random() < 0.4:   # a tray: a rim round the board
+        rim_h, rim_t = rng.uniform(0.015, 0.04), 0.008
+        for (ox, oy, hx, hy) in ((bl - rim_t, 0, rim_t, bd), (-(bl - rim_t), 0, rim_t, bd),
+                                 (0, bd - rim_t, bl, rim_t), (0, -(bd - rim_t), bl, rim_t)):
+            c = np.append(bc + (Rb @ [ox, oy, 0])[:2], top + rim_h / 2)
+            parts.append((Box(c, Rb, [hx, hy, rim_h / 2]), 0, board_mat))
+        inner_l, inner_d = bl - 2 * rim_t - 0.003, bd - 2 * rim_t - 0.003
+    board_foot = rect(bc[0], bc[1], bl, bd, byaw)
+    items = []
+    n_board = int(rng.integers(2, 10))
+    label = place_pile(rng, prints, n_board, top, rect(bc[0], bc[1], inner_l, inner_d, byaw), bc, 0.08, 0.7,
+                       items, kind_of, parts, 0)
+    items.append({"kind": "board", "foot": board_foot, "at": bc, "z0": -1.0, "label": 0, "h": None, "yaw": None,
+                  "top": None, "busy": True})
+    n_floor = int(rng.integers(1, 8))
+    label = place_pile(rng, prints, n_floor, ground_z, region, bc + rng.uniform(-0.4, 0.4, 2), 0.4, 0.4,
+                       items, kind_of, parts, label)
+    target = np.array([bc[0], bc[1], 0.0]) + np.append(rng.uniform(-0.15, 0.15, 2), 0)
+    pos, Rc = look_at(target, rng.uniform(0.9, 1.8), np.radians(rng.uniform(35, 80)), rng.uniform(-0.5, 0.5), rng)
+    return parts, pos, Rc
+
+
+FAMILIES = ["tabletop", "pile", "floor"]
+
+
+# ---------------------------------------------------------------------------------------
+# Sensors. Colour and depth come from one camera (depth registered to the colour image),
+# 640x480 for all (or --width/--height, the focal length scaled with the width); each
+# sensor's focal length is its colour camera's at 640x480.
+# ---------------------------------------------------------------------------------------
+SENSORS = {
+    # Kinect v1: colour and depth 640x480, f = 525 px (the OpenNI default).
+    "structured_light": {"focal": FOCAL},
+    # RealSense D435: its colour stream at 640x480 has f of about 615 px (69 x 42 degrees).
+    "active_stereo": {"focal": 615.0},
+    # Azure Kinect, narrow-field unbinned depth (640x576, 75 x 65 degrees: f of about 504 px),
+    # cropped to 640x480, colour transformed into the depth camera (as its SDK does).
+    "tof": {"focal": 504.0},
+}
+
+# Active stereo (RealSense D4xx). Depth RMS error = z^2 x subpixel RMS / (f x baseline)
+# (Intel's D400 depth-quality white paper): the noise is in disparity, so it grows with z^2.
+AS_FOCAL_DEPTH = 383.0   # px: the D435's depth imagers at 640x480 (87 x 58 degrees full field, cropped)
+AS_BASELINE = 0.050      # m: the D435's left-right imager baseline (D415: 55 mm)
+AS_SUBPIXEL_RMS = 0.08   # px: the white paper's typical subpixel RMS on a textured target
+AS_ZMIN, AS_ZMAX = 0.3, 6.0  # m: about the D435's minimum depth at 640x480; far enough for a room
+AS_FATTEN = 3            # px at 640: foreground bleeds into the background up to half a 7 x 7
+                         # correlation window (edge fattening of block matching), 1-3 px a pixel
+AS_HOLES = 0.02          # share of pixels lost in speckle holes (blobs of a few px where matching fails)
+
+# Time of flight (Kinect v2 / Azure Kinect, AMCW).
+TOF_ZMIN, TOF_ZMAX = 0.5, 3.86   # m: Azure Kinect NFOV unbinned operating range
+TOF_SIGMA_REF = 0.0015   # m of random error at amplitude TOF_AMP_REF (Kinect v2 / Azure: 1-2 mm at
+TOF_AMP_REF = 0.25       # 1 m on a mid-grey target); it grows as 1/sqrt(amplitude)
+TOF_SIGMA_MAX = 0.017    # m: the Azure Kinect's documented bound on the random error's std
+TOF_SIGMA_MIN = 0.0005
+TOF_AMP_DROP = (0.02, 0.06)  # amplitude (albedo x cos / range^2, m^-2) below which a pixel is
+                             # always / never invalidated: the depth engine drops low-signal pixels
+                             # (dark surfaces, grazing angles, far)
+TOF_EDGE = 0.02          # m: a jump to a neighbour that makes a pixel's footprint straddle an edge
+TOF_FLY = 0.6            # share of edge pixels that return a mixed depth (flying pixels)...
+TOF_EDGE_INVALID = 0.25  # ...and that the depth engine's mixed-pixel test invalidates
+TOF_MP_GAIN = 4.0        # strength of the second bounce (multipath) between facing surfaces: a few
+                         # mm to about 1 cm in a concave corner, as measured on Kinect v2 / Azure
+
+
+def shift(a, dy, dx, fill=0):
+    """out[y, x] = a[y + dy, x + dx], `fill` outside."""
+    out = np.full_like(a, fill)
+    H, W = a.shape[:2]
+    ys, yd = (slice(dy, H), slice(0, H - dy)) if dy >= 0 else (slice(0, H + dy), slice(-dy, H))
+    xs, xd = (slice(dx, W), slice(0, W - dx)) if dx >= 0 else (slice(0, W + dx), slice(-dx, W))
+    out[yd, xd] = a[ys, xs]
+    return out
+
+
+def box_blur(a, r):
+    """Mean over a (2r+1)^2 window (edges padded)."""
+    p = np.pad(a, r, mode="edge")
+    c = np.cumsum(np.cumsum(p, axis=0), axis=1)
+    c = np.pad(c, ((1, 0), (1, 0)))
+    k = 2 * r + 1
+    return (c[k:, k:] - c[:-k, k:] - c[k:, :-k] + c[:-k, :-k]) / (k * k)
+
+
+def depth_structured_light(rng, parts, pos, Rc, P, z, hit, d_norm, f, s, width, height):
+    """Kinect v1 (the generator's model since version 1; unchanged)."""
     # Depth: the projector sits BASELINE to the camera's right; a point it does not see has
     # no depth (the shadow beside an object).
     proj = pos + Rc[0] * BASELINE
@@ -527,6 +970,183 @@ def render(seed, width=640, height=480, truth=None):
     jump[1:, :] |= dz_v
     jump[:-1, :] |= dz_v
     valid &= ~(jump & (rng.random(jump.shape) < 0.5))
+    zt = z.reshape(height, width)
+    fb = f * BASELINE
+    info = {"clean": valid.copy(), "sigma_px": DISPARITY_SIGMA * s, "fb": fb,
+            "bound": zt * zt / fb * (5 * DISPARITY_SIGMA * s + 1 / SUBPIXEL) + 0.001}
+    return zq, valid, info
+
+
+def depth_active_stereo(rng, parts, pos, Rc, P, z, hit, s, width, height):
+    """RealSense D4xx-like: disparity noise (error ~ z^2), no depth where the right imager does
+    not see the point (the invalid band left of near objects, as wide as the disparity step
+    between them and what is behind), edges fattened into the background, speckle holes."""
+    valid = hit & (z > AS_ZMIN) & (z < AS_ZMAX)
+    right = pos + Rc[0] * AS_BASELINE
+    to_r = P - right
+    dist_r = np.linalg.norm(to_r, axis=1)
+    band = np.zeros(len(z), bool)
+    cand = np.nonzero(valid)[0]
+    band[cand] = occluded(parts, right, to_r[cand] / dist_r[cand, None], dist_r[cand])
+    valid &= ~band
+    fb = AS_FOCAL_DEPTH * s * AS_BASELINE
+    sigma = AS_SUBPIXEL_RMS * s
+    disp = np.where(valid, fb / np.where(z > 0, z, 1), 0) + rng.normal(0, sigma, len(z))
+    zq = np.where(valid & (disp > 0), fb / np.where(disp > 0, disp, 1), 0).reshape(height, width)
+    valid = valid.reshape(height, width) & (zq > 0)
+    # Fattening: a background pixel within 1-3 px of a nearer surface takes its depth.
+    R = max(1, int(round(AS_FATTEN * s)))
+    reach = rng.integers(1, R + 1, (height, width))
+    step = 0.02 + 3 * zq * zq / fb * sigma
+    near = np.where(valid, zq, np.inf)
+    zf = zq.copy()
+    fat = np.zeros_like(valid)
+    for dy in range(-R, R + 1):
+        for dx in range(-R, R + 1):
+            if (dy or dx) and max(abs(dy), abs(dx)) <= R:
+                nb = shift(near, dy, dx, np.inf)
+                take = valid & (max(abs(dy), abs(dx)) <= reach) & (nb < zf - step)
+                zf = np.where(take, nb, zf)
+                fat |= take
+    # Speckle holes: blobs of a few pixels where matching fails.
+    blur = box_blur(rng.random((height, width)), max(1, int(round(2 * s))))
+    holes = blur > np.quantile(blur, 1 - AS_HOLES)
+    valid &= ~holes
+    zt = z.reshape(height, width)
+    info = {"clean": valid & ~fat, "fattened": fat & valid, "band": band.reshape(height, width),
+            "sigma_px": sigma, "fb": fb, "bound": zt * zt / fb * 5 * sigma + 0.001}
+    return np.where(valid, zf, 0), valid, info
+
+
+def multipath(P, nrm, albedo, pos, ok, height, width, s):
+    """Extra range (m, >= 0) from light that bounced off a facing surface nearby before
+    reaching the point: the ToF phase of the mix lies behind the direct one. Sampled on rings
+    of 4, 10 and 20 px (at 640) around each pixel; only surfaces that face each other count
+    (concave corners: an object's foot on the table, boxes side by side, floor and wall)."""
+    P3, N3 = P.reshape(height, width, 3), nrm.reshape(height, width, 3)
+    A, ok2 = albedo.reshape(height, width), ok.reshape(height, width)
+    CP = np.linalg.norm(P3 - pos, axis=2)
+    bias = np.zeros((height, width))
+    wsum = np.zeros((height, width))
+    samples = [(r, a) for r in (4, 10, 20) for a in np.arange(8) * np.pi / 4]
+    for r, a in samples:
+        rr = max(1.0, r * s)
+        dy, dx = int(round(rr * np.sin(a))), int(round(rr * np.cos(a)))
+        Q, NQ = shift(P3, dy, dx), shift(N3, dy, dx)
+        AQ, okq = shift(A, dy, dx), shift(ok2, dy, dx, False)
+        d = Q - P3
+        dist = np.linalg.norm(d, axis=2) + 1e-9
+        cp = (d * N3).sum(axis=2) / dist
+        cq = -(d * NQ).sum(axis=2) / dist
+        m = ok2 & okq & (cp > 0.1) & (cq > 0.1)
+        w = np.where(m, TOF_MP_GAIN * AQ * cp * cq / len(samples), 0)
+        excess = np.linalg.norm(Q - pos, axis=2) + dist - CP
+        bias += w * np.maximum(excess, 0) / 2
+        wsum += w
+    return (bias / (1 + wsum)).reshape(-1)
+
+
+def depth_tof(rng, P, z, hit, nrm, d_norm, lum, pos, width, height, s):
+    """Kinect v2 / Azure Kinect-like: noise growing as the returned signal falls, dropouts
+    where it is too weak (dark surfaces, grazing, far), multipath pushing depth back in
+    concave corners, flying pixels (mixed depths) along depth edges."""
+    valid = hit & (z > TOF_ZMIN) & (z < TOF_ZMAX)
+    rng_m = np.linalg.norm(P - pos, axis=1)
+    facing = np.clip(-(nrm * d_norm).sum(axis=1), 0, 1)
+    albedo = lum / 255.0    # the colour's brightness stands for the near-infrared albedo
+    amp = albedo * np.maximum(facing, 0.05) / np.maximum(rng_m, 0.1) ** 2
+    lo, hi = TOF_AMP_DROP
+    dropped = rng.random(len(z)) < np.clip((hi - amp) / (hi - lo), 0, 1)
+    sigma = np.clip(TOF_SIGMA_REF * np.sqrt(TOF_AMP_REF / np.maximum(amp, 1e-6)), TOF_SIGMA_MIN, TOF_SIGMA_MAX)
+    mp = np.where(valid, multipath(P, nrm, albedo, pos, valid, height, width, s), 0)
+    zt = np.where(valid, z * (1 + mp / np.maximum(rng_m, 1e-6)) + rng.normal(0, 1, len(z)) * sigma, 0)
+    zt = zt.reshape(height, width)
+    valid = valid.reshape(height, width)
+    # Flying pixels: a pixel with a neighbour across a depth jump mixes the two depths (or is
+    # invalidated); the neighbour with the largest jump is the other side.
+    best = np.zeros_like(zt)
+    other = np.zeros_like(zt)
+    for dy, dx in ((0, 1), (0, -1), (1, 0), (-1, 0)):
+        nb = shift(zt, dy, dx)
+        nv = shift(valid, dy, dx, False)
+        j = np.where(valid & nv, np.abs(nb - zt), 0)
+        better = j > best
+        best = np.where(better, j, best)
+        other = np.where(better, nb, other)
+    edge = best > TOF_EDGE
+    r = rng.random(zt.shape)
+    fly = edge & (r < TOF_FLY)
+    inval = edge & (r >= TOF_FLY) & (r < TOF_FLY + TOF_EDGE_INVALID)
+    w = rng.random(zt.shape)
+    zout = np.where(fly, w * zt + (1 - w) * other, zt)
+    valid = valid & ~inval & ~dropped.reshape(height, width)
+    z2 = z.reshape(height, width)
+    s2 = sigma.reshape(height, width)
+    mp2 = mp.reshape(height, width)
+    info = {"clean": valid & ~fly, "flying": fly & valid, "multipath": mp2,
+            "amplitude": amp.reshape(height, width), "dropped": dropped.reshape(height, width),
+            "sigma_m": s2, "bound": 5 * s2 + 0.0011 + mp2 * z2 / np.maximum(rng_m.reshape(height, width), 1e-6),
+            "near": np.minimum(zt, np.where(fly, other, zt)), "far": np.maximum(zt, np.where(fly, other, zt))}
+    return np.where(valid, zout, 0), valid, info
+
+
+def render(seed, width=640, height=480, truth=None, family="tabletop", sensor="structured_light"):
+    """The frame of `seed` in `family` seen by `sensor`: colour, depth (mm), labels,
+    intrinsics. `truth`, a dict, gets the exact depth (`z`, metres), each pixel's world point
+    (`world`), its part's label before the visibility rule (`raw_labels`), each label's kind of
+    group (`kinds`, label -> kind) and the sensor model's `clean` pixels (their depth is the
+    ray cast's within `bound`, metres) and masks, for the tests and eval/kinds.py."""
+    if family not in FAMILIES:
+        raise ValueError(f"unknown family {family!r} (one of {', '.join(FAMILIES)})")
+    if sensor not in SENSORS:
+        raise ValueError(f"unknown sensor {sensor!r} (one of {', '.join(SENSORS)})")
+    rng = np.random.default_rng(seed)
+    kind_of = {}
+    prints = np.random.default_rng([seed, 1])
+    if family == "tabletop":
+        parts, (L, D, _) = build_scene(rng, prints, kind_of)
+        pos, Rc = camera(rng, L, D)
+    elif family == "pile":
+        parts, pos, Rc = build_pile(rng, prints, kind_of)
+    else:
+        parts, pos, Rc = build_floor(rng, prints, kind_of)
+    s = width / 640.0
+    f, cx, cy = SENSORS[sensor]["focal"] * s, (width - 1) / 2.0, (height - 1) / 2.0
+    u, v = np.meshgrid(np.arange(width), np.arange(height))
+    rays_cam = np.stack([(u - cx) / f, (v - cy) / f, np.ones_like(u, dtype=float)], axis=-1).reshape(-1, 3)
+    d_world = rays_cam @ Rc  # camera -> world (rows of Rc are the camera axes)
+    d_norm = d_world / np.linalg.norm(d_world, axis=1, keepdims=True)
+    t, idx, n = cast(parts, pos, d_norm)
+    hit = t < INF
+    P = pos + np.where(hit[:, None], t[:, None], 0) * d_norm
+    z = (P - pos) @ Rc[2]  # depth along the optical axis
+
+    # Colour: each part's material, Lambert shading from a light above and a little behind
+    # the camera, plus ambient; a little sensor noise.
+    light = np.array([0.3, -0.5, 1.0])
+    light /= np.linalg.norm(light)
+    col = np.zeros((len(d_norm), 3))
+    labels = np.zeros(len(d_norm), np.int32)
+    for i, (_, lab, mat) in enumerate(parts):
+        m = idx == i
+        if not m.any():
+            continue
+        col[m] = shade_any(mat, P[m])
+        labels[m] = lab
+    lum = col.mean(axis=1)
+    lam = np.clip(n @ light, 0, 1)
+    facing = np.clip(-(n * d_norm).sum(axis=1), 0, 1)
+    col = col * (0.45 + 0.45 * lam[:, None] + 0.1 * facing[:, None])
+    col += rng.normal(0, 2.0, col.shape)
+    col[~hit] = 0
+    color = np.clip(col, 0, 255).astype(np.uint8).reshape(height, width, 3)
+
+    if sensor == "structured_light":
+        zq, valid, info = depth_structured_light(rng, parts, pos, Rc, P, z, hit, d_norm, f, s, width, height)
+    elif sensor == "active_stereo":
+        zq, valid, info = depth_active_stereo(rng, parts, pos, Rc, P, z, hit, s, width, height)
+    else:
+        zq, valid, info = depth_tof(rng, P, z, hit, n, d_norm, lum, pos, width, height, s)
     depth_mm = np.where(valid, np.round(zq * 1000), 0).astype(np.uint16)
 
     # Labels: objects with too few pixels with depth are background (nothing could find them).
@@ -545,8 +1165,8 @@ def render(seed, width=640, height=480, truth=None):
         truth["world"] = P.reshape(height, width, 3)
         truth["raw_labels"] = labels
         truth["kinds"] = out_kinds
-        truth["sigma_px"] = DISPARITY_SIGMA * s
-        truth["fb"] = f * BASELINE
+        truth["sensor"] = sensor
+        truth.update(info)
     intr = {"fx": f, "fy": f, "cx": cx, "cy": cy, "width": width, "height": height,
             "depth_scale_m_per_unit": 0.001}
     return color, depth_mm, out, intr
@@ -575,6 +1195,10 @@ def main(argv=None):
     ap.add_argument("--seeds", required=True, help="A-B (inclusive) or one seed")
     ap.add_argument("--width", type=int, default=640)
     ap.add_argument("--height", type=int, default=480)
+    ap.add_argument("--family", default="tabletop", choices=FAMILIES,
+                    help="the kind of scene (default tabletop: a table in a room)")
+    ap.add_argument("--sensor", default="structured_light", choices=list(SENSORS),
+                    help="the depth sensor's model (default structured_light: Kinect v1)")
     a = ap.parse_args(argv)
     try:
         seeds = parse_seeds(a.seeds)
@@ -583,10 +1207,11 @@ def main(argv=None):
     if a.width < 32 or a.height < 24:
         sys.exit("scenegen.py: --width and --height must be at least 32 and 24")
     for seed in seeds:
-        write(a.out / f"scene_{seed:05d}", *render(seed, a.width, a.height))
+        write(a.out / f"scene_{seed:05d}", *render(seed, a.width, a.height, family=a.family, sensor=a.sensor))
     # Last, so that a folder with it is whole: eval/benchmark.py reuses only such a folder.
     (a.out / "scenegen.json").write_text(json.dumps(
-        {"version": VERSION, "seeds": a.seeds, "width": a.width, "height": a.height}) + "\n")
+        {"version": VERSION, "seeds": a.seeds, "width": a.width, "height": a.height,
+         "family": a.family, "sensor": a.sensor}) + "\n")
     print(f"scenegen.py: {len(seeds)} scenes -> {a.out}")
 
 

@@ -169,5 +169,149 @@ class Scenegen(unittest.TestCase):
         self.assertIn("empty", str(e.exception.code))
 
 
+class FamiliesAndSensors(unittest.TestCase):
+    """Every family under every sensor: a small scene whose labels and depth agree with the
+    ray cast, and each sensor's own artefacts where its model puts them."""
+    W, H = 160, 120
+    SEEDS = {"tabletop": 7, "pile": 10003, "floor": 20003}
+
+    @classmethod
+    def setUpClass(cls):
+        cls.frames = {}
+        for family in scenegen.FAMILIES:
+            for sensor in scenegen.SENSORS:
+                truth = {}
+                frame = scenegen.render(cls.SEEDS[family], cls.W, cls.H, truth, family=family, sensor=sensor)
+                cls.frames[family, sensor] = frame, truth
+
+    def test_default_is_tabletop_under_structured_light_and_a_seed_renders_the_same_twice(self):
+        a = scenegen.render(7, self.W, self.H)
+        b = self.frames["tabletop", "structured_light"][0]
+        for x, y in zip(a[:3], b[:3]):
+            np.testing.assert_array_equal(x, y)
+        for family, sensor in (("pile", "tof"), ("floor", "active_stereo")):
+            again = scenegen.render(self.SEEDS[family], self.W, self.H, family=family, sensor=sensor)
+            for x, y in zip(self.frames[family, sensor][0][:3], again[:3]):
+                np.testing.assert_array_equal(x, y)
+
+    def test_labels_are_whole_visible_objects_on_the_support(self):
+        scale = (640 / self.W) ** 2
+        for (family, sensor), ((_, depth, label, _), truth) in self.frames.items():
+            with self.subTest(family=family, sensor=sensor):
+                raw = truth["raw_labels"]
+                n = int(label.max())
+                self.assertGreaterEqual(n, 2 if family != "tabletop" else 1)
+                self.assertLessEqual(n, 20)
+                np.testing.assert_array_equal(np.unique(label), np.arange(n + 1))
+                for lab in range(1, n + 1):
+                    m = label == lab
+                    parts = np.unique(raw[m])
+                    self.assertEqual(len(parts), 1)
+                    self.assertGreater(parts[0], 0)
+                    np.testing.assert_array_equal(m, raw == parts[0])
+                    self.assertGreaterEqual((m & (depth > 0)).sum() * scale, scenegen.MIN_VISIBLE)
+                for part in np.setdiff1d(np.unique(raw), [0]):
+                    if not (label[raw == part] > 0).any():
+                        self.assertLess(((raw == part) & (depth > 0)).sum() * scale, scenegen.MIN_VISIBLE)
+                # Objects rest on the support (the table top or the floor, z = 0) or above it.
+                self.assertGreaterEqual(truth["world"][..., 2][label > 0].min(), -1e-6)
+                self.assertEqual(sorted(truth["kinds"]), list(range(1, n + 1)))
+
+    def test_depth_is_the_ray_cast_within_each_sensors_noise(self):
+        for (family, sensor), ((_, depth, label, intr), truth) in self.frames.items():
+            with self.subTest(family=family, sensor=sensor):
+                z = truth["z"]
+                valid = depth > 0
+                clean = truth["clean"]
+                self.assertTrue((valid[clean]).all())
+                self.assertGreater(valid.mean(), 0.5)
+                self.assertGreater(clean.sum(), 0.75 * valid.sum())
+                err = np.abs(depth * intr["depth_scale_m_per_unit"] - z)
+                self.assertTrue((err[clean] <= truth["bound"][clean]).all(),
+                                f"worst {(err - truth['bound'])[clean].max():.4f} m over the bound")
+                # The objects' pixels are mostly clean: the labels hold where the depth does.
+                self.assertGreater((clean & (label > 0)).sum(), 0.6 * ((label > 0) & valid).sum())
+                # Missing depth where the ray hit something (shadows, bands, edges, dropouts).
+                self.assertGreater(((z > 0) & ~valid).sum(), 0)
+                self.assertEqual(intr["fx"], scenegen.SENSORS[sensor]["focal"] * self.W / 640)
+
+    def test_active_stereo_fattens_edges_and_leaves_a_band_left_of_near_objects(self):
+        for family in scenegen.FAMILIES:
+            (_, depth, _, _), truth = self.frames[family, "active_stereo"]
+            with self.subTest(family=family):
+                z, d = truth["z"], depth / 1000.0
+                fat = truth["fattened"]
+                self.assertGreater(fat.sum(), 0)
+                # A fattened pixel took a nearer surface's depth, from within 3 px (at 640).
+                self.assertTrue((d[fat] < z[fat] - 0.01).all())
+                near = np.full(z.shape, np.inf)
+                for dy in (-1, 0, 1):
+                    for dx in (-1, 0, 1):
+                        near = np.minimum(near, scenegen.shift(np.where(depth > 0, d, np.inf), dy, dx, np.inf))
+                # The band: no depth, and a nearer surface a little to its right.
+                band = truth["band"] & (z > 0)
+                self.assertGreater(band.sum(), 0)
+                self.assertFalse((depth[band] > 0).any())
+                reach = int(np.ceil(self.W / 640 * scenegen.SENSORS["active_stereo"]["focal"] *
+                                    scenegen.AS_BASELINE / scenegen.AS_ZMIN)) + 2
+                right = np.full(z.shape, np.inf)
+                for dx in range(1, reach + 1):
+                    right = np.minimum(right, scenegen.shift(np.where(z > 0, z, np.inf), 0, dx, np.inf))
+                self.assertTrue((right[band] < z[band] - 0.005).mean() > 0.95)
+
+    def test_tof_flying_pixels_multipath_and_dark_dropouts(self):
+        for family in scenegen.FAMILIES:
+            (_, depth, _, _), truth = self.frames[family, "tof"]
+            with self.subTest(family=family):
+                d = depth / 1000.0
+                fly = truth["flying"]
+                self.assertGreater(fly.sum(), 0)
+                tol = 0.0011
+                self.assertTrue((d[fly] >= truth["near"][fly] - tol).all())
+                self.assertTrue((d[fly] <= truth["far"][fly] + tol).all())
+                mp = truth["multipath"]
+                self.assertGreaterEqual(mp.min(), 0.0)
+                self.assertGreater(mp.max(), 0.002)   # a corner somewhere pushes depth back
+                amp, dropped = truth["amplitude"], truth["dropped"]
+                lo, hi = scenegen.TOF_AMP_DROP
+                self.assertTrue(dropped[amp <= lo].all())
+                self.assertFalse(dropped[amp >= hi].any())
+                self.assertFalse((depth[dropped] > 0).any())
+
+    def test_the_families_hold_what_they_say(self):
+        counts = {"pile": [], "floor": []}
+        for family in counts:
+            for seed in range(30):
+                kind_of = {}
+                rng = np.random.default_rng(seed)
+                if family == "pile":
+                    parts, pos, Rc = scenegen.build_pile(rng, np.random.default_rng([seed, 1]), kind_of)
+                    # Looking down at 40-90 degrees (roll aside) from 0.8-1.5 m (a target 3 cm up).
+                    self.assertGreaterEqual(-Rc[2][2], np.sin(np.radians(40)) - 0.01)
+                    self.assertTrue(0.8 * np.sin(np.radians(40)) < pos[2] <= 1.5 + 0.03 + 1e-9, pos)
+                    self.assertTrue(5 <= len(kind_of) <= 20, len(kind_of))
+                else:
+                    parts, pos, Rc = scenegen.build_floor(rng, np.random.default_rng([seed, 1]), kind_of)
+                    self.assertTrue(1 <= len(kind_of) <= 20, len(kind_of))
+                counts[family].append(kind_of)
+                labels = sorted({lab for _, lab, _ in parts if lab > 0})
+                self.assertEqual(labels, list(range(1, len(kind_of) + 1)))
+        kinds = {k for ks in counts["pile"] for k in ks.values()}
+        self.assertLessEqual({"box", "can", "bottle", "sphere", "stack", "lean"}, kinds)
+
+    def test_family_and_sensor_are_written_and_unknown_ones_refused(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            scenegen.main(["--out", tmp, "--seeds", "11000", "--width", "64", "--height", "48",
+                           "--family", "pile", "--sensor", "tof"])
+            stamp = json.loads((pathlib.Path(tmp) / "scenegen.json").read_text())
+            self.assertEqual((stamp["family"], stamp["sensor"]), ("pile", "tof"))
+            _, depth, label, _ = scenegen.render(11000, 64, 48, family="pile", sensor="tof")
+            np.testing.assert_array_equal(np.array(Image.open(pathlib.Path(tmp) / "scene_11000" / "depth.png")), depth)
+        with self.assertRaises(ValueError):
+            scenegen.render(1, 64, 48, family="garden")
+        with self.assertRaises(ValueError):
+            scenegen.render(1, 64, 48, sensor="lidar")
+
+
 if __name__ == "__main__":
     unittest.main()
