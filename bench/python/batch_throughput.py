@@ -5,8 +5,9 @@ local worker processes (docs/SCALE.md).
     PYTHONPATH=build/python /usr/bin/python3 bench/python/batch_throughput.py \
         [ROOT] [--copies 4] [--workers 1,2] [--threads-per-worker 1] [--decimate 2]
 
-ROOT (default data/samples) is linked --copies times under a temporary root, so that there
-are enough sequences to keep the workers busy; each configuration runs into a fresh output
+ROOT (default data/samples) is copied --copies times under a temporary root (files hard-linked
+where the filesystem allows: discovery reads a folder reached twice through links once), so
+that there are enough sequences to keep the workers busy; each configuration runs into a fresh output
 folder. The wall time is the batch's own (batch.json "wall_s"): from the first task submitted
 to the last result, the cluster's start-up excluded (it is reported apart).
 """
@@ -14,6 +15,7 @@ import argparse
 import json
 import os
 import pathlib
+import shutil
 import sys
 import tempfile
 import time
@@ -21,6 +23,13 @@ import time
 from wul3d import batch
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def _link_or_copy(src, dst):
+    try:
+        os.link(src, dst)
+    except OSError:
+        shutil.copy2(src, dst)
 
 
 def main(argv=None):
@@ -38,7 +47,8 @@ def main(argv=None):
         root = pathlib.Path(tmp) / "root"
         root.mkdir()
         for i in range(args.copies):
-            os.symlink(pathlib.Path(args.root).resolve(), root / f"copy{i}")
+            shutil.copytree(pathlib.Path(args.root).resolve(), root / f"copy{i}",
+                            copy_function=_link_or_copy)
         n_seq = len(batch.discover(root))
         for workers in (int(w) for w in args.workers.split(",")):
             t0 = time.monotonic()

@@ -16,6 +16,7 @@
 #include "wul3d/parse.hpp"
 #include "wul3d/registration.hpp"
 #include "wul3d/stop.hpp"
+#include "wul3d/output.hpp"
 #include "wul3d/write_guard.hpp"
 
 #if __has_include("wul3d/run.hpp")
@@ -180,6 +181,7 @@ void bind_run(py::module_& m) {
             return py::dict(py::arg("frames") = s.frames, py::arg("stopped_by") = s.stopped_by,
                             py::arg("ms_per_frame_median") = s.ms_per_frame_median,
                             py::arg("fps") = s.fps, py::arg("wall_s") = s.wall_s,
+                            py::arg("fps_end_to_end") = s.end_to_end_fps,
                             py::arg("peak_rss_mb") = s.peak_rss_mb);
         },
         py::arg("input"), py::arg("out"), py::arg("options"));
@@ -215,6 +217,8 @@ void bind_write_guard(py::module_& m) {
                            "The advisory lock of an output folder (wul3d/write_guard.hpp): "
                            "raises wul3d.InputError when another process writes it.")
         .def(py::init<const std::string&>(), py::arg("dir"));
+    m.def("_frame_output_files", &frame_output_files,
+          "The files wul3d writes in a frame folder (output.hpp, frame_output_files).");
     m.def("_remove_stale_temporaries", &remove_stale_temporaries, py::arg("dir"),
           "Removes the .wul3d.tmp-* / .wul3d.partial-* a killed writer left in `dir`.");
 }

@@ -157,8 +157,8 @@ def run(input, out, **options) -> dict:
             overwrite (as `wul3d run --overwrite`).
 
     Returns:
-        dict: frames, stopped_by, ms_per_frame_median, fps, wall_s, peak_rss_mb (as in
-        summary.json). The GIL is released while it runs.
+        dict: frames, stopped_by, ms_per_frame_median, fps, wall_s, fps_end_to_end,
+        peak_rss_mb (as in summary.json). The GIL is released while it runs.
 
     Ctrl-C stops the run within a second, even mid-frame: the frames before are complete,
     OUT/summary.json says "stopped_by": "signal", then KeyboardInterrupt is raised.
