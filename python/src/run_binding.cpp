@@ -83,48 +83,67 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     return r;
 }
 
-/// SIGINT while a run is on the main thread: the CLI's handling (frame_feed.cpp) for as long
-/// as the run lasts. The handler asks the library to stop (stop.hpp), which the stages check
-/// mid-frame; the run then ends as "signal" with its outputs complete, and KeyboardInterrupt
-/// is raised once summary.json is written. Python's own handler cannot do this: it runs only
-/// when the main thread runs Python, which it does not until the run returns.
-volatile std::sig_atomic_t g_interrupted = 0;
+/// SIGINT and SIGTERM while a run is on the main thread: the CLI's handling (frame_feed.cpp)
+/// for as long as the run lasts. The handler asks the library to stop (stop.hpp), which the
+/// stages check mid-frame; the run then ends as "signal" with its outputs complete, and once
+/// summary.json is written SIGINT raises KeyboardInterrupt and SIGTERM ends the process as
+/// its default action would. Python's own handler cannot do this: it runs only when the
+/// main thread runs Python, which it does not until the run returns.
+volatile std::sig_atomic_t g_stopped_by = 0;  // the signal that stopped the run, 0 none
 
-extern "C" void on_interrupt(int) {
-    g_interrupted = 1;
+extern "C" void on_stop_signal(int signal_number) {
+    g_stopped_by = signal_number;
     request_stop();
 }
 
 class InterruptScope {
 public:
-    /// Takes SIGINT over only where Python would raise KeyboardInterrupt for it: on the main
-    /// thread, with the default handler (signal.default_int_handler) in place. GIL held.
+    /// Takes a signal over only where Python leaves it to its default: SIGINT with
+    /// signal.default_int_handler (KeyboardInterrupt), SIGTERM with SIG_DFL; and only on the
+    /// main thread. GIL held.
     InterruptScope() {
         const py::module_ threading = py::module_::import("threading");
         const py::module_ signal = py::module_::import("signal");
         if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return;
-        if (!signal.attr("getsignal")(SIGINT).is(signal.attr("default_int_handler"))) return;
-        g_interrupted = 0;
+        g_stopped_by = 0;
         clear_stop_request();
-        struct sigaction sa {};
-        sa.sa_handler = on_interrupt;
-        sigemptyset(&sa.sa_mask);
-        sa.sa_flags = SA_RESETHAND;  // as the command: a second Ctrl-C ends the process at once
-        installed_ = sigaction(SIGINT, &sa, &previous_) == 0;
+        if (signal.attr("getsignal")(SIGINT).is(signal.attr("default_int_handler")))
+            int_.take(SIGINT);
+        if (signal.attr("getsignal")(SIGTERM).equal(signal.attr("SIG_DFL"))) term_.take(SIGTERM);
     }
     ~InterruptScope() {
-        if (!installed_) return;
-        sigaction(SIGINT, &previous_, nullptr);  // Python's handler again
-        if (g_interrupted) clear_stop_request();  // later runs and pipelines start afresh
+        int_.give_back(SIGINT);  // Python's handlers again
+        term_.give_back(SIGTERM);
+        if (g_stopped_by) clear_stop_request();  // later runs and pipelines start afresh
     }
     InterruptScope(const InterruptScope&) = delete;
     InterruptScope& operator=(const InterruptScope&) = delete;
 
-    bool interrupted() const { return installed_ && g_interrupted; }
+    bool interrupted() const { return (int_.taken || term_.taken) && g_stopped_by != 0; }
+    /// After a SIGTERM stopped the run: its default action, now that the outputs are final.
+    void end_if_terminated() {
+        if (!term_.taken || g_stopped_by != SIGTERM) return;
+        term_.give_back(SIGTERM);
+        std::raise(SIGTERM);
+    }
 
 private:
-    bool installed_ = false;
-    struct sigaction previous_ {};
+    struct Taken {
+        bool taken = false;
+        struct sigaction previous {};
+        void take(int signal_number) {
+            struct sigaction sa {};
+            sa.sa_handler = on_stop_signal;
+            sigemptyset(&sa.sa_mask);
+            sa.sa_flags = SA_RESETHAND;  // as the command: a second signal acts at once
+            taken = sigaction(signal_number, &sa, &previous) == 0;
+        }
+        void give_back(int signal_number) {
+            if (taken) sigaction(signal_number, &previous, nullptr);
+            taken = false;
+        }
+    };
+    Taken int_, term_;
 };
 
 /// Between frames, at most every 50 ms: Python's pending signals, with the GIL taken back
@@ -165,7 +184,7 @@ void bind_run(py::module_& m) {
         [](const py::object& input, const py::object& out, const py::dict& options) {
             RunOptions r = run_options(to_path(input, "input"), to_path(out, "out"),
                                        options.attr("copy")());  // a copy to consume
-            const InterruptScope interrupt;
+            InterruptScope interrupt;
             SignalPoll poll;
             r.stop = [&interrupt, &poll] { return interrupt.interrupted() || poll(); };
             RunSummary s;
@@ -174,6 +193,7 @@ void bind_run(py::module_& m) {
                 s = run_sequence(r);
             }
             poll.rethrow();
+            interrupt.end_if_terminated();
             if (interrupt.interrupted()) {
                 PyErr_SetNone(PyExc_KeyboardInterrupt);
                 throw py::error_already_set();

@@ -161,7 +161,8 @@ def run(input, out, **options) -> dict:
         peak_rss_mb (as in summary.json). The GIL is released while it runs.
 
     Ctrl-C stops the run within a second, even mid-frame: the frames before are complete,
-    OUT/summary.json says "stopped_by": "signal", then KeyboardInterrupt is raised.
+    OUT/summary.json says "stopped_by": "signal", then KeyboardInterrupt is raised. SIGTERM
+    (with no handler of the caller's) stops it the same way, then ends the process.
 
     Raises ValueError (parameters, select out of range), wul3d.InputError (input; OUT equal
     to, inside or holding the input), wul3d.IoError (output), TypeError (an unknown option,

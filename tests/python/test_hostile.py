@@ -180,22 +180,23 @@ def lines(path):
         return 0
 
 
-def interrupt_when(proc, ready, after_s=0.0, within_s=10):
-    """SIGINT `after_s` after ready() holds; (seconds until proc ended, stdout, stderr)."""
+def interrupt_when(proc, ready, after_s=0.0, within_s=10, signal_number=signal.SIGINT):
+    """SIGINT (or `signal_number`) `after_s` after ready() holds; (seconds until proc ended,
+    stdout, stderr)."""
     deadline = time.monotonic() + 60
     while not ready():
         assert proc.poll() is None, proc.communicate()
         assert time.monotonic() < deadline, "the run did not start"
         time.sleep(0.05)
     time.sleep(after_s)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signal_number)
     t0 = time.monotonic()
     try:
         stdout, stderr = proc.communicate(timeout=within_s)
     except subprocess.TimeoutExpired:
         proc.kill()
         proc.communicate()
-        pytest.fail(f"wul3d.run ran on for {within_s} s after SIGINT")
+        pytest.fail(f"wul3d.run ran on for {within_s} s after signal {signal_number}")
     return time.monotonic() - t0, stdout, stderr
 
 
@@ -221,6 +222,20 @@ def test_sigint_stops_a_long_run(tmp_path, handler):
     expected = "KeyboardInterrupt" if handler == "default" else "Mine: the caller's own SIGINT"
     assert expected in stderr, stderr
     assert stderr.count("Traceback") == 1, stderr
+    assert_out_as_the_command_leaves_it(out, 3000)
+
+
+def test_sigterm_stops_a_long_run_then_ends_the_process(tmp_path):
+    # SIGTERM's default action ended the interpreter at once: no summary.json, frames.jsonl
+    # cut wherever it was. Now the run stops as the command does, then the process ends
+    # as SIGTERM's default action would (killed by signal 15), with OUT final.
+    seq, out = tiny_tum(tmp_path / "seq", 3000), tmp_path / "out"
+    proc = start_python(RUN_LONG, seq, out, "default")
+    elapsed, stdout, stderr = interrupt_when(proc, lambda: lines(out / "frames.jsonl") >= 20,
+                                             signal_number=signal.SIGTERM)
+    assert elapsed < 2, elapsed
+    assert proc.returncode == -signal.SIGTERM, (proc.returncode, stderr)
+    assert "returned" not in stdout and "Traceback" not in stderr, stderr
     assert_out_as_the_command_leaves_it(out, 3000)
 
 
