@@ -219,6 +219,17 @@ def yaw_matrix(yaw, tilt_axis=None, tilt=0.0):
 # ---------------------------------------------------------------------------------------
 # The scene: a list of (primitive, label, material).
 # ---------------------------------------------------------------------------------------
+def table_parts(L, D, table_h, wood):
+    """A table L x D with its top at z = 0 (3 cm thick) and four legs down to the floor at
+    z = -table_h, all of material `wood` and label 0. Draws nothing from the generator."""
+    parts = [(Box([0, 0, -0.015], np.eye(3), [L / 2, D / 2, 0.015]), 0, wood)]
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            parts.append((Box([sx * (L / 2 - 0.05), sy * (D / 2 - 0.05), -table_h / 2 - 0.015],
+                              np.eye(3), [0.025, 0.025, table_h / 2 - 0.015]), 0, wood))
+    return parts
+
+
 def build_scene(rng, prints, kind_of=None):
     """`prints`: the random stream of the cylinders' labels, apart from `rng` so that adding
     them left every layout as it was. `kind_of`, a dict, gets each object's label -> the kind
@@ -230,11 +241,7 @@ def build_scene(rng, prints, kind_of=None):
     L, D = rng.uniform(1.2, 1.8), rng.uniform(0.7, 1.0)
     wood = material(rng, textured=False)
     wood["a"] = np.array([rng.uniform(150, 210), rng.uniform(110, 160), rng.uniform(70, 120)])
-    parts.append((Box([0, 0, -0.015], np.eye(3), [L / 2, D / 2, 0.015]), 0, wood))
-    for sx in (-1, 1):
-        for sy in (-1, 1):
-            parts.append((Box([sx * (L / 2 - 0.05), sy * (D / 2 - 0.05), -table_h / 2 - 0.015],
-                              np.eye(3), [0.025, 0.025, table_h / 2 - 0.015]), 0, wood))
+    parts += table_parts(L, D, table_h, wood)
     # Room: floor, a wall behind the table and one to a side.
     parts.append((Plane([0, 0, 1], -table_h), 0, material(rng)))
     back = rng.uniform(0.3, 1.5) + D / 2
@@ -792,11 +799,7 @@ def build_pile(rng, prints, kind_of):
     L, D = rng.uniform(1.4, 2.2), rng.uniform(0.9, 1.3)
     wood = material(rng, textured=False)
     wood["a"] = np.array([rng.uniform(150, 225), rng.uniform(110, 170), rng.uniform(60, 120)])
-    parts.append((Box([0, 0, -0.015], np.eye(3), [L / 2, D / 2, 0.015]), 0, wood))
-    for sx in (-1, 1):
-        for sy in (-1, 1):
-            parts.append((Box([sx * (L / 2 - 0.05), sy * (D / 2 - 0.05), -table_h / 2 - 0.015],
-                              np.eye(3), [0.025, 0.025, table_h / 2 - 0.015]), 0, wood))
+    parts += table_parts(L, D, table_h, wood)
     parts.append((Plane([0, 0, 1], -table_h), 0, material(rng)))
     parts.append((Plane([0, -1, 0], -(D / 2 + rng.uniform(0.0, 0.6))), 0, material(rng, textured=False)))
     n = int(rng.integers(5, 21))

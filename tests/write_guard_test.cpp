@@ -9,8 +9,6 @@
 #include <unistd.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -24,14 +22,10 @@ using wul3d::check_write_target;
 using wul3d::InputError;
 using wul3d::WriteTarget;
 using wul3d::test::CommandResult;
+using wul3d::test::run_bounded;
+using wul3d::test::slurp;
 using wul3d::test::TempDir;
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_text(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+using wul3d::test::write_text;
 
 /// The message of the InputError that `f` throws, or "" when it throws none.
 template <class F>
@@ -46,17 +40,9 @@ std::string refusal(F&& f) {
 
 /// A copy of one shipped frame as a one-frame recording in `dir`/rec/image_0000.
 fs::path recording(const TempDir& tmp) {
-    const fs::path frame = tmp / "rec" / "image_0000";
-    fs::create_directories(frame);
-    for (const auto& e : fs::directory_iterator(wul3d::test::sample_dir() / "uois_tabletop" / "image_0000"))
-        fs::copy_file(e.path(), frame / e.path().filename());
-    return frame.parent_path();
-}
-
-CommandResult run_bounded(const std::vector<std::string>& args) {
-    std::vector<std::string> argv = {"timeout", "60", wul3d::test::cli_path().string()};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return wul3d::test::run_command(argv);
+    wul3d::test::copy_frame(wul3d::test::sample_dir() / "uois_tabletop" / "image_0000",
+                            tmp / "rec" / "image_0000");
+    return tmp / "rec";
 }
 
 // ---- the library -----------------------------------------------------------------------------
