@@ -1,0 +1,55 @@
+# ROS 1 (docs/ROS.md; docs/INPUTS.md, "4. ROS bags"); included from the top CMakeLists.txt
+# after the wul3d library target is defined. Debian 12 ships ROS 1 (Noetic-era) libraries;
+# ROS 2 is not packaged there and not supported yet.
+#
+#   bags      src/bag/bag_source.cpp    librosbag_storage      Debian: librosbag-dev
+#   wul3d_ros apps/wul3d_ros/main.cpp   roscpp, message_filters Debian: libroscpp-dev,
+#             (and tests/ros/)          + message headers       libmessage-filters-dev, ...
+# Without them the library is built with src/bag/bag_unavailable.cpp, which refuses bags with
+# one line, and wul3d_ros is not built. Debian's rosbag_storage.pc cannot be used (it requires
+# a pluginlib.pc that its ROS 2 pluginlib lacks), so the bag libraries are found one by one;
+# rosbag/bag.h includes that ROS 2 pluginlib, whose headers live in per-package folders.
+# ROS 1's message headers do not compile as C++20 (std::allocator<void>::rebind), so the
+# files that include them are compiled as C++17.
+find_package(PkgConfig QUIET)
+set(WUL3D_ROS_BAGS OFF)
+set(WUL3D_ROS_NODE OFF)
+
+set(_ros_libs "")
+foreach(_lib rosbag_storage roslz4 roscpp_serialization rostime cpp_common console_bridge
+             boost_filesystem)
+  find_library(WUL3D_LIB_${_lib} ${_lib})
+  if(WUL3D_LIB_${_lib})
+    list(APPEND _ros_libs ${WUL3D_LIB_${_lib}})
+  else()
+    set(_ros_missing "lib${_lib}")
+  endif()
+endforeach()
+find_path(WUL3D_ROSBAG_INCLUDE rosbag/bag.h)
+find_path(WUL3D_SENSOR_MSGS_INCLUDE sensor_msgs/Image.h)
+set(_ros_includes "")
+foreach(_pkg pluginlib class_loader rcpputils rcutils ament_index_cpp)
+  if(EXISTS /usr/include/${_pkg}/${_pkg})
+    list(APPEND _ros_includes /usr/include/${_pkg})
+  elseif(NOT EXISTS /usr/include/${_pkg})
+    set(_ros_missing "${_pkg} headers")
+  endif()
+endforeach()
+if(NOT WUL3D_ROSBAG_INCLUDE OR NOT WUL3D_SENSOR_MSGS_INCLUDE)
+  set(_ros_missing "rosbag/bag.h or sensor_msgs/Image.h")
+endif()
+
+if(NOT _ros_missing)
+  set(WUL3D_ROS_BAGS ON)
+  set(WUL3D_ROS_INCLUDES ${_ros_includes})
+  set(WUL3D_ROS_BAG_LIBS ${_ros_libs})
+  target_sources(wul3d PRIVATE ${PROJECT_SOURCE_DIR}/src/bag/bag_source.cpp)
+  set_source_files_properties(${PROJECT_SOURCE_DIR}/src/bag/bag_source.cpp
+                              PROPERTIES COMPILE_OPTIONS "-std=c++17")
+  target_include_directories(wul3d SYSTEM PRIVATE ${_ros_includes})
+  target_link_libraries(wul3d PRIVATE ${_ros_libs})
+  message(STATUS "wul3d ROS bags: on (librosbag_storage)")
+else()
+  target_sources(wul3d PRIVATE ${PROJECT_SOURCE_DIR}/src/bag/bag_unavailable.cpp)
+  message(STATUS "wul3d ROS bags: off (${_ros_missing} not found; Debian: librosbag-dev)")
+endif()
