@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <map>
 #include <optional>
 #include <regex>
@@ -22,6 +21,7 @@
 #include "../io_detail.hpp"
 #include "wul3d/bag.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/ros_image.hpp"
 
 namespace wul3d {
 
@@ -32,13 +32,6 @@ using detail::size_str;
 constexpr const char* kImage = "sensor_msgs/Image";
 constexpr const char* kCompressed = "sensor_msgs/CompressedImage";
 constexpr const char* kInfo = "sensor_msgs/CameraInfo";
-
-bool is_depth_encoding(const std::string& e) {
-    return e == "16UC1" || e == "mono16" || e == "32FC1";
-}
-bool is_color_encoding(const std::string& e) {
-    return e == "rgb8" || e == "bgr8" || e == "rgba8" || e == "bgra8" || e == "mono8";
-}
 
 std::string parent_of(const std::string& topic) {
     const auto slash = topic.rfind('/');
@@ -139,8 +132,8 @@ Layout detect_plain(Bag& bag) {
     for (const std::string& t : bag.topics_of(kImage)) {
         const auto img = bag.first<sensor_msgs::Image>(t);
         if (!img) continue;
-        if (is_depth_encoding(img->encoding)) depth.push_back(t);
-        else if (is_color_encoding(img->encoding)) color.push_back(t);
+        if (is_ros_depth_encoding(img->encoding)) depth.push_back(t);
+        else if (is_ros_color_encoding(img->encoding)) color.push_back(t);
     }
     for (const std::string& t : bag.topics_of(kCompressed)) {
         const auto img = bag.first<sensor_msgs::CompressedImage>(t);
@@ -226,14 +219,9 @@ Layout given_layout(Bag& bag, const std::string& spec) {
 }
 
 PinholeIntrinsics intrinsics_of(const sensor_msgs::CameraInfo& info) {
-    PinholeIntrinsics K;
-    K.width = static_cast<int>(std::min<std::uint32_t>(info.width, 1u << 30));
-    K.height = static_cast<int>(std::min<std::uint32_t>(info.height, 1u << 30));
-    K.fx = info.K[0];
-    K.fy = info.K[4];
-    K.cx = info.K[2];
-    K.cy = info.K[5];
-    return K;
+    std::array<double, 9> K;
+    std::copy(info.K.begin(), info.K.end(), K.begin());
+    return intrinsics_from_ros(info.width, info.height, K);
 }
 
 /// A stream's pose in the device's frame: P_device = R P_stream + t.
@@ -316,93 +304,12 @@ std::vector<Pair> pair_by_time(const std::vector<rosbag::MessageInstance>& depth
             if (!best || std::abs(tc[*best] - t) > max_dt_s) continue;
             p.color = best;
         }
+        // Two depth messages of one recorded time: the names of OUT/<name>/ stay distinct.
+        if (!pairs.empty() && pairs.back().name.rfind(p.name, 0) == 0)
+            p.name += "_" + std::to_string(i);
         pairs.push_back(std::move(p));
     }
     return pairs;
-}
-
-/// An image's pixel rows: width x height of `bytes_per_pixel`, `step` apart.
-const std::uint8_t* checked_rows(const std::string& what, const sensor_msgs::Image& img,
-                                 std::size_t bytes_per_pixel) {
-    if (img.width == 0 || img.height == 0 || img.width > kMaxImageSide ||
-        img.height > kMaxImageSide ||
-        std::uint64_t{img.width} * img.height > max_image_pixels()) {
-        throw InputError(what + ": image of " + std::to_string(img.width) + "x" +
-                         std::to_string(img.height) + " is empty or over the limit");
-    }
-    const std::uint64_t row = std::uint64_t{img.width} * bytes_per_pixel;
-    if (img.step < row || std::uint64_t{img.step} * img.height > img.data.size()) {
-        throw InputError(what + ": " + img.encoding + " image of " + std::to_string(img.width) +
-                         "x" + std::to_string(img.height) + " with step " +
-                         std::to_string(img.step) + " needs " +
-                         std::to_string(std::max<std::uint64_t>(row, img.step) * img.height) +
-                         " bytes but has " + std::to_string(img.data.size()));
-    }
-    return img.data.data();
-}
-
-void convert_depth(const std::string& what, const sensor_msgs::Image& img, float scale,
-                   DepthImage& out) {
-    const bool is_float = img.encoding == "32FC1";
-    if (!is_float && img.encoding != "16UC1" && img.encoding != "mono16") {
-        throw InputError(what + ": depth encoding '" + img.encoding +
-                         "' is not read (16UC1, mono16, 32FC1 are)");
-    }
-    const std::uint8_t* src = checked_rows(what, img, is_float ? 4 : 2);
-    const int w = static_cast<int>(img.width), h = static_cast<int>(img.height);
-    out.width = w;
-    out.height = h;
-    out.data.resize(std::size_t(w) * std::size_t(h));
-    const bool swap = img.is_bigendian != 0;  // the machines wul3d runs on are little-endian
-    for (int v = 0; v < h; ++v) {
-        const std::uint8_t* row = src + std::size_t(v) * img.step;
-        std::uint16_t* dst = out.data.data() + std::size_t(v) * std::size_t(w);
-        for (int u = 0; u < w; ++u) {
-            std::uint8_t b[4];
-            std::memcpy(b, row + std::size_t(u) * (is_float ? 4 : 2), is_float ? 4 : 2);
-            if (swap) std::reverse(b, b + (is_float ? 4 : 2));
-            if (!is_float) {
-                std::memcpy(&dst[u], b, 2);
-                continue;
-            }
-            float z;
-            std::memcpy(&z, b, 4);
-            // 32FC1 is metres (REP 118); no depth is NaN, 0 or +-inf.
-            const float units = z / scale;
-            dst[u] = std::isfinite(units) && units >= 0.5f && units < 65535.5f
-                         ? static_cast<std::uint16_t>(std::lround(units))
-                         : std::uint16_t{0};
-        }
-    }
-    out.scale_m_per_unit = is_float ? 0.001f : scale;
-}
-
-void convert_color(const std::string& what, const sensor_msgs::Image& img, ColorImage& out) {
-    const std::string& e = img.encoding;
-    const std::size_t bpp = e == "mono8" ? 1 : (e == "rgba8" || e == "bgra8") ? 4 : 3;
-    if (!is_color_encoding(e)) {
-        throw InputError(what + ": colour encoding '" + e +
-                         "' is not read (rgb8, bgr8, rgba8, bgra8, mono8 are)");
-    }
-    const std::uint8_t* src = checked_rows(what, img, bpp);
-    const bool bgr = e == "bgr8" || e == "bgra8";
-    const int w = static_cast<int>(img.width), h = static_cast<int>(img.height);
-    out.width = w;
-    out.height = h;
-    out.rgb.resize(3 * std::size_t(w) * std::size_t(h));
-    for (int v = 0; v < h; ++v) {
-        const std::uint8_t* row = src + std::size_t(v) * img.step;
-        std::uint8_t* dst = out.rgb.data() + 3 * std::size_t(v) * std::size_t(w);
-        for (int u = 0; u < w; ++u, row += bpp, dst += 3) {
-            if (bpp == 1) {
-                dst[0] = dst[1] = dst[2] = row[0];
-            } else {
-                dst[0] = row[bgr ? 2 : 0];
-                dst[1] = row[1];
-                dst[2] = row[bgr ? 0 : 2];
-            }
-        }
-    }
 }
 
 class BagSource final : public FrameSource {
@@ -476,7 +383,7 @@ public:
 
             const auto d = depth_msgs_[pair.depth].instantiate<sensor_msgs::Image>();
             if (!d) throw InputError(at + ": not a sensor_msgs/Image");
-            convert_depth(at, *d, depth_scale_, depth);
+            depth_from_ros(at, ros_image_of(*d), depth_scale_, depth);
             if (pair.color) {
                 read_color(color_msgs_[*pair.color], color);
             } else {
@@ -537,13 +444,14 @@ private:
         const std::string at = path_ + ": " + layout_.color + " at " + stamp_name(m.getTime());
         if (m.getDataType() == kCompressed) {
             const auto c = m.instantiate<sensor_msgs::CompressedImage>();
+            if (!c) throw InputError(at + ": not a sensor_msgs/CompressedImage");
             scratch_.bytes.assign(c->data.begin(), c->data.end());
             detail::decode_color_image_into(at, scratch_, out);
             return;
         }
         const auto img = m.instantiate<sensor_msgs::Image>();
         if (!img) throw InputError(at + ": not a sensor_msgs/Image");
-        convert_color(at, *img, out);
+        color_from_ros(at, ros_image_of(*img), out);
     }
 
     static void check_size(const std::string& at, const std::string& from,
