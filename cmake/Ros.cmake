@@ -53,3 +53,27 @@ else()
   target_sources(wul3d PRIVATE ${PROJECT_SOURCE_DIR}/src/bag/bag_unavailable.cpp)
   message(STATUS "wul3d ROS bags: off (${_ros_missing} not found; Debian: librosbag-dev)")
 endif()
+if(WUL3D_ROS_BAGS AND PkgConfig_FOUND)
+  pkg_check_modules(WUL3D_PC_ROSCPP QUIET IMPORTED_TARGET roscpp message_filters)
+endif()
+find_path(WUL3D_VISUALIZATION_MSGS_INCLUDE visualization_msgs/MarkerArray.h)
+find_path(WUL3D_DIAGNOSTIC_MSGS_INCLUDE diagnostic_msgs/DiagnosticArray.h)
+if(WUL3D_PC_ROSCPP_FOUND AND WUL3D_VISUALIZATION_MSGS_INCLUDE AND WUL3D_DIAGNOSTIC_MSGS_INCLUDE)
+  set(WUL3D_ROS_NODE ON)
+  add_executable(wul3d_ros ${PROJECT_SOURCE_DIR}/apps/wul3d_ros/main.cpp)
+  set_target_properties(wul3d_ros PROPERTIES CXX_STANDARD 17)
+  target_include_directories(wul3d_ros SYSTEM PRIVATE ${_ros_includes})
+  target_link_libraries(wul3d_ros PRIVATE wul3d PkgConfig::WUL3D_PC_ROSCPP
+                        nlohmann_json::nlohmann_json)
+  target_compile_options(wul3d_ros PRIVATE ${WUL3D_WARNINGS})
+  # A ROS package for roslaunch (apps/wul3d_ros/wul3d.launch): ROS_PACKAGE_PATH=build/ros.
+  set(_pkg ${PROJECT_BINARY_DIR}/ros/wul3d_ros)
+  configure_file(${PROJECT_SOURCE_DIR}/apps/wul3d_ros/package.xml ${_pkg}/package.xml COPYONLY)
+  add_custom_command(TARGET wul3d_ros POST_BUILD
+    COMMAND ${CMAKE_COMMAND} -E create_symlink $<TARGET_FILE:wul3d_ros> ${_pkg}/wul3d_ros)
+  message(STATUS "wul3d ROS node: on (wul3d_ros)")
+else()
+  message(STATUS "wul3d ROS node: off (roscpp, message_filters, visualization_msgs or "
+                 "diagnostic_msgs not found; Debian: libroscpp-dev libmessage-filters-dev "
+                 "libvisualization-msgs-dev libdiagnostic-msgs-dev)")
+endif()

@@ -37,6 +37,10 @@
 #   libclass-loader-dev librcpputils-dev           headers that Debian's rosbag/bag.h includes (through
 #   librcutils-dev libament-index-cpp-dev          its ROS 2 pluginlib) but librosbag-dev does not bring
 #   libsensor-msgs-dev libstd-msgs-dev             the messages of bags and of the node
+#   libroscpp-dev libmessage-filters-dev           the ROS 1 node wul3d_ros (docs/ROS.md): roscpp, the
+#                                                  colour/depth/camera_info synchronizer; built only when found
+#   libvisualization-msgs-dev libdiagnostic-msgs-dev  its boxes (MarkerArray) and its /diagnostics
+#   python3-roslaunch python3-rosmaster rosout     roscore and roslaunch: the node's tests start a roscore
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -86,6 +90,13 @@ packages=(
   libament-index-cpp-dev
   libsensor-msgs-dev
   libstd-msgs-dev
+  libroscpp-dev
+  libmessage-filters-dev
+  libvisualization-msgs-dev
+  libdiagnostic-msgs-dev
+  python3-roslaunch
+  python3-rosmaster
+  rosout
 )
 
 missing=()
