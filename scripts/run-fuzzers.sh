@@ -19,10 +19,15 @@ out=$build/fuzz-out
 rm -rf "$seeds" "$out"
 mkdir -p "$out"
 "$build/fuzz/make_seeds" data/samples "$seeds"
+fuzzers="png jpeg intrinsics_json calibration_json tum_list fakenect frame"
+if [[ -x "$build/fuzz/fuzz_bag" ]]; then  # built where librosbag is (cmake/Ros.cmake)
+  "$build/fuzz/make_bag_seeds" "$seeds/bag"
+  fuzzers="$fuzzers bag"
+fi
 
 total_runs=0
 printf '%-18s %10s %8s\n' harness executions exec/s
-for fuzzer in png jpeg intrinsics_json calibration_json tum_list fakenect frame; do
+for fuzzer in $fuzzers; do
   corpus=$out/corpus_$fuzzer
   mkdir -p "$corpus"
   log=$out/$fuzzer.log

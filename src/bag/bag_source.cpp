@@ -11,6 +11,8 @@
 #include <std_msgs/Float32.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -475,6 +477,83 @@ private:
     detail::ImageScratch scratch_;
 };
 
+/// The largest chunk a bag may declare, uncompressed: librosbag allocates that much before
+/// decompressing. rosbag record writes chunks of 768 KiB (more only for one larger message).
+constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{256} << 20;
+/// The largest record header: a connection's (its message definition) is a few KiB.
+constexpr std::uint32_t kMaxRecordHeaderBytes = 1u << 20;
+
+std::uint32_t le32(const char* p) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(p[i]);
+    return v;
+}
+
+std::uint64_t le64(const char* p) {
+    return le32(p) | (std::uint64_t{le32(p + 4)} << 32);
+}
+
+/// librosbag trusts the lengths and positions a bag declares (a record header of 2 GB is
+/// allocated before it is read), so the top-level records are walked first: [u32 header
+/// length][header: u32 length + "name=value" fields][u32 data length][data], each within the
+/// file; a chunk's declared size ("size") at most kMaxChunkBytes; and the positions the bag
+/// header ("index_pos") and the chunk infos ("chunk_pos") point to must be records' starts.
+/// Only headers are read; data is skipped.
+void check_records(const std::string& path) {
+    std::error_code ec;
+    const std::uint64_t file_size = std::filesystem::file_size(path, ec);
+    if (ec) throw InputError(path + ": cannot read the bag (" + ec.message() + ")");
+    std::ifstream in(path, std::ios::binary);
+    std::vector<char> header;
+    std::vector<std::uint64_t> starts, targets;  // records' starts; positions pointed to
+    const auto damaged = [&](std::uint64_t at, const std::string& what) {
+        return InputError(path + ": cannot read the bag (the record at byte " + std::to_string(at) +
+                          " " + what + "; truncated or damaged)");
+    };
+    for (std::uint64_t pos = 13; pos < file_size;) {  // after "#ROSBAG V2.0\n"
+        char len[4];
+        if (file_size - pos < 4 || !in.seekg(std::streamoff(pos)).read(len, 4))
+            throw damaged(pos, "is cut short");
+        const std::uint32_t header_len = le32(len);
+        if (header_len > kMaxRecordHeaderBytes || file_size - pos - 4 < std::uint64_t{header_len} + 4)
+            throw damaged(pos, "declares a header of " + std::to_string(header_len) + " bytes");
+        header.resize(header_len);
+        in.read(header.data(), header_len);
+        in.read(len, 4);
+        if (!in) throw damaged(pos, "is cut short");
+        const std::uint32_t data_len = le32(len);
+        if (file_size - pos - 8 - header_len < data_len)
+            throw damaged(pos, "declares " + std::to_string(data_len) + " bytes of data");
+        // The fields: is it a chunk (op 0x05), and how large is it uncompressed?
+        char op = 0;
+        std::optional<std::uint32_t> chunk_size;
+        for (std::size_t f = 0; f + 4 <= header.size();) {
+            const std::uint32_t n = le32(header.data() + f);
+            if (n > header.size() - f - 4) break;  // librosbag says what is wrong with it
+            const std::string field(header.data() + f + 4, n);
+            if (field.size() == 4 && field.compare(0, 3, "op=") == 0) op = field[3];
+            if (field.size() == 9 && field.compare(0, 5, "size=") == 0) chunk_size = le32(field.data() + 5);
+            if (field.size() == 18 && (field.compare(0, 10, "index_pos=") == 0 ||
+                                       field.compare(0, 10, "chunk_pos=") == 0)) {
+                const std::uint64_t to = le64(field.data() + 10);
+                if (to != 0) targets.push_back(to);  // index_pos 0: an unindexed bag
+            }
+            f += 4 + std::size_t(n);
+        }
+        if (op == 0x05 && chunk_size && *chunk_size > kMaxChunkBytes)
+            throw damaged(pos, "is a chunk of " + std::to_string(*chunk_size) +
+                                   " bytes, over the limit of " + std::to_string(kMaxChunkBytes));
+        starts.push_back(pos);
+        pos += 8 + std::uint64_t{header_len} + data_len;
+    }
+    for (const std::uint64_t to : targets) {
+        if (!std::binary_search(starts.begin(), starts.end(), to)) {
+            throw InputError(path + ": cannot read the bag (its index points to byte " +
+                             std::to_string(to) + ", where no record starts; damaged)");
+        }
+    }
+}
+
 }  // namespace
 
 bool bag_support() { return true; }
@@ -489,6 +568,7 @@ std::unique_ptr<FrameSource> open_bag(const std::string& path, const SourceOptio
         throw ParamError("SourceOptions.bag_max_dt_s = " + std::to_string(options.bag_max_dt_s) +
                          ": must be >= 0");
     }
+    check_records(path);
     return std::make_unique<BagSource>(path, options);
 }
 

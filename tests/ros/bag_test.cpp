@@ -258,6 +258,29 @@ TEST(BagCli, BadBags_OneLineAndExit2) {
     fs::resize_file(dir / "truncated.bag", full / 2);
     expect_refused({(dir / "truncated.bag").string()}, "truncated.bag");
 
+    // A record that declares a header of 2 GB (librosbag would allocate it; fuzz_bag found it).
+    fs::copy_file(dir / "plain.bag", dir / "huge.bag");
+    {
+        std::fstream f(dir / "huge.bag", std::ios::in | std::ios::out | std::ios::binary);
+        const char len[4] = {0, 0, 0, 0x7f};
+        f.seekp(13).write(len, 4);
+    }
+    expect_refused({(dir / "huge.bag").string()}, "declares a header of 2130706432 bytes");
+
+    // The bag's header pointing its index into the middle of a record (fuzz_bag found it).
+    fs::copy_file(dir / "plain.bag", dir / "index.bag");
+    {
+        std::fstream f(dir / "index.bag", std::ios::in | std::ios::out | std::ios::binary);
+        std::string head(4096, '\0');
+        f.read(head.data(), 4096);
+        const auto at = head.find("index_pos=");
+        ASSERT_NE(at, std::string::npos);
+        head[at + 10] = char(head[at + 10] + 1);
+        f.clear();
+        f.seekp(std::streamoff(at + 10)).write(&head[at + 10], 1);
+    }
+    expect_refused({(dir / "index.bag").string()}, "where no record starts");
+
     {  // colour of another size than depth; depth data shorter than its size says
         rosbag::Bag bag((dir / "sizes.bag").string(), rosbag::bagmode::Write);
         const ros::Time t = frame_time(0);
