@@ -11,6 +11,7 @@
 # rosbag/bag.h includes that ROS 2 pluginlib, whose headers live in per-package folders.
 # ROS 1's message headers do not compile as C++20 (std::allocator<void>::rebind), so the
 # files that include them are compiled as C++17.
+option(WUL3D_WITH_ROS "Build the ROS 1 bag reader and node where ROS is found" ON)
 find_package(PkgConfig QUIET)
 set(WUL3D_ROS_BAGS OFF)
 set(WUL3D_ROS_NODE OFF)
@@ -38,6 +39,9 @@ endforeach()
 if(NOT WUL3D_ROSBAG_INCLUDE OR NOT WUL3D_SENSOR_MSGS_INCLUDE)
   set(_ros_missing "rosbag/bag.h or sensor_msgs/Image.h")
 endif()
+if(NOT WUL3D_WITH_ROS)
+  set(_ros_missing "WUL3D_WITH_ROS=OFF")
+endif()
 
 if(NOT _ros_missing)
   set(WUL3D_ROS_BAGS ON)
@@ -51,7 +55,11 @@ if(NOT _ros_missing)
   message(STATUS "wul3d ROS bags: on (librosbag_storage)")
 else()
   target_sources(wul3d PRIVATE ${PROJECT_SOURCE_DIR}/src/bag/bag_unavailable.cpp)
-  message(STATUS "wul3d ROS bags: off (${_ros_missing} not found; Debian: librosbag-dev)")
+  if(WUL3D_WITH_ROS)
+    message(STATUS "wul3d ROS bags: off (${_ros_missing} not found; Debian: librosbag-dev)")
+  else()
+    message(STATUS "wul3d ROS bags: off (WUL3D_WITH_ROS=OFF)")
+  endif()
 endif()
 if(WUL3D_ROS_BAGS AND PkgConfig_FOUND)
   pkg_check_modules(WUL3D_PC_ROSCPP QUIET IMPORTED_TARGET roscpp message_filters)
@@ -72,6 +80,8 @@ if(WUL3D_PC_ROSCPP_FOUND AND WUL3D_VISUALIZATION_MSGS_INCLUDE AND WUL3D_DIAGNOST
   add_custom_command(TARGET wul3d_ros POST_BUILD
     COMMAND ${CMAKE_COMMAND} -E create_symlink $<TARGET_FILE:wul3d_ros> ${_pkg}/wul3d_ros)
   message(STATUS "wul3d ROS node: on (wul3d_ros)")
+elseif(NOT WUL3D_ROS_BAGS)
+  message(STATUS "wul3d ROS node: off (as the ROS bags)")
 else()
   message(STATUS "wul3d ROS node: off (roscpp, message_filters, visualization_msgs or "
                  "diagnostic_msgs not found; Debian: libroscpp-dev libmessage-filters-dev "

@@ -8,7 +8,7 @@ bool bag_support() { return false; }
 
 std::unique_ptr<FrameSource> open_bag(const std::string& path, const SourceOptions&) {
     throw InputError(path + ": this wul3d was built without ROS bag support (librosbag-dev "
-                            "was not found; scripts/install-deps.sh installs it)");
+                            "was not found, or WUL3D_WITH_ROS=OFF; scripts/install-deps.sh installs it)");
 }
 
 }  // namespace wul3d

@@ -130,6 +130,15 @@ wul3d::test::CommandResult publish(const fs::path& out, const std::vector<std::s
     return wul3d::test::run_command(args);
 }
 
+/// Sorted frame folder names of a `wul3d run` output.
+std::vector<std::string> run_frames(const fs::path& out) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(out))
+        if (e.is_directory()) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
 }  // namespace
 
 TEST(RosNode, LabelsEqualRunsObjectsPngPixelForPixel) {
@@ -137,10 +146,7 @@ TEST(RosNode, LabelsEqualRunsObjectsPngPixelForPixel) {
     const auto run = wul3d::test::run_cli(
         {"run", tabletop().string(), "--out", (dir / "run").string(), "--quiet"});
     ASSERT_EQ(run.exit_code, 0) << run.err;
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir / "run"))
-        if (e.is_directory()) names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
+    const auto names = run_frames(dir / "run");
 
     RosCore core(dir.path());
     Child node({WUL3D_ROS_NODE_BIN}, dir / "node.log");
@@ -157,6 +163,38 @@ TEST(RosNode, LabelsEqualRunsObjectsPngPixelForPixel) {
         EXPECT_TRUE(got.labels == want.labels) << "frame " << names[i];
     }
     EXPECT_TRUE(node.alive()) << read_text(dir / "node.log");
+}
+
+TEST(RosNode, UnalignedDepthWithACalibration_LabelsEqualRunWithThatCalibration) {
+    wul3d::test::TempDir dir;
+    // A two-camera calibration of the shipped frames' camera (both cameras one, 1 cm apart):
+    // the node registers each frame first, as `wul3d run --calibration` does.
+    auto source = wul3d::open_source(tabletop().string(), {});
+    wul3d::SourceItem item;
+    source->read(0, item);
+    wul3d::StereoCalibration calib;
+    calib.depth = calib.color = item.frame.intrinsics;
+    calib.translation_m = {0.01, 0, 0};
+    wul3d::write_calibration_json((dir / "calib.json").string(), calib);
+    const auto run = wul3d::test::run_cli({"run", tabletop().string(), "--calibration",
+                                           (dir / "calib.json").string(), "--out",
+                                           (dir / "run").string(), "--quiet"});
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto names = run_frames(dir / "run");
+
+    RosCore core(dir.path());
+    Child node({WUL3D_ROS_NODE_BIN, "_calibration:=" + (dir / "calib.json").string()},
+               dir / "node.log");
+    fs::create_directories(dir / "labels");
+    const auto r = publish(dir / "labels", {"lockstep"});
+    ASSERT_EQ(r.exit_code, 0) << r.err << read_text(dir / "node.log");
+    ASSERT_EQ(names.size(), 4u);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        const auto want = wul3d::read_label_png((dir / "run" / names[i] / "objects.png").string());
+        const auto got = wul3d::read_label_png((dir / "labels" / (std::to_string(i) + ".png")).string());
+        EXPECT_EQ(got.width, want.width);
+        EXPECT_TRUE(got.labels == want.labels) << "frame " << names[i];
+    }
 }
 
 TEST(RosNode, SurvivesMalformedMessagesAndThePublisherRestarting) {
