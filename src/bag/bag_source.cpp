@@ -17,7 +17,6 @@
 #include <cstdio>
 #include <map>
 #include <optional>
-#include <regex>
 #include <sstream>
 
 #include "../io_detail.hpp"
@@ -169,18 +168,37 @@ Layout detect_plain(Bag& bag) {
     return l;
 }
 
+/// Whether `topic` is "/device_N/sensor_M/<Kind>_K/image/data" with Kind Depth or Color;
+/// then `sensor` is "/device_N/sensor_M". (No std::regex: GCC 12 warns inside it under ASan.)
+bool realsense_stream(const std::string& topic, std::string& sensor, std::string& kind) {
+    std::vector<std::string> parts;
+    std::stringstream in(topic);
+    for (std::string p; std::getline(in, p, '/');) parts.push_back(p);
+    const auto numbered = [](const std::string& s, const std::string& prefix) {
+        return s.size() > prefix.size() && s.compare(0, prefix.size(), prefix) == 0 &&
+               s.find_first_not_of("0123456789", prefix.size()) == std::string::npos;
+    };
+    if (parts.size() != 6 || !parts[0].empty() || !numbered(parts[1], "device_") ||
+        !numbered(parts[2], "sensor_") || parts[4] != "image" || parts[5] != "data")
+        return false;
+    if (numbered(parts[3], "Depth_")) kind = "Depth";
+    else if (numbered(parts[3], "Color_")) kind = "Color";
+    else return false;
+    sensor = "/" + parts[1] + "/" + parts[2];
+    return true;
+}
+
 /// RealSense Viewer's layout: /device_N/sensor_M/<Stream>_K/image/data and its siblings.
 std::optional<Layout> detect_realsense(Bag& bag) {
-    static const std::regex stream(R"((/device_\d+/sensor_\d+)/(Depth|Color)_\d+/image/data)");
     Layout l;
     std::string depth_sensor;
     for (const auto& [topic, type] : bag.types()) {
-        std::smatch m;
-        if (type != kImage || !std::regex_match(topic, m, stream)) continue;
-        std::string& slot = m[2] == "Depth" ? l.depth : l.color;
+        std::string sensor, kind;
+        if (type != kImage || !realsense_stream(topic, sensor, kind)) continue;
+        std::string& slot = kind == "Depth" ? l.depth : l.color;
         if (!slot.empty()) continue;  // the first stream of each kind (topics sorted by name)
         slot = topic;
-        if (m[2] == "Depth") depth_sensor = m[1];
+        if (kind == "Depth") depth_sensor = sensor;
     }
     if (l.depth.empty()) return std::nullopt;
     l.realsense = true;
