@@ -522,47 +522,90 @@ void check_records(const std::string& path) {
     const std::uint64_t file_size = std::filesystem::file_size(path, ec);
     if (ec) throw InputError(path + ": cannot read the bag (" + ec.message() + ")");
     std::ifstream in(path, std::ios::binary);
-    std::vector<char> header;
-    std::vector<std::uint64_t> starts, targets;  // records' starts; positions pointed to
     const auto damaged = [&](std::uint64_t at, const std::string& what) {
         return InputError(path + ": cannot read the bag (the record at byte " + std::to_string(at) +
                           " " + what + "; truncated or damaged)");
     };
-    for (std::uint64_t pos = 13; pos < file_size;) {  // after "#ROSBAG V2.0\n"
+    /// One record's lengths and the header fields that matter here, checked to end by `end`.
+    struct Record {
+        std::uint32_t header_len = 0, data_len = 0;
+        char op = 0;
+        std::optional<std::uint32_t> size;  // a chunk's uncompressed size
+        std::string compression;            // a chunk's
+        std::vector<std::uint64_t> points_to;  // index_pos, chunk_pos
+    };
+    std::vector<char> header;
+    const auto read_record = [&](std::uint64_t pos, std::uint64_t end) {
+        Record r;
         char len[4];
-        if (file_size - pos < 4 || !in.seekg(std::streamoff(pos)).read(len, 4))
+        if (end - pos < 4 || !in.seekg(std::streamoff(pos)).read(len, 4))
             throw damaged(pos, "is cut short");
-        const std::uint32_t header_len = le32(len);
-        if (header_len > kMaxRecordHeaderBytes || file_size - pos - 4 < std::uint64_t{header_len} + 4)
-            throw damaged(pos, "declares a header of " + std::to_string(header_len) + " bytes");
-        header.resize(header_len);
-        in.read(header.data(), header_len);
+        r.header_len = le32(len);
+        if (r.header_len > kMaxRecordHeaderBytes || end - pos - 4 < std::uint64_t{r.header_len} + 4)
+            throw damaged(pos, "declares a header of " + std::to_string(r.header_len) + " bytes");
+        header.resize(r.header_len);
+        in.read(header.data(), r.header_len);
         in.read(len, 4);
         if (!in) throw damaged(pos, "is cut short");
-        const std::uint32_t data_len = le32(len);
-        if (file_size - pos - 8 - header_len < data_len)
-            throw damaged(pos, "declares " + std::to_string(data_len) + " bytes of data");
-        // The fields: is it a chunk (op 0x05), and how large is it uncompressed?
-        char op = 0;
-        std::optional<std::uint32_t> chunk_size;
-        for (std::size_t f = 0; f + 4 <= header.size();) {
-            const std::uint32_t n = le32(header.data() + f);
-            if (n > header.size() - f - 4) break;  // librosbag says what is wrong with it
+        r.data_len = le32(len);
+        if (end - pos - 8 - r.header_len < r.data_len)
+            throw damaged(pos, "declares " + std::to_string(r.data_len) + " bytes of data");
+        // The fields must tile the header exactly, each "name=value": cpp_common's
+        // ros::Header::parse reads past a header whose fields do not (fuzz_bag found it).
+        for (std::size_t f = 0; f < header.size();) {
+            const std::uint32_t n = header.size() - f >= 4 ? le32(header.data() + f) : 0;
+            if (header.size() - f < 4 || n > header.size() - f - 4)
+                throw damaged(pos, "has a header field running past its header");
             const std::string field(header.data() + f + 4, n);
-            if (field.size() == 4 && field.compare(0, 3, "op=") == 0) op = field[3];
-            if (field.size() == 9 && field.compare(0, 5, "size=") == 0) chunk_size = le32(field.data() + 5);
+            if (field.find('=') == std::string::npos)
+                throw damaged(pos, "has a header field with no '='");
+            if (field.size() == 4 && field.compare(0, 3, "op=") == 0) r.op = field[3];
+            if (field.size() == 9 && field.compare(0, 5, "size=") == 0) r.size = le32(field.data() + 5);
+            if (field.compare(0, 12, "compression=") == 0) r.compression = field.substr(12);
             if (field.size() == 18 && (field.compare(0, 10, "index_pos=") == 0 ||
                                        field.compare(0, 10, "chunk_pos=") == 0)) {
                 const std::uint64_t to = le64(field.data() + 10);
-                if (to != 0) targets.push_back(to);  // index_pos 0: an unindexed bag
+                if (to != 0) r.points_to.push_back(to);  // index_pos 0: an unindexed bag
             }
             f += 4 + std::size_t(n);
         }
-        if (op == 0x05 && chunk_size && *chunk_size > kMaxChunkBytes)
-            throw damaged(pos, "is a chunk of " + std::to_string(*chunk_size) +
-                                   " bytes, over the limit of " + std::to_string(kMaxChunkBytes));
+        return r;
+    };
+
+    std::vector<std::uint64_t> starts, targets;  // records' starts; positions pointed to
+    std::vector<std::uint64_t> inner;            // the last plain chunk's records, from its data
+    bool inner_known = false;
+    for (std::uint64_t pos = 13; pos < file_size;) {  // after "#ROSBAG V2.0\n"
+        const Record r = read_record(pos, file_size);
+        targets.insert(targets.end(), r.points_to.begin(), r.points_to.end());
+        const std::uint64_t data = pos + 8 + r.header_len, next = data + r.data_len;
+        if (r.op == 0x05) {  // a chunk: its size; and, stored plainly, the records inside
+            if (r.size && *r.size > kMaxChunkBytes)
+                throw damaged(pos, "is a chunk of " + std::to_string(*r.size) +
+                                       " bytes, over the limit of " + std::to_string(kMaxChunkBytes));
+            inner.clear();
+            inner_known = r.compression == "none";
+            if (inner_known) {
+                if (!r.size || *r.size != r.data_len)
+                    throw damaged(pos, "is a plain chunk whose size is not its data's");
+                for (std::uint64_t at = data; at < next;) {
+                    const Record m = read_record(at, next);
+                    inner.push_back(at - data);
+                    at += 8 + std::uint64_t{m.header_len} + m.data_len;
+                }
+            }
+        } else if (r.op == 0x04 && inner_known) {  // the chunk's index: (time, offset) each
+            if (r.data_len % 12 != 0) throw damaged(pos, "is an index of a broken size");
+            std::vector<char> entries(r.data_len);
+            in.seekg(std::streamoff(data)).read(entries.data(), std::streamsize(r.data_len));
+            if (!in) throw damaged(pos, "is cut short");
+            for (std::size_t e = 0; e < entries.size(); e += 12) {
+                if (!std::binary_search(inner.begin(), inner.end(), le32(entries.data() + e + 8)))
+                    throw damaged(pos, "indexes a message where its chunk holds none");
+            }
+        }
         starts.push_back(pos);
-        pos += 8 + std::uint64_t{header_len} + data_len;
+        pos = next;
     }
     for (const std::uint64_t to : targets) {
         if (!std::binary_search(starts.begin(), starts.end(), to)) {
