@@ -32,6 +32,15 @@
 #   clang libclang-rt-14-dev libomp-14-dev         the fuzzers (fuzz/, .ci/run): clang 14's libFuzzer
 #                                                  (-fsanitize=fuzzer), its sanitizer runtimes, OpenMP
 #   zlib1g-dev                                     tests/robust_cli_test.cpp writes PNG chunks (crc32)
+#   librosbag-dev                                  ROS 1 bags as input (src/bag/, docs/INPUTS.md); built
+#                                                  only when found
+#   libclass-loader-dev librcpputils-dev           headers that Debian's rosbag/bag.h includes (through
+#   librcutils-dev libament-index-cpp-dev          its ROS 2 pluginlib) but librosbag-dev does not bring
+#   libsensor-msgs-dev libstd-msgs-dev             the messages of bags and of the node
+#   libroscpp-dev libmessage-filters-dev           the ROS 1 node wul3d_ros (docs/ROS.md): roscpp, the
+#                                                  colour/depth/camera_info synchronizer; built only when found
+#   libvisualization-msgs-dev libdiagnostic-msgs-dev  its boxes (MarkerArray) and its /diagnostics
+#   python3-roslaunch python3-rosmaster rosout     roscore and roslaunch: the node's tests start a roscore
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -74,6 +83,20 @@ packages=(
   libclang-rt-14-dev
   libomp-14-dev
   zlib1g-dev
+  librosbag-dev
+  libclass-loader-dev
+  librcpputils-dev
+  librcutils-dev
+  libament-index-cpp-dev
+  libsensor-msgs-dev
+  libstd-msgs-dev
+  libroscpp-dev
+  libmessage-filters-dev
+  libvisualization-msgs-dev
+  libdiagnostic-msgs-dev
+  python3-roslaunch
+  python3-rosmaster
+  rosout
 )
 
 missing=()

@@ -27,6 +27,10 @@ if [ "$only" = batch ]; then
   harnesses=""
 else
   "$build/fuzz/make_seeds" data/samples "$seeds"
+  if [[ -x "$build/fuzz/fuzz_bag" ]]; then  # built where librosbag is (cmake/Ros.cmake)
+    "$build/fuzz/make_bag_seeds" "$seeds/bag"
+    harnesses="$harnesses bag"
+  fi
 fi
 
 total_runs=0

@@ -38,6 +38,9 @@ void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageS
                          DepthImage& out, const HeaderCheck& check = {});
 void read_color_image_into(const std::string& path, ImageScratch& scratch, ColorImage& out,
                            const HeaderCheck& check = {});
+/// As read_color_image_into, of the PNG or JPEG already in `scratch.bytes` (a bag's
+/// CompressedImage); `what` names it in errors.
+void decode_color_image_into(const std::string& what, ImageScratch& scratch, ColorImage& out);
 void read_label_png_into(const std::string& path, ImageScratch& scratch, LabelImage& out);
 
 /// "WxH".

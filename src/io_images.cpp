@@ -462,16 +462,16 @@ public:
     /// PNG only unless allow_jpeg. InputError if missing, not a PNG (or JPEG), damaged.
     ImageFile(const std::string& path, ImageScratch& s, bool allow_jpeg) : path_(path), s_(s) {
         detail::read_regular_file(path, max_image_file_bytes(), s.bytes);
-        if (is_png(s.bytes)) {
-            png_.emplace(path, check_png(path, s.bytes, s.cleaned));
-        } else if (allow_jpeg && is_jpeg(s.bytes)) {
-            check_jpeg(path, s.bytes);
-            jpeg_.emplace(path, s.bytes);
-        } else {
-            throw InputError(path + (allow_jpeg ? ": cannot decode (not a PNG or JPEG file)"
-                                                : ": cannot decode (not a PNG file)"));
-        }
-        check_size(path, width(), height());
+        open(allow_jpeg);
+    }
+    /// An image already in `s.bytes` (a compressed image of a bag); `path` names it in errors.
+    struct InMemory {};
+    ImageFile(const std::string& path, ImageScratch& s, bool allow_jpeg, InMemory)
+        : path_(path), s_(s) {
+        if (s.bytes.size() > max_image_file_bytes())
+            throw InputError(path + ": compressed image of " + bytes_str(s.bytes.size()) +
+                             " is over the limit of " + bytes_str(max_image_file_bytes()));
+        open(allow_jpeg);
     }
 
     std::size_t width() const { return png_ ? png_->width() : jpeg_->width(); }
@@ -491,6 +491,21 @@ public:
     }
 
 private:
+    void open(bool allow_jpeg) {
+        const std::string& path = path_;
+        ImageScratch& s = s_;
+        if (is_png(s.bytes)) {
+            png_.emplace(path, check_png(path, s.bytes, s.cleaned));
+        } else if (allow_jpeg && is_jpeg(s.bytes)) {
+            check_jpeg(path, s.bytes);
+            jpeg_.emplace(path, s.bytes);
+        } else {
+            throw InputError(path + (allow_jpeg ? ": cannot decode (not a PNG or JPEG file)"
+                                                : ": cannot decode (not a PNG file)"));
+        }
+        check_size(path, width(), height());
+    }
+
     const std::string& path_;
     ImageScratch& s_;
     std::optional<PngDecoder> png_;
@@ -739,9 +754,12 @@ void read_depth_png_into(const std::string& path, float scale_m_per_unit, ImageS
     out.scale_m_per_unit = scale_m_per_unit;
 }
 
-void read_color_image_into(const std::string& path, ImageScratch& s, ColorImage& out,
-                           const HeaderCheck& check) {
-    ImageFile file(path, s, true);
+namespace {
+
+/// Colour of an opened PNG or JPEG: 8-bit grey, RGB or RGBA, into RGB; `check` sees its size
+/// before anything is decoded.
+void decode_color(const std::string& path, ImageFile& file, ColorImage& out,
+                  const HeaderCheck& check) {
     const PixelFormat f = file.format();
     if (f.bits != 8 || (f.channels != 1 && f.channels != 3 && f.channels != 4)) {
         throw InputError(path + ": colour must be 8-bit grey, RGB or RGBA, got " + describe(f));
@@ -751,6 +769,19 @@ void read_color_image_into(const std::string& path, ImageScratch& s, ColorImage&
     decode_or_clear(out, out.rgb, [&] { file.read(Layout::Rgb8, out.rgb.data()); });
     out.width = static_cast<int>(file.width());
     out.height = static_cast<int>(file.height());
+}
+
+}  // namespace
+
+void read_color_image_into(const std::string& path, ImageScratch& s, ColorImage& out,
+                           const HeaderCheck& check) {
+    ImageFile file(path, s, true);
+    decode_color(path, file, out, check);
+}
+
+void decode_color_image_into(const std::string& what, ImageScratch& s, ColorImage& out) {
+    ImageFile file(what, s, true, ImageFile::InMemory{});
+    decode_color(what, file, out, {});
 }
 
 void read_label_png_into(const std::string& path, ImageScratch& s, LabelImage& out) {

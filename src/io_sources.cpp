@@ -2,7 +2,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -10,6 +12,7 @@
 #include <unordered_map>
 
 #include "io_detail.hpp"
+#include "wul3d/bag.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 
@@ -488,6 +491,7 @@ const char* input_format_name(InputFormat f) {
         case InputFormat::Frames: return "frames";
         case InputFormat::Tum: return "tum";
         case InputFormat::Unregistered: return "unregistered";
+        case InputFormat::Bag: return "bag";
     }
     return "?";
 }
@@ -497,8 +501,17 @@ InputFormat parse_input_format(const std::string& name) {
     if (name == "frames") return InputFormat::Frames;
     if (name == "tum") return InputFormat::Tum;
     if (name == "unregistered") return InputFormat::Unregistered;
+    if (name == "bag") return InputFormat::Bag;
     throw ParamError("unknown input format '" + name +
-                     "' (known: auto, frames, tum, unregistered)");
+                     "' (known: auto, frames, tum, unregistered, bag)");
+}
+
+bool is_bag_file(const std::string& path) {
+    if (!is_file(path)) return false;  // a FIFO is never opened here
+    static constexpr char kMagic[] = "#ROSBAG V2.0";
+    char head[sizeof kMagic - 1] = {};
+    std::ifstream in(path, std::ios::binary);
+    return in.read(head, sizeof head) && std::memcmp(head, kMagic, sizeof head) == 0;
 }
 
 std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOptions& options) {
@@ -506,6 +519,13 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
     std::error_code ec;
     const auto status = fs::status(root, ec);
     if (!fs::exists(status)) throw InputError(path + ": no such file or directory");
+    if (options.format == InputFormat::Bag ||
+        (options.format == InputFormat::Auto && is_bag_file(path))) {
+        return open_bag(path, options);
+    }
+    if (!options.bag_topics.empty()) {
+        throw ParamError("topics are for ROS bags, but " + path + " is no bag");
+    }
     if (!fs::is_directory(status)) {
         throw InputError(path + ": not a folder (" + kNoFramesHint + ")");
     }

@@ -740,7 +740,9 @@ TEST(OpenSource, ParseInputFormat) {
     EXPECT_EQ(wul3d::parse_input_format("frames"), wul3d::InputFormat::Frames);
     EXPECT_EQ(wul3d::parse_input_format("tum"), wul3d::InputFormat::Tum);
     EXPECT_EQ(wul3d::parse_input_format("unregistered"), wul3d::InputFormat::Unregistered);
-    EXPECT_THROW(wul3d::parse_input_format("bag"), wul3d::ParamError);
+    EXPECT_EQ(wul3d::parse_input_format("bag"), wul3d::InputFormat::Bag);
+    EXPECT_STREQ(wul3d::input_format_name(wul3d::InputFormat::Bag), "bag");
+    EXPECT_THROW(wul3d::parse_input_format("rosbag"), wul3d::ParamError);
 }
 
 TEST(OpenSource, SampleFolderOfFrameFolders) {

@@ -33,14 +33,16 @@ void add_max_pixels_option(CLI::App* cmd) {
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     add_max_pixels_option(cmd);
     cmd->add_option("input", o.input,
-                    "Frame folder(s), TUM RGB-D sequence, or unregistered frames (or --camera)");
+                    "Frame folder(s), TUM RGB-D sequence, unregistered frames or a ROS bag (or --camera)");
     cmd->add_option("--camera", o.camera,
                     "Live camera instead of INPUT: freenect[:INDEX] (Kinect v1), "
                     "openni2[:URI|FILE.oni], freenect2[:SERIAL], realsense[:SERIAL]");
     cmd->add_flag("--lossless", o.lossless,
                   "With --camera: capture waits for processing instead of dropping frames "
                   "(for replays: fakenect, .oni)");
-    cmd->add_option("--format", o.format, "auto|frames|tum|unregistered")->capture_default_str();
+    cmd->add_option("--format", o.format, "auto|frames|tum|unregistered|bag")->capture_default_str();
+    cmd->add_option("--topics", o.topics,
+                    "ROS bag topics COLOR,DEPTH[,INFO] (default: detected; docs/INPUTS.md)");
     cmd->add_option("--preset", o.preset, "paper: the paper's parameters");
     cmd->add_option("--k", o.k, "Number of clusters (default 7)");
     cmd->add_option("--alpha", o.alpha, "Colour scale, eq. 4, [0.002, 0.1] (default 0.0033)");
@@ -114,6 +116,7 @@ SourceOptions make_source_options(const PipelineOptions& o) {
     s.format = parse_input_format(o.format);
     s.tum_camera = o.tum_camera;
     s.calibration = o.calibration;
+    s.bag_topics = o.topics;
     s.registration = parse_registration_mode(o.registration);
     if (!o.intrinsics.empty()) s.intrinsics = parse_intrinsics_override(o.intrinsics);
     return s;

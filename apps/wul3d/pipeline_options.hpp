@@ -24,6 +24,7 @@ struct PipelineOptions {
     std::string tum_camera;
     std::string intrinsics;
     std::string calibration;
+    std::string topics;  // --topics COLOR,DEPTH[,INFO] of a ROS bag
     std::string registration = "depth-to-color";
     std::string select;
     std::string segmenter;

@@ -93,8 +93,9 @@ enum class InputFormat {
     Frames,        ///< frame folders: color.png, depth.png, intrinsics.json [, label.png]
     Tum,           ///< TUM RGB-D: rgb.txt, depth.txt, rgb/, depth/
     Unregistered,  ///< frame folders with colour and depth of different sizes + calibration
+    Bag,           ///< a ROS 1 bag (wul3d/bag.hpp; only where built with librosbag)
 };
-InputFormat parse_input_format(const std::string& name);  ///< auto|frames|tum|unregistered
+InputFormat parse_input_format(const std::string& name);  ///< auto|frames|tum|unregistered|bag
 const char* input_format_name(InputFormat format);       ///< the inverse of parse_input_format
 
 struct SourceOptions {
@@ -110,6 +111,9 @@ struct SourceOptions {
     std::string calibration;
     RegistrationMode registration = RegistrationMode::DepthToColor;
     double tum_max_dt_s = 0.02;  ///< TUM colour/depth association tolerance
+    /// Bags only: "COLOR,DEPTH[,INFO]" topics (`run --topics`); empty = detect the layout.
+    std::string bag_topics;
+    double bag_max_dt_s = 0.02;  ///< bags: colour/depth pairing tolerance, seconds
 };
 
 /// One item of a sequence: either already registered (`frame`) or raw (`raw`), which the
@@ -133,7 +137,8 @@ public:
     virtual const StereoCalibration* calibration() const { return nullptr; }
 };
 
-/// Opens `path`. Auto-detection: a folder with rgb.txt and depth.txt is TUM; a folder
+/// Opens `path`. Auto-detection: a file that starts as a ROS bag does is a bag (bag.hpp);
+/// a folder with rgb.txt and depth.txt is TUM; a folder
 /// with depth.png is one frame; a folder whose sub-folders hold depth.png is a sequence
 /// (sorted by name); either of the last two is Unregistered when a calibration is given or
 /// `calibration.json` lies beside the frames, else Frames. Throws InputError for a missing
