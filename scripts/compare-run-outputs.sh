@@ -31,7 +31,8 @@ for c in "${cases[@]}"; do
   python3 - "$work/$name/old" "$work/$name/new" <<'PY' || ok=0
 import json, pathlib, sys
 # Per-frame statistics: summary.json's "per_frame" before issue 24, OUT/frames.jsonl since.
-timing = {"stage_ms_median", "ms_per_frame_median", "fps", "wall_s", "fps_end_to_end", "peak_rss_mb"}
+timing = {"stage_ms_median", "ms_per_frame_median", "fps", "wall_s", "fps_end_to_end", "peak_rss_mb",
+          "threads_stages", "threads_writers"}  # timings, and how a run shared its threads
 def load(out):
     s = json.loads((pathlib.Path(out) / "summary.json").read_text())
     lines = pathlib.Path(out) / "frames.jsonl"

@@ -23,6 +23,7 @@
 #include "wul3d/objects.hpp"
 #include "wul3d/output.hpp"
 #include "wul3d/stop.hpp"
+#include "wul3d/threads.hpp"
 #include "wul3d/write_guard.hpp"
 #include "write_behind.hpp"
 
@@ -222,9 +223,25 @@ void check_out_apart_from_inputs(const RunOptions& o) {
     check_write_target(o.out_dir, WriteTarget::Folder, inputs, "output folder");
 }
 
+/// How a run shares its worker threads (threads.hpp's count, all cores by default): a
+/// quarter of them, 1 to 4, write (a frame's outputs cost about as much as its processing),
+/// one reads ahead, and the stages take the rest, at least one. On 2 cores the stages then
+/// run on one thread beside the reader and the writer: alternated on osd_mosd, that ran the
+/// whole command 1.5 times as fast as the stages on both cores fighting them for the cores
+/// (docs/SPEED.md, "The command end to end").
+struct RunThreads {
+    int total, writers, stages;
+};
+RunThreads run_threads() {
+    const int total = num_threads();
+    const int writers = std::clamp(total / 4, 1, 4);
+    return {total, writers, std::max(1, total - 1 - writers)};
+}
+
 /// summary.json's frame-independent part.
 nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const RunSummary& s,
-                            const StageLog& log, const Selection& selection) {
+                            const StageLog& log, const Selection& selection,
+                            const RunThreads& threads) {
     nlohmann::json summary;
     if (feed.live()) {
         summary["input"] = nullptr;
@@ -242,7 +259,9 @@ nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const Ru
     summary["parameters"] = parameters_json(o.params, o.preset);
     summary["frames"] = s.frames;
     summary["frames_file"] = kFramesFile;
-    summary["threads"] = omp_get_max_threads();
+    summary["threads"] = threads.total;
+    summary["threads_stages"] = threads.stages;
+    summary["threads_writers"] = threads.writers;
     summary["stage_ms_median"] = log.medians();
     summary["ms_per_frame_median"] = s.ms_per_frame_median;
     summary["fps"] = s.fps;
@@ -304,11 +323,18 @@ void take_frame(PendingFrame& p, const std::string& name, SourceItem& item, cons
     if (selection.cluster) p.line["selected_pixels"] = selection.cluster->pixels();
 }
 
-/// Writer threads for a run: a quarter of the cores, 1 to 4 (a frame's outputs take about
-/// 1.5 times its processing on one core; more writers would take cores from the stages).
-int writer_threads() {
-    return std::clamp(static_cast<int>(std::thread::hardware_concurrency()) / 4, 1, 4);
-}
+/// The calling thread's OpenMP team size for a scope (an OpenMP setting of each thread: other
+/// threads' pipelines keep theirs), then back.
+class ScopedTeam {
+public:
+    explicit ScopedTeam(int n) : previous_(omp_get_max_threads()) { omp_set_num_threads(n); }
+    ~ScopedTeam() { omp_set_num_threads(previous_); }
+    ScopedTeam(const ScopedTeam&) = delete;
+    ScopedTeam& operator=(const ScopedTeam&) = delete;
+
+private:
+    int previous_;
+};
 
 }  // namespace
 
@@ -343,9 +369,11 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     FramesLog frames_log((out_dir / kFramesFile).string());
 
     RunSummary s;
-    const int writers = writer_threads();
+    const RunThreads threads = run_threads();
+    const ScopedTeam stages_team(threads.stages);
     detail::WriteBehind<PendingFrame> writes(
-        static_cast<std::size_t>(writers) + 2, writers, [&o](PendingFrame& p) {
+        static_cast<std::size_t>(threads.writers) + 2, threads.writers, [&o](PendingFrame& p) {
+            omp_set_num_threads(1);  // a writer's overlay is one thread's work among several
             const auto t0 = Clock::now();
             write_frame(o.out_dir, p.name, p.has_cloud ? &p.cloud : nullptr, p.frame(), p.result,
                         p.outputs);
@@ -451,7 +479,7 @@ RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
     }
     try {
         write_text_file((out_dir / kSummaryFile).string(),
-                        json_text(summary_json(o, feed, s, log, selection), 2) + "\n");
+                        json_text(summary_json(o, feed, s, log, selection, threads), 2) + "\n");
     } catch (const std::exception&) {
         if (!failed) throw;  // the first error is the one to report (a full disk, twice)
     }
