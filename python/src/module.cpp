@@ -193,6 +193,14 @@ private:
 };
 
 /// One frame read from disk (wul3d.read), registered when the input is unregistered.
+/// A file name as Python's os.fsdecode gives it: bytes that are not UTF-8 as surrogates
+/// (a frame folder named "img\xff\xfe" reads back, and os.fsencode gives its bytes again).
+py::str fs_str(const std::string& name) {
+    PyObject* s = PyUnicode_DecodeFSDefaultAndSize(name.data(), static_cast<Py_ssize_t>(name.size()));
+    if (!s) throw py::error_already_set();
+    return py::reinterpret_steal<py::str>(s);
+}
+
 struct PyFrame {
     std::string name;
     py::object color;  ///< (H, W, 3) uint8 or None
@@ -542,14 +550,18 @@ run at the same time (do not write to the arrays meanwhile).
 
 void bind_reading(py::module_& m) {
     py::class_<PyFrame>(m, "Frame", "One registered RGB-D frame read from disk (wul3d.read).")
-        .def_readonly("name", &PyFrame::name, "Its name: OUT/<name>/ in `wul3d run`.")
+        .def_property_readonly(
+            "name", [](const PyFrame& f) { return fs_str(f.name); },
+            "Its name: OUT/<name>/ in `wul3d run` (bytes that are not UTF-8 as os.fsdecode "
+            "gives them).")
         .def_readonly("color", &PyFrame::color, "(H, W, 3) uint8 RGB, or None.")
         .def_readonly("depth", &PyFrame::depth, "(H, W) uint16, units of depth_scale.")
         .def_readonly("depth_scale", &PyFrame::depth_scale, "Metres per depth unit.")
         .def_readonly("intrinsics", &PyFrame::intrinsics, "wul3d.Intrinsics of the frame.")
         .def("__repr__", [](const PyFrame& f) {
-            return "Frame('" + f.name + "', " + std::to_string(f.depth.shape(1)) + "x" +
-                   std::to_string(f.depth.shape(0)) + (f.color.is_none() ? ", depth only)" : ")");
+            return "Frame(" + py::repr(fs_str(f.name)).cast<std::string>() + ", " +
+                   std::to_string(f.depth.shape(1)) + "x" + std::to_string(f.depth.shape(0)) +
+                   (f.color.is_none() ? ", depth only)" : ")");
         });
 
     py::class_<Reader>(m, "_Reader")

@@ -507,3 +507,13 @@ def test_read_and_run_honour_max_pixels(max_pixels, tmp_path):
         wul3d.run(TABLETOP, tmp_path / "o", frames=1)
     wul3d.set_max_pixels(640 * 480)
     assert wul3d.read(TABLETOP)[0].depth.shape == (480, 640)
+
+
+def test_frame_names_that_are_not_utf8_read_back_as_fsdecode_gives_them(tmp_path):
+    # Frame.name raised UnicodeDecodeError for a frame folder named with bytes b"\xff\xfe".
+    name = os.fsdecode(b"img\xff\xfe")
+    shutil.copytree(TABLETOP / "image_0000", tmp_path / "seq" / name)
+    frame = wul3d.read(str(tmp_path / "seq"))[0]
+    assert frame.name == name
+    assert os.fsencode(frame.name) == b"img\xff\xfe"
+    assert "Frame(" in repr(frame)
