@@ -1,5 +1,6 @@
 // Frame sequences of io.hpp: frame folders, TUM RGB-D and unregistered frame folders.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -471,6 +472,151 @@ std::unique_ptr<FrameSource> open_tum(const std::string& path, const fs::path& r
     return std::make_unique<TumSource>(std::move(pairs), K, from);
 }
 
+// ---- OCID sequences and PCD files --------------------------------------------------------
+
+/// The depth/result_*.png of an OCID sequence folder, sorted by name; empty if not one.
+std::vector<fs::path> ocid_depth_files(const fs::path& seq) {
+    std::vector<fs::path> files;
+    if (!is_dir(seq / "rgb") || !is_dir(seq / "depth")) return files;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(seq / "depth", ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("result_", 0) == 0 && e.path().extension() == ".png") files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+/// The first OCID sequence folder under `root` (at most four levels down:
+/// ARID20/table/top/seq01), or empty.
+fs::path find_ocid_sequence(const fs::path& root, int levels) {
+    if (levels < 0) return {};
+    std::vector<fs::path> subs;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(root, ec))
+        if (is_dir(e.path())) subs.push_back(e.path());
+    std::sort(subs.begin(), subs.end());
+    for (const fs::path& s : subs) {
+        if (!ocid_depth_files(s).empty()) return s;
+        fs::path deeper = find_ocid_sequence(s, levels - 1);
+        if (!deeper.empty()) return deeper;
+    }
+    return {};
+}
+
+/// One OCID sequence: depth/result_*.png (mm), rgb/ of the same names, intrinsics from
+/// pcd/<first frame>.pcd or given.
+class OcidSource final : public FrameSource {
+public:
+    OcidSource(fs::path seq, std::vector<fs::path> depth, PinholeIntrinsics K, std::string from)
+        : seq_(std::move(seq)), depth_(std::move(depth)), K_(K), from_(std::move(from)) {}
+
+    std::size_t size() const override { return depth_.size(); }
+    std::string name(std::size_t i) const override {
+        check_index(i, size());
+        return depth_[i].stem().string();
+    }
+    InputFormat format() const override { return InputFormat::Ocid; }
+
+    void read(std::size_t i, SourceItem& item) override {
+        check_index(i, size());
+        item.is_raw = false;
+        RgbdFrame& f = item.frame;
+        f.name = name(i);
+        f.intrinsics = K_;
+        const std::string depth = depth_[i].string();
+        detail::read_depth_png_into(depth, 0.001f, depth_scratch_, f.depth, [&](int w, int h) {
+            if (K_.sized() && !K_.same_size(w, h))
+                throw InputError(depth + ": depth is " + size_str(w, h) + " but the intrinsics (" +
+                                 from_ + ") are " + size_str(K_.width, K_.height));
+        });
+        if (!K_.sized()) {
+            f.intrinsics.width = f.depth.width;
+            f.intrinsics.height = f.depth.height;
+            f.intrinsics.validate(depth + ": the intrinsics (" + from_ + ")");
+        }
+        const fs::path color = seq_ / "rgb" / depth_[i].filename();
+        if (present(color)) {
+            detail::read_color_image_into(color.string(), color_scratch_, f.color, [&](int w, int h) {
+                check_colour_size(seq_, w, h, f.depth.width, f.depth.height);
+            });
+        } else {
+            clear_colour(f.color);
+        }
+    }
+
+private:
+    fs::path seq_;
+    std::vector<fs::path> depth_;
+    PinholeIntrinsics K_;
+    std::string from_;
+    detail::ImageScratch depth_scratch_, color_scratch_;
+};
+
+std::unique_ptr<FrameSource> open_ocid(const std::string& path, const fs::path& seq,
+                                       std::vector<fs::path> depth, const SourceOptions& options) {
+    if (!options.calibration.empty())
+        throw ParamError("a calibration is for unregistered input, but " + path +
+                         " is read as an OCID sequence (registered)");
+    PinholeIntrinsics K;
+    std::string from;
+    const fs::path pcd = seq / "pcd" / (depth.front().stem().string() + ".pcd");
+    if (options.intrinsics) {
+        K = *options.intrinsics;
+        from = "given";
+        if (K.sized())
+            K.validate("the given intrinsics");
+        else
+            K.validate_unsized("the given intrinsics");
+    } else if (something_at(pcd)) {
+        K = read_pcd_frame(pcd.string()).intrinsics;
+        from = "recovered from " + pcd.string();
+    } else {
+        throw InputError(path + ": an OCID sequence without " + pcd.string() +
+                         " to recover the intrinsics from; give them (--intrinsics)");
+    }
+    return std::make_unique<OcidSource>(seq, std::move(depth), K, from);
+}
+
+/// One organized PCD file as a one-frame sequence.
+class PcdSource final : public FrameSource {
+public:
+    PcdSource(fs::path file, std::optional<PinholeIntrinsics> K)
+        : file_(std::move(file)), K_(std::move(K)) {}
+    std::size_t size() const override { return 1; }
+    std::string name(std::size_t i) const override {
+        check_index(i, size());
+        return file_.stem().string();
+    }
+    InputFormat format() const override { return InputFormat::Pcd; }
+    void read(std::size_t i, SourceItem& item) override {
+        check_index(i, size());
+        item.is_raw = false;
+        item.frame = read_pcd_frame(file_.string());
+        item.frame.name = name(i);
+        if (K_) {
+            PinholeIntrinsics K = *K_;
+            if (!K.sized()) K.width = item.frame.depth.width, K.height = item.frame.depth.height;
+            K.validate(file_.string() + ": the given intrinsics");
+            if (!K.same_size(item.frame.depth.width, item.frame.depth.height))
+                throw InputError(file_.string() + ": the PCD is " +
+                                 size_str(item.frame.depth.width, item.frame.depth.height) +
+                                 " but the given intrinsics are " + size_str(K.width, K.height));
+            item.frame.intrinsics = K;
+        }
+    }
+
+private:
+    fs::path file_;
+    std::optional<PinholeIntrinsics> K_;
+};
+
+bool is_pcd_path(const fs::path& p) {
+    std::string ext = p.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext == ".pcd" && is_file(p);
+}
+
 // ---- calibration ------------------------------------------------------------------------
 
 /// Where calibration.json is looked for: the input folder, then its parent (beside a
@@ -492,6 +638,8 @@ const char* input_format_name(InputFormat f) {
         case InputFormat::Tum: return "tum";
         case InputFormat::Unregistered: return "unregistered";
         case InputFormat::Bag: return "bag";
+        case InputFormat::Ocid: return "ocid";
+        case InputFormat::Pcd: return "pcd";
     }
     return "?";
 }
@@ -502,8 +650,10 @@ InputFormat parse_input_format(const std::string& name) {
     if (name == "tum") return InputFormat::Tum;
     if (name == "unregistered") return InputFormat::Unregistered;
     if (name == "bag") return InputFormat::Bag;
+    if (name == "ocid") return InputFormat::Ocid;
+    if (name == "pcd") return InputFormat::Pcd;
     throw ParamError("unknown input format '" + name +
-                     "' (known: auto, frames, tum, unregistered, bag)");
+                     "' (known: auto, frames, tum, unregistered, bag, ocid, pcd)");
 }
 
 bool is_bag_file(const std::string& path) {
@@ -526,8 +676,22 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
     if (!options.bag_topics.empty()) {
         throw ParamError("topics are for ROS bags, but " + path + " is no bag");
     }
+    if (options.format == InputFormat::Pcd ||
+        (options.format == InputFormat::Auto && is_pcd_path(root))) {
+        if (!options.calibration.empty())
+            throw ParamError("a calibration is for unregistered input, but " + path +
+                             " is read as a PCD (registered)");
+        return std::make_unique<PcdSource>(root, options.intrinsics);
+    }
     if (!fs::is_directory(status)) {
         throw InputError(path + ": not a folder (" + kNoFramesHint + ")");
+    }
+    if (options.format == InputFormat::Ocid || options.format == InputFormat::Auto) {
+        std::vector<fs::path> depth = ocid_depth_files(root);
+        if (!depth.empty()) return open_ocid(path, root, std::move(depth), options);
+        if (options.format == InputFormat::Ocid)
+            throw InputError(path + ": not an OCID sequence (expected rgb/ and depth/ holding "
+                                    "result_*.png)");
     }
 
     InputFormat format = options.format;
@@ -542,7 +706,16 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
         return open_tum(path, root, options);
     }
 
-    FrameDirs dirs = find_frame_dirs(path, root);
+    FrameDirs dirs;
+    try {
+        dirs = find_frame_dirs(path, root);
+    } catch (const InputError&) {
+        // An OCID tree above its sequences: one sequence at a time.
+        const fs::path seq = find_ocid_sequence(root, 4);
+        if (seq.empty()) throw;
+        throw InputError(path + ": an OCID tree; give one sequence folder (one with rgb/ and "
+                                "depth/, e.g. " + seq.string() + ")");
+    }
     // "Beside the frames": in the folder of a sequence's frame folders; for a single frame
     // folder, in it or in its parent.
     std::optional<fs::path> calib_file;

@@ -57,6 +57,19 @@ bool is_dir(const fs::path& p) {
     return fs::is_directory(p, ec);
 }
 
+/// An OCID sequence folder as downloaded: rgb/, depth/ and label/.
+bool is_ocid_sequence(const fs::path& p) {
+    return is_dir(p / "label") && is_dir(p / "depth") && is_dir(p / "rgb");
+}
+
+/// OCID's background ids: 0 (no depth), 1 (floor or wall) and, on tables, 2 (the table).
+/// The sequence's path says which: .../floor/... or .../table/....
+int ocid_background_max(const fs::path& seq) {
+    for (const fs::path& part : fs::absolute(seq).lexically_normal())
+        if (part == "floor") return 1;
+    return 2;
+}
+
 bool kept(const EvalOptions& o, const std::string& name) {
     if (o.only.empty()) return true;
     return std::any_of(o.only.begin(), o.only.end(),
@@ -72,8 +85,21 @@ std::vector<FramePair> pair_frames(const EvalOptions& o) {
     if (!is_file(pred) && !is_dir(pred)) throw InputError(o.pred + ": prediction not found");
 
     std::vector<FramePair> frames;
-    const bool single = is_file(gt) || is_file(gt / o.gt_file);
-    if (single) {
+    const bool single = !is_ocid_sequence(gt) && (is_file(gt) || is_file(gt / o.gt_file));
+    if (is_ocid_sequence(gt)) {
+        // OCID as downloaded: label/result_*.png, named by their stem as `wul3d run` names
+        // the frames.
+        std::error_code ec;
+        for (const auto& e : fs::directory_iterator(gt / "label", ec)) {
+            const std::string n = e.path().filename().string();
+            if (n.rfind("result_", 0) == 0 && e.path().extension() == ".png" && is_file(e.path()))
+                frames.push_back({e.path().stem().string(), e.path(), {}});
+        }
+        if (ec) throw InputError(o.gt + "/label: cannot list the folder (" + ec.message() + ")");
+        if (frames.empty()) throw InputError(o.gt + ": OCID sequence without label/result_*.png");
+        std::sort(frames.begin(), frames.end(),
+                  [](const FramePair& a, const FramePair& b) { return a.name < b.name; });
+    } else if (single) {
         FramePair f;
         f.gt = is_file(gt) ? gt : gt / o.gt_file;
         const fs::path folder = is_file(gt) ? gt.parent_path() : gt;
@@ -142,7 +168,10 @@ nlohmann::json score_json(const ImageScore& s) {
             {"matches", matches}};
 }
 
-void run(const EvalOptions& o) {
+void run(EvalOptions o) {
+    // An OCID sequence's own background ids, unless given.
+    if (is_ocid_sequence(o.gt) && o.gt_background_max == 0)
+        o.gt_background_max = ocid_background_max(o.gt);
     EvalParams params;
     params.boundary_tolerance_px = o.tolerance_px;
     params.validate();
@@ -275,8 +304,9 @@ void add_eval_command(CLI::App& app) {
                     "folder or one label PNG")
         ->required();
     cmd->add_option("gt", opts->gt,
-                    "Ground truth: a folder of frame folders with label.png, one frame folder "
-                    "or one label PNG")
+                    "Ground truth: a folder of frame folders with label.png, one frame folder, "
+                    "one label PNG, or an OCID sequence (label/result_*.png; ids 0-2 on "
+                    "tables, 0-1 on the floor are background)")
         ->required();
     cmd->add_option("--pred-file", opts->pred_file,
                     "Prediction file in each frame folder (labels.png scores raw clusters)")

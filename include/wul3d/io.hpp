@@ -3,6 +3,7 @@
 /// Reading RGB-D recordings and writing outputs. Readers check everything a user can get
 /// wrong (missing file, truncated PNG, bit depth, sizes) and throw InputError with the path;
 /// writers write to a temporary name and rename, so no output is ever half-written.
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -65,6 +66,25 @@ IntrinsicsFile read_intrinsics_json(const std::string& path);
 StereoCalibration read_calibration_json(const std::string& path);
 void write_calibration_json(const std::string& path, const StereoCalibration& calib);
 
+/// An organized PCD file (PCL's format, v0.7; DATA ascii, binary or binary_compressed) as
+/// a frame: fields x y z (float, metres) and optionally rgb or rgba (packed, 4 bytes); other
+/// fields are skipped. HEIGHT must be > 1. Depth is z in millimetres (NaN or out of range
+/// -> 0, depth_scale 0.001), colour from rgb (none without it), and the intrinsics are
+/// recovered from the points (least squares of u = fx x/z + cx, v = fy y/z + cy). InputError
+/// with one line for a header that lies about the data's size, an unorganized cloud, too
+/// few valid points (kPcdMinFitPoints) or a fit whose RMS residual exceeds kPcdMaxFitRmsPx.
+inline constexpr int kPcdMinFitPoints = 100;
+inline constexpr double kPcdMaxFitRmsPx = 0.5;
+/// The largest PCD header read, bytes.
+inline constexpr std::uint64_t kMaxPcdHeaderBytes = std::uint64_t{1} << 16;
+RgbdFrame read_pcd_frame(const std::string& path);
+/// As read_pcd_frame, of a PCD already in memory; `what` names it in errors.
+RgbdFrame parse_pcd_frame(const std::string& what, const unsigned char* data, std::size_t size);
+enum class PcdData { Ascii, Binary, BinaryCompressed };
+/// Writes `frame` as an organized PCD (x y z [rgb]; pixels without depth are NaN points),
+/// the format read_pcd_frame reads: for tests, fuzz seeds and users' tools.
+void write_pcd(const std::string& path, const RgbdFrame& frame, PcdData data, bool with_rgb);
+
 // ---- outputs (atomic: temporary name, then rename) ------------------------------------
 
 void write_label_png(const std::string& path, const LabelImage& labels);      ///< 16-bit
@@ -94,8 +114,11 @@ enum class InputFormat {
     Tum,           ///< TUM RGB-D: rgb.txt, depth.txt, rgb/, depth/
     Unregistered,  ///< frame folders with colour and depth of different sizes + calibration
     Bag,           ///< a ROS 1 bag (wul3d/bag.hpp; only where built with librosbag)
+    Ocid,          ///< one OCID sequence as downloaded: rgb/, depth/ [, label/, pcd/] of result_*.png
+    Pcd,           ///< one organized PCD file (read_pcd_frame)
 };
-InputFormat parse_input_format(const std::string& name);  ///< auto|frames|tum|unregistered|bag
+/// auto|frames|tum|unregistered|bag|ocid|pcd
+InputFormat parse_input_format(const std::string& name);
 const char* input_format_name(InputFormat format);       ///< the inverse of parse_input_format
 
 struct SourceOptions {
@@ -138,7 +161,10 @@ public:
 };
 
 /// Opens `path`. Auto-detection: a file that starts as a ROS bag does is a bag (bag.hpp);
-/// a folder with rgb.txt and depth.txt is TUM; a folder
+/// a file that starts with a PCD header is one frame (read_pcd_frame); a folder with rgb/
+/// and depth/ holding result_*.png is an OCID sequence (depth in mm, intrinsics from
+/// pcd/<first frame>.pcd or SourceOptions::intrinsics); a folder with rgb.txt and depth.txt
+/// is TUM; a folder
 /// with depth.png is one frame; a folder whose sub-folders hold depth.png is a sequence
 /// (sorted by name); either of the last two is Unregistered when a calibration is given or
 /// `calibration.json` lies beside the frames, else Frames. Throws InputError for a missing

@@ -1,0 +1,129 @@
+// Organized PCD files as frames (io.hpp read_pcd_frame): PCDs written from a shipped frame's
+// depth and intrinsics read back as the same depth, colour and intrinsics; headers that lie
+// about the data's size are one-line errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+#include "wul3d/error.hpp"
+#include "wul3d/io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using wul3d::PcdData;
+using wul3d::RgbdFrame;
+using wul3d::test::TempDir;
+
+RgbdFrame sample_frame() {
+    const fs::path dir = wul3d::test::sample_dir() / "uois_tabletop/image_0000";
+    RgbdFrame f;
+    const wul3d::IntrinsicsFile K = wul3d::read_intrinsics_json((dir / "intrinsics.json").string());
+    f.intrinsics = K.intrinsics;
+    f.depth = wul3d::read_depth_png((dir / "depth.png").string(), K.depth_scale_m_per_unit);
+    f.color = wul3d::read_color_image((dir / "color.png").string());
+    return f;
+}
+
+void expect_same(const RgbdFrame& want, const RgbdFrame& got, bool with_rgb) {
+    ASSERT_EQ(got.depth.width, want.depth.width);
+    ASSERT_EQ(got.depth.height, want.depth.height);
+    EXPECT_FLOAT_EQ(got.depth.scale_m_per_unit, 0.001f);
+    std::size_t off = 0;
+    for (std::size_t i = 0; i < want.depth.data.size(); ++i)
+        if (std::abs(int(got.depth.data[i]) - int(want.depth.data[i])) > 1) ++off;
+    EXPECT_EQ(off, 0u);
+    const wul3d::PinholeIntrinsics& a = want.intrinsics;
+    const wul3d::PinholeIntrinsics& b = got.intrinsics;
+    EXPECT_NEAR(b.fx, a.fx, 0.005 * a.fx);
+    EXPECT_NEAR(b.fy, a.fy, 0.005 * a.fy);
+    EXPECT_NEAR(b.cx, a.cx, 0.005 * a.cx);
+    EXPECT_NEAR(b.cy, a.cy, 0.005 * a.cy);
+    EXPECT_EQ(b.width, a.width);
+    EXPECT_EQ(b.height, a.height);
+    if (with_rgb)
+        EXPECT_EQ(got.color.rgb, want.color.rgb);
+    else
+        EXPECT_TRUE(got.color.empty());
+}
+
+struct Case {
+    PcdData data;
+    bool rgb;
+};
+
+class PcdRoundTrip : public testing::TestWithParam<Case> {};
+
+TEST_P(PcdRoundTrip, ReadsBackTheDepthColourAndIntrinsics) {
+    TempDir tmp;
+    const RgbdFrame want = sample_frame();
+    const std::string path = (tmp / "cloud.pcd").string();
+    wul3d::write_pcd(path, want, GetParam().data, GetParam().rgb);
+    expect_same(want, wul3d::read_pcd_frame(path), GetParam().rgb);
+}
+
+INSTANTIATE_TEST_SUITE_P(Pcd, PcdRoundTrip,
+                         testing::Values(Case{PcdData::Ascii, false}, Case{PcdData::Ascii, true},
+                                         Case{PcdData::Binary, false}, Case{PcdData::Binary, true},
+                                         Case{PcdData::BinaryCompressed, false},
+                                         Case{PcdData::BinaryCompressed, true}));
+
+/// A binary PCD of the sample with its header's `from` replaced by `to`, or cut to `keep` bytes.
+std::string edited(const fs::path& dir, const std::string& from, const std::string& to,
+                   std::size_t keep = std::string::npos, PcdData data = PcdData::Binary) {
+    const std::string path = (dir / "orig.pcd").string();
+    wul3d::write_pcd(path, sample_frame(), data, true);
+    std::string bytes = wul3d::test::slurp(path);
+    if (!from.empty()) bytes.replace(bytes.find(from), from.size(), to);
+    if (keep != std::string::npos) bytes.resize(keep);
+    const std::string out = (dir / "bad.pcd").string();
+    wul3d::test::write_text(out, bytes);
+    return out;
+}
+
+TEST(Pcd, AHeaderThatLiesAboutItsSizeIsAnInputError) {
+    TempDir tmp;
+    const std::vector<std::string> bad = {
+        edited(tmp.path(), "POINTS 307200", "POINTS 307201"),
+        edited(tmp.path(), "HEIGHT 480", "HEIGHT 481"),  // POINTS no longer WIDTH x HEIGHT
+        edited(tmp.path(), "", "", 300000),               // data shorter than declared
+        edited(tmp.path(), "WIDTH 640\nHEIGHT 480\n", "WIDTH 65536\nHEIGHT 65536\n"),
+        edited(tmp.path(), "", "", 300000, PcdData::BinaryCompressed),
+        edited(tmp.path(), "", "", 300000, PcdData::Ascii),
+        edited(tmp.path(), "DATA binary", "DATA zip"),
+    };
+    for (const std::string& path : bad) {
+        try {
+            wul3d::read_pcd_frame(path);
+            ADD_FAILURE() << path << " was read";
+        } catch (const wul3d::InputError& e) {
+            EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(Pcd, AnUnorganizedCloudIsRefused) {
+    TempDir tmp;
+    const std::string path =
+        edited(tmp.path(), "WIDTH 640\nHEIGHT 480\n", "WIDTH 307200\nHEIGHT 1\n");
+    EXPECT_THROW(wul3d::read_pcd_frame(path), wul3d::InputError);
+}
+
+TEST(Pcd, TheCommandRunsAPcdAndSaysALyingHeaderInOneLine) {
+    TempDir tmp;
+    const std::string good = (tmp / "frame.pcd").string();
+    wul3d::write_pcd(good, sample_frame(), PcdData::Binary, true);
+    const auto ok = wul3d::test::run_cli({"run", good, "--out", (tmp / "out").string()});
+    ASSERT_EQ(ok.exit_code, 0) << wul3d::test::describe(ok);
+    EXPECT_TRUE(fs::exists(tmp / "out/frame/objects.png"));
+    const std::string bad = edited(tmp.path(), "POINTS 307200", "POINTS 307201");
+    wul3d::test::expect_one_line(wul3d::test::run_cli({"run", bad, "--out", (tmp / "out2").string()}),
+                                 2, {"POINTS"});
+}
+
+}  // namespace
