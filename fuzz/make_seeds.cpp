@@ -123,6 +123,22 @@ int main(int argc, char** argv) {
         spit(out / "intrinsics_json" / ("small" + id + ".json"), i);
         spit(out / "frame" / ("frame" + id), u32(d.size()) + d + u32(c.size()) + c + i);
         spit(out / "frame" / ("depth_only" + id), u32(d.size()) + d + u32(0) + i);
+        {
+            // Organized PCDs of the small frame: every DATA kind, with and without rgb.
+            RgbdFrame f;
+            f.depth = depth;
+            f.color = color;
+            f.intrinsics = k;
+            const std::pair<PcdData, const char*> kinds[] = {{PcdData::Ascii, "ascii"},
+                                                             {PcdData::Binary, "binary"},
+                                                             {PcdData::BinaryCompressed, "compressed"}};
+            for (const auto& [kind, kind_name] : kinds)
+                for (const bool rgb : {false, true}) {
+                    write_pcd((tmp / "p.pcd").string(), f, kind, rgb);
+                    spit(out / "pcd" / (std::string(kind_name) + (rgb ? "_rgb" : "") + id + ".pcd"),
+                         slurp(tmp / "p.pcd"));
+                }
+        }
     }
     write_calibration_json((tmp / "k.json").string(), kinect_v2_default_calibration());
     spit(out / "calibration_json" / "kinect_v2.json", slurp(tmp / "k.json"));

@@ -22,7 +22,7 @@ out=$build/fuzz-out
 only=${WUL3D_FUZZ_ONLY:-}
 rm -rf "$seeds" "$out"
 mkdir -p "$out"
-harnesses="png jpeg intrinsics_json calibration_json tum_list fakenect frame"
+harnesses="png jpeg intrinsics_json calibration_json tum_list fakenect frame pcd"
 if [ "$only" = batch ]; then
   harnesses=""
 else

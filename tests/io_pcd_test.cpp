@@ -3,7 +3,9 @@
 // about the data's size are one-line errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -105,6 +107,70 @@ TEST(Pcd, AHeaderThatLiesAboutItsSizeIsAnInputError) {
             EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
         }
     }
+}
+
+/// LZF with back references (the writer stores literal runs only): literals, and copies of
+/// the bytes 4 back (NaN points, equal colours), short and long forms.
+std::string lzf_compress(const std::string& in) {
+    std::string out, lit;
+    auto flush = [&] {
+        for (std::size_t p = 0; p < lit.size(); p += 32) {
+            const std::size_t n = std::min<std::size_t>(32, lit.size() - p);
+            out.push_back(static_cast<char>(n - 1));
+            out += lit.substr(p, n);
+        }
+        lit.clear();
+    };
+    std::size_t i = 0;
+    while (i < in.size()) {
+        std::size_t len = 0;
+        while (i >= 4 && i + len < in.size() && len < 264 && in[i + len] == in[i + len - 4]) ++len;
+        if (len >= 3) {
+            flush();
+            const std::size_t off = 3;  // back 4
+            if (len - 2 < 7) {
+                out.push_back(static_cast<char>(((len - 2) << 5) | (off >> 8)));
+            } else {
+                out.push_back(static_cast<char>((7 << 5) | (off >> 8)));
+                out.push_back(static_cast<char>(len - 2 - 7));
+            }
+            out.push_back(static_cast<char>(off & 0xff));
+            i += len;
+        } else {
+            lit.push_back(in[i++]);
+        }
+    }
+    flush();
+    return out;
+}
+
+TEST(Pcd, BinaryCompressedWithBackReferencesReadsBack) {
+    TempDir tmp;
+    const RgbdFrame want = sample_frame();
+    const std::string path = (tmp / "c.pcd").string();
+    wul3d::write_pcd(path, want, PcdData::BinaryCompressed, true);
+    std::string bytes = wul3d::test::slurp(path);
+    const std::size_t body = bytes.find("DATA binary_compressed\n") + 23;
+    // The writer's literal runs back to the plain bytes, then compressed for real.
+    std::string plain;
+    for (std::size_t p = body + 8; p < bytes.size();) {
+        const std::size_t n = static_cast<unsigned char>(bytes[p]) + 1u;
+        plain += bytes.substr(p + 1, n);
+        p += 1 + n;
+    }
+    const std::string packed = lzf_compress(plain);
+    ASSERT_LT(packed.size(), plain.size() * 9 / 10);
+    const std::uint32_t sizes[2] = {static_cast<std::uint32_t>(packed.size()),
+                                    static_cast<std::uint32_t>(plain.size())};
+    bytes.resize(body);
+    bytes.append(reinterpret_cast<const char*>(sizes), sizeof sizes);
+    bytes += packed;
+    wul3d::test::write_text(path, bytes);
+    expect_same(want, wul3d::read_pcd_frame(path), true);
+    // A reference before the start of the data is refused.
+    bytes[body + 8] = static_cast<char>((1 << 5) | 0x1f);
+    wul3d::test::write_text(path, bytes);
+    EXPECT_THROW(wul3d::read_pcd_frame(path), wul3d::InputError);
 }
 
 TEST(Pcd, AnUnorganizedCloudIsRefused) {
