@@ -189,7 +189,7 @@ public:
         } catch (const StopBeforePixels&) {
         }
         if (contradicted) {
-            const auto [w, h] = *contradicted;
+            const int w = contradicted->first, h = contradicted->second;  // clang 14: no captured bindings
             if (present(color)) {
                 try {
                     detail::read_color_image_into(color.string(), color_scratch_, f.color,
