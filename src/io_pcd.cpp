@@ -17,6 +17,11 @@ namespace wul3d {
 
 namespace {
 
+/// The largest PCD read, and the most its binary data may declare: 64 MiB plus 64 bytes a
+/// pixel of the image limit (an ascii PCD takes some 40 bytes a point).
+constexpr std::uint64_t kMaxPcdFileBytesBase = std::uint64_t{1} << 26;
+constexpr std::uint64_t kMaxPcdFileBytesPerPixel = 64;
+
 struct PcdField {
     std::string name;
     int size = 0;
@@ -243,6 +248,10 @@ Points read_points(const std::string& what, const PcdHeader& h, const unsigned c
         return p;
     }
     const std::uint64_t need = static_cast<std::uint64_t>(n) * h.point_bytes;
+    if (need > kMaxPcdFileBytesBase + kMaxPcdFileBytesPerPixel * max_image_pixels())
+        throw InputError(what + ": PCD points of " + std::to_string(h.point_bytes) +
+                         " bytes each declare " + std::to_string(need) +
+                         " bytes, over the limit for the image limit (--max-pixels)");
     std::vector<unsigned char> unpacked;
     const unsigned char* block = body;
     bool field_major = false;
@@ -352,7 +361,11 @@ RgbdFrame parse_pcd_frame(const std::string& what, const unsigned char* data, st
     f.intrinsics.cx = fu.c;
     f.intrinsics.fy = fv.f;
     f.intrinsics.cy = fv.c;
-    f.intrinsics.validate(what + ": the intrinsics recovered from the PCD");
+    try {
+        f.intrinsics.validate(what + ": the intrinsics recovered from the PCD");
+    } catch (const ParamError& e) {
+        throw InputError(e.what());  // the file's fault, not a parameter's
+    }
     if (!p.rgb.empty()) {
         f.color.width = w;
         f.color.height = ht;
@@ -368,8 +381,8 @@ RgbdFrame parse_pcd_frame(const std::string& what, const unsigned char* data, st
 
 RgbdFrame read_pcd_frame(const std::string& path) {
     std::vector<unsigned char> bytes;
-    // An ascii PCD takes some 40 bytes a point: 64 MiB plus 64 bytes a pixel of the limit.
-    detail::read_regular_file(path, (std::uint64_t{1} << 26) + 64 * max_image_pixels(), bytes);
+    detail::read_regular_file(path, kMaxPcdFileBytesBase + kMaxPcdFileBytesPerPixel * max_image_pixels(),
+                              bytes);
     RgbdFrame f = parse_pcd_frame(path, bytes.data(), bytes.size());
     return f;
 }

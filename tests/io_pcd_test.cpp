@@ -173,6 +173,26 @@ TEST(Pcd, BinaryCompressedWithBackReferencesReadsBack) {
     EXPECT_THROW(wul3d::read_pcd_frame(path), wul3d::InputError);
 }
 
+TEST(Pcd, PointsThatAreNoPinholeCameraAndTooFewPointsAreRefused) {
+    TempDir tmp;
+    std::string text = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                       "WIDTH 20\nHEIGHT 10\nPOINTS 200\nDATA ascii\n";
+    unsigned seed = 1;
+    for (int i = 0; i < 200; ++i) {
+        seed = seed * 1103515245u + 12345u;
+        text += std::to_string((seed >> 16) % 1000 / 1000.0 - 0.5) + " " +
+                std::to_string((seed >> 8) % 1000 / 1000.0 - 0.5) + " 1\n";
+    }
+    wul3d::test::write_text(tmp / "random.pcd", text);
+    wul3d::test::expect_one_line(wul3d::test::run_cli({"run", (tmp / "random.pcd").string(), "--out",
+                                                       (tmp / "out").string()}),
+                                 2, {"pinhole", "RMS"});
+    std::string few = text;
+    few.replace(few.find("WIDTH 20\nHEIGHT 10\nPOINTS 200"), 29, "WIDTH 20\nHEIGHT 2\nPOINTS 040");
+    wul3d::test::write_text(tmp / "few.pcd", few);
+    EXPECT_THROW(wul3d::read_pcd_frame((tmp / "few.pcd").string()), wul3d::InputError);
+}
+
 TEST(Pcd, AnUnorganizedCloudIsRefused) {
     TempDir tmp;
     const std::string path =
