@@ -73,7 +73,13 @@ INSTANTIATE_TEST_SUITE_P(Pcd, PcdRoundTrip,
                          testing::Values(Case{PcdData::Ascii, false}, Case{PcdData::Ascii, true},
                                          Case{PcdData::Binary, false}, Case{PcdData::Binary, true},
                                          Case{PcdData::BinaryCompressed, false},
-                                         Case{PcdData::BinaryCompressed, true}));
+                                         Case{PcdData::BinaryCompressed, true}),
+                         [](const testing::TestParamInfo<Case>& param_info) {
+                             const char* data = param_info.param.data == PcdData::Ascii    ? "Ascii"
+                                                : param_info.param.data == PcdData::Binary ? "Binary"
+                                                                                     : "BinaryCompressed";
+                             return std::string(data) + (param_info.param.rgb ? "Rgb" : "");
+                         });
 
 /// A binary PCD of the sample with its header's `from` replaced by `to`, or cut to `keep` bytes.
 std::string edited(const fs::path& dir, const std::string& from, const std::string& to,
