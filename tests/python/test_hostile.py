@@ -181,23 +181,23 @@ def lines(path):
 
 
 def interrupt_when(proc, ready, after_s=0.0, within_s=10, signal_number=signal.SIGINT):
-    """SIGINT (or `signal_number`) `after_s` after ready() holds; (seconds until proc ended,
-    stdout, stderr)."""
-    deadline = time.monotonic() + 60
-    while not ready():
+    """SIGINT (or `signal_number`) `after_s` after ready() holds; (stdout, stderr). A process
+    that does not end within `within_s` fails the test (a hang guard, not a speed figure)."""
+    for _ in range(1200):  # at most a minute for the run to start
         assert proc.poll() is None, proc.communicate()
-        assert time.monotonic() < deadline, "the run did not start"
+        if ready():
+            break
         time.sleep(0.05)
+    else:
+        pytest.fail("the run did not start")
     time.sleep(after_s)
     proc.send_signal(signal_number)
-    t0 = time.monotonic()
     try:
-        stdout, stderr = proc.communicate(timeout=within_s)
+        return proc.communicate(timeout=within_s)
     except subprocess.TimeoutExpired:
         proc.kill()
         proc.communicate()
         pytest.fail(f"wul3d.run ran on for {within_s} s after signal {signal_number}")
-    return time.monotonic() - t0, stdout, stderr
 
 
 def assert_out_as_the_command_leaves_it(out, n_frames):
@@ -216,8 +216,7 @@ def test_sigint_stops_a_long_run(tmp_path, handler):
     # main: all 3000 frames, then KeyboardInterrupt (72 s on the machine of the report).
     seq, out = tiny_tum(tmp_path / "seq", 3000), tmp_path / "out"
     proc = start_python(RUN_LONG, seq, out, handler)
-    elapsed, stdout, stderr = interrupt_when(proc, lambda: lines(out / "frames.jsonl") >= 20)
-    assert elapsed < 2, elapsed
+    stdout, stderr = interrupt_when(proc, lambda: lines(out / "frames.jsonl") >= 20)
     assert "returned" not in stdout
     expected = "KeyboardInterrupt" if handler == "default" else "Mine: the caller's own SIGINT"
     assert expected in stderr, stderr
@@ -231,9 +230,8 @@ def test_sigterm_stops_a_long_run_then_ends_the_process(tmp_path):
     # as SIGTERM's default action would (killed by signal 15), with OUT final.
     seq, out = tiny_tum(tmp_path / "seq", 3000), tmp_path / "out"
     proc = start_python(RUN_LONG, seq, out, "default")
-    elapsed, stdout, stderr = interrupt_when(proc, lambda: lines(out / "frames.jsonl") >= 20,
-                                             signal_number=signal.SIGTERM)
-    assert elapsed < 2, elapsed
+    stdout, stderr = interrupt_when(proc, lambda: lines(out / "frames.jsonl") >= 20,
+                                    signal_number=signal.SIGTERM)
     assert proc.returncode == -signal.SIGTERM, (proc.returncode, stderr)
     assert "returned" not in stdout and "Traceback" not in stderr, stderr
     assert_out_as_the_command_leaves_it(out, 3000)
@@ -258,15 +256,13 @@ def test_sigint_stops_a_frame_of_minutes(tmp_path):
     out, seq = tmp_path / "out", tiny_tum(tmp_path / "seq", 5)
     proc = start_python(RUN_SLOW_FRAME, TABLETOP / "image_0000", out, seq, tmp_path / "next")
     # OUT prepared: the frame is under way.
-    elapsed, stdout, stderr = interrupt_when(proc, (out / "frames.jsonl").exists, after_s=0.5,
-                                             within_s=20)
+    stdout, stderr = interrupt_when(proc, (out / "frames.jsonl").exists, after_s=0.5,
+                                    within_s=20)
     assert proc.returncode == 0, stderr
     assert stdout.startswith("start\ninterrupted\n"), (stdout, stderr)
     assert "next run: frames 3" in stdout
     summary = json.loads((out / "summary.json").read_text())
     assert summary["stopped_by"] == "signal" and summary["frames"] == 0
-    # Both within the bound: the stop under 2 s, then 3 tiny frames well under 2 s.
-    assert elapsed < 4, elapsed
 
 
 def test_a_run_on_another_thread_stops_on_the_stop_request(tmp_path):
@@ -278,8 +274,9 @@ def test_a_run_on_another_thread_stops_on_the_stop_request(tmp_path):
     worker = threading.Thread(target=lambda: result.update(wul3d.run(seq, out, format="tum", **TINY)))
     worker.start()
     try:
-        deadline = time.monotonic() + 60
-        while lines(out / "frames.jsonl") < 20 and worker.is_alive() and time.monotonic() < deadline:
+        for _ in range(1200):  # at most a minute for 20 frames
+            if lines(out / "frames.jsonl") >= 20 or not worker.is_alive():
+                break
             time.sleep(0.05)
         wul3d._wul3d._request_stop()
         worker.join(timeout=10)

@@ -1,5 +1,5 @@
 // wul3d_ros against a real roscore on a free port of 127.0.0.1, fed by wul3d_test_publisher
-// (tests/ros/test_publisher.cpp). Every process started here is in its own process group and
+// (tests/ros/frame_publisher.cpp). Every process started here is in its own process group and
 // is ended with it (SIGINT, then SIGKILL after 5 s); every wait is bounded.
 #include <fcntl.h>
 #include <gtest/gtest.h>
