@@ -9,46 +9,24 @@ For every family x sensor (eval/scenegen.py --family, --sensor) it writes the se
 11000-11099, floor 20000-20099 / 21000-21099; `--seeds N` takes the first N of each range),
 runs `wul3d run GEN --out OUT -q RUN_FLAGS` and `wul3d eval OUT GEN`, and prints one row each:
 family, sensor, frames, objects, Overlap F, Boundary F, %>=75. Generated folders are written
-once to WORK/gen_<family>_<sensor>_<A-B> and reused while their scenegen.json names the
+once to WORK/gen_<family>_<sensor>_<A-B> (WORK/gen_<A-B> for tabletop under structured
+light, as eval/benchmark.py names them) and reused while their scenegen.json names the
 generator's version, family, sensor and seeds. One process at a time: rendering is about 1-1.5 s
 a 640x480 frame.
 """
 import argparse
-import json
 import pathlib
-import re
-import subprocess
 import sys
-import time
 
 HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from benchmark import run, score  # noqa: E402
+from benchmark import generate, run, score  # noqa: E402
 
 FAMILIES = ["tabletop", "pile", "floor"]
 SENSORS = ["structured_light", "active_stereo", "tof"]
 SEEDS = {"tabletop": {"tune": 0, "report": 1000},
          "pile": {"tune": 10000, "report": 11000},
          "floor": {"tune": 20000, "report": 21000}}  # each range 100 seeds from here
-
-
-def generate(work, family, sensor, seeds):
-    folder = work / f"gen_{family}_{sensor}_{seeds}"
-    stamp = folder / "scenegen.json"
-    version = re.search(r"^VERSION = (\d+)", (HERE / "scenegen.py").read_text(), re.M).group(1)
-    if stamp.is_file():
-        got = json.loads(stamp.read_text())
-        if (str(got.get("version")), got.get("family", "tabletop"), got.get("sensor", "structured_light"),
-                got.get("seeds")) == (version, family, sensor, seeds):
-            return folder
-    t = time.time()
-    res = subprocess.run([sys.executable, str(HERE / "scenegen.py"), "--out", str(folder), "--seeds", seeds,
-                          "--family", family, "--sensor", sensor], capture_output=True, text=True)
-    if res.returncode != 0:
-        sys.exit(f"families.py: scenegen.py failed: {res.stderr.strip()}")
-    print(f"families.py: {family} {sensor} seeds {seeds} generated in {time.time() - t:.0f} s -> {folder}",
-          file=sys.stderr)
-    return folder
 
 
 def main():
@@ -81,8 +59,8 @@ def main():
         first = SEEDS[family][a.set]
         seeds = f"{first}-{first + a.seeds - 1}"
         for sensor in sensors:
-            gen = generate(a.work, family, sensor, seeds)
-            out = a.work / f"gen_{family}_{sensor}_{seeds}.{tag}"
+            gen = generate(a.work, seeds, family, sensor)
+            out = gen.with_name(f"{gen.name}.{tag}")
             run(a.wul3d, gen, out, flags)
             rows.append((family, sensor, seeds, score(a.wul3d, out, gen)))
     print(f"set: {a.set}, flags: {' '.join(flags) if flags else '(default)'}")
