@@ -3,7 +3,7 @@
 
 Usage: scripts/plot-bench.py OUT.png CSV [CSV ...]   (needs Debian's python3-matplotlib)
 
-Each CSV (k,width,height,points,fps_median,ms_median,peak_rss_mb) is one line per panel,
+Each CSV (`wul3d bench --csv`, one thread count) is one line per panel,
 labelled by its resolution and, from its file name, the pipeline: a name containing "paper"
 is `wul3d bench --pipeline paper` (the paper's steps alone), any other the object pipeline;
 "decimateN" in the name adds `--decimate N`.

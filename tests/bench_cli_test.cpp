@@ -1,9 +1,10 @@
-// `wul3d bench`: one fresh process per k, a CSV row per k. Checks the shape of the output,
-// not the timings (speed belongs to bench/, not to tests).
+// `wul3d bench`: one fresh process per (threads, k), a CSV row each. Checks the shape of the
+// output, not the timings (speed belongs to bench/, not to tests).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "test_support.hpp"
@@ -18,6 +19,12 @@ std::vector<std::string> split(const std::string& line, char sep) {
     while (std::getline(ss, item, sep)) out.push_back(item);
     return out;
 }
+constexpr std::size_t kColumns = 18;  // k, threads, 6 figures, 10 stages
+constexpr std::size_t kFirstStage = 8;
+const std::vector<std::string> kStages = {"registration", "decimation", "backprojection",
+                                          "normals",      "background", "clustering",
+                                          "colors",       "plane",      "segmentation",
+                                          "objects"};
 }  // namespace
 
 TEST(CliBench, OneRowPerKWithMemoryAndSpeed) {
@@ -29,19 +36,22 @@ TEST(CliBench, OneRowPerKWithMemoryAndSpeed) {
     std::ifstream in(csv);
     std::string line;
     ASSERT_TRUE(std::getline(in, line));
-    EXPECT_EQ(line, "k,width,height,points,fps_median,ms_median,peak_rss_mb");
+    std::string header = "k,threads,width,height,points,fps_median,ms_median,peak_rss_mb";
+    for (const auto& stage : kStages) header += ",ms_" + stage;
+    EXPECT_EQ(line, header);
     for (const char* k : {"2", "3"}) {
         ASSERT_TRUE(std::getline(in, line));
         const auto cols = split(line, ',');
-        ASSERT_EQ(cols.size(), 7u) << line;
+        ASSERT_EQ(cols.size(), kColumns) << line;
         EXPECT_EQ(cols[0], k);
-        EXPECT_EQ(cols[1], "640");
-        EXPECT_EQ(cols[2], "480");
+        EXPECT_GE(std::stoi(cols[1]), 1);  // all cores: however many this machine has
+        EXPECT_EQ(cols[2], "640");
+        EXPECT_EQ(cols[3], "480");
         // points: the decimated frame's (320 x 240 at the default --decimate 2)
-        EXPECT_GT(std::stod(cols[3]), 25000.0);
-        EXPECT_LE(std::stod(cols[3]), 320.0 * 240.0);
-        EXPECT_GT(std::stod(cols[4]), 0.0);       // fps
-        EXPECT_GT(std::stod(cols[6]), 10.0);      // peak MB of that process
+        EXPECT_GT(std::stod(cols[4]), 25000.0);
+        EXPECT_LE(std::stod(cols[4]), 320.0 * 240.0);
+        EXPECT_GT(std::stod(cols[5]), 0.0);       // fps
+        EXPECT_GT(std::stod(cols[7]), 10.0);      // peak MB of that process
     }
     EXPECT_FALSE(std::getline(in, line));
 }
@@ -50,7 +60,41 @@ TEST(CliBench, ResamplesToTheRequestedResolution) {
     const auto r = run_cli({"bench", (sample_dir() / "uois_tabletop").string(), "--k", "2",
                             "--frames", "1", "--passes", "1", "--resolution", "320x240"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.out.find("\n2,320,240,"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(",320,240,"), std::string::npos) << r.out;
+}
+
+TEST(CliBench, OneRowPerThreadCountWithEachStagesTime) {
+    const auto r = run_cli({"bench", (sample_dir() / "uois_tabletop").string(), "--k", "4",
+                            "--threads", "1,2", "--frames", "1", "--passes", "2"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto lines = split(r.out, '\n');
+    ASSERT_EQ(lines.size(), 3u) << r.out;
+    for (std::size_t i = 1; i < 3; ++i) {
+        const auto cols = split(lines[i], ',');
+        ASSERT_EQ(cols.size(), kColumns) << lines[i];
+        EXPECT_EQ(cols[0], "4");
+        EXPECT_EQ(cols[1], std::to_string(i));  // the count the measuring process ran on
+        std::map<std::string, double> ms;
+        for (std::size_t s = 0; s < kStages.size(); ++s) ms[kStages[s]] = std::stod(cols[kFirstStage + s]);
+        // Registered frames: no registration. Every stage of the object pipeline ran.
+        EXPECT_EQ(ms["registration"], 0.0);
+        for (const char* stage : {"decimation", "backprojection", "clustering", "plane",
+                                  "segmentation", "objects"})
+            EXPECT_GT(ms[stage], 0.0) << stage;
+        // Each stage is a part of the frame: none alone exceeds the frame's median by much
+        // (medians of different frames, so not a strict sum).
+        for (const auto& [stage, value] : ms) EXPECT_LT(value, 2.0 * std::stod(cols[6])) << stage;
+    }
+    // The paper's steps stop before the plane: those stages are 0.
+    const auto paper = run_cli({"bench", (sample_dir() / "uois_tabletop").string(), "--k", "4",
+                                "--threads", "1", "--frames", "1", "--passes", "1", "--pipeline", "paper"});
+    ASSERT_EQ(paper.exit_code, 0) << paper.err;
+    const auto plines = split(paper.out, '\n');
+    ASSERT_EQ(plines.size(), 2u) << paper.out;
+    const auto cols = split(plines[1], ',');
+    ASSERT_EQ(cols.size(), kColumns);
+    EXPECT_GT(std::stod(cols[kFirstStage + 5]), 0.0);   // clustering
+    for (std::size_t s : {7u, 8u, 9u}) EXPECT_EQ(std::stod(cols[kFirstStage + s]), 0.0) << kStages[s];
 }
 
 TEST(CliBench, PaperPipelineStopsAfterTheColoursAndHoldsLessMemory) {
@@ -66,24 +110,25 @@ TEST(CliBench, PaperPipelineStopsAfterTheColoursAndHoldsLessMemory) {
         return lines.size() == 2 ? split(lines[1], ',') : std::vector<std::string>{};
     };
     const auto paper = row("paper", {"--decimate", "1"}), objects = row("objects", {"--decimate", "1"});
-    ASSERT_EQ(paper.size(), 7u);
-    ASSERT_EQ(objects.size(), 7u);
-    EXPECT_EQ(paper[3], objects[3]);  // the same points clustered
-    EXPECT_LT(std::stod(paper[6]) + 10.0, std::stod(objects[6]));
+    ASSERT_EQ(paper.size(), kColumns);
+    ASSERT_EQ(objects.size(), kColumns);
+    EXPECT_EQ(paper[4], objects[4]);  // the same points clustered
+    EXPECT_LT(std::stod(paper[7]) + 10.0, std::stod(objects[7]));
     // By default the paper's steps run on every pixel, as the paper does, and the object
     // pipeline on a quarter of them (--decimate 2).
     const auto paper_default = row("paper", {}), objects_default = row("objects", {});
-    ASSERT_EQ(paper_default.size(), 7u);
-    ASSERT_EQ(objects_default.size(), 7u);
-    EXPECT_EQ(paper_default[3], paper[3]);
-    EXPECT_GT(std::stod(paper_default[3]), 3.5 * std::stod(objects_default[3]));
-    EXPECT_LT(std::stod(paper_default[3]), 4.5 * std::stod(objects_default[3]));
+    ASSERT_EQ(paper_default.size(), kColumns);
+    ASSERT_EQ(objects_default.size(), kColumns);
+    EXPECT_EQ(paper_default[4], paper[4]);
+    EXPECT_GT(std::stod(paper_default[4]), 3.5 * std::stod(objects_default[4]));
+    EXPECT_LT(std::stod(paper_default[4]), 4.5 * std::stod(objects_default[4]));
 }
 
 TEST(CliBench, BadArgumentsAreOneLineErrors) {
     for (const auto& args : std::vector<std::vector<std::string>>{
              {"--k", "2,x"}, {"--k", "0"}, {"--resolution", "big"}, {"--pipeline", "fast"},
-             {"--segmenter", "magic"}}) {
+             {"--segmenter", "magic"}, {"--threads", "1,,2"}, {"--threads", "2,"},
+             {"--threads", "one"}}) {
         std::vector<std::string> all = {"bench", (sample_dir() / "uois_tabletop").string()};
         all.insert(all.end(), args.begin(), args.end());
         const auto r = run_cli(all);

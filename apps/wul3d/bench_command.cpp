@@ -1,6 +1,8 @@
-// `wul3d bench`: frames per second and peak memory of the pipeline against k, one fresh
-// process per k (so that one k's peak memory cannot hide another's), as in the paper's
-// Figure 7. Parsing, timing and reporting only; the pipeline is the library's.
+// `wul3d bench`: frames per second and peak memory of the pipeline against k and the number
+// of threads, one fresh process per (threads, k) (so that one k's peak memory cannot hide
+// another's), as in the paper's Figure 7, with each stage's median time (for the scaling
+// curve and the stages' serial shares: bench/scaling.py). Parsing, timing and reporting
+// only; the pipeline is the library's.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +15,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -38,10 +41,52 @@ struct BenchOptions {
     int passes = 4;          // times the frames are run through the pipeline
     std::string pipeline = "objects";  // objects: the default object pipeline; paper: its steps only
     std::string segmenter;             // empty: the default
-    int threads = 0;                   // 0: all cores
+    std::string threads = "0";         // comma-separated; 0: all cores
     int decimate = 0;                  // PipelineParams::decimation; 0: decimation_of()
     int single_k = 0;        // internal: measure this k in this process and print one row
 };
+
+/// The stages of StageTimes in the order of the CSV's ms_<stage> columns.
+const std::vector<std::pair<const char*, double StageTimes::*>>& stage_columns() {
+    static const std::vector<std::pair<const char*, double StageTimes::*>> columns = {
+        {"registration", &StageTimes::registration}, {"decimation", &StageTimes::decimation},
+        {"backprojection", &StageTimes::backprojection}, {"normals", &StageTimes::normals},
+        {"background", &StageTimes::background}, {"clustering", &StageTimes::clustering},
+        {"colors", &StageTimes::colors}, {"plane", &StageTimes::plane},
+        {"segmentation", &StageTimes::segmentation}, {"objects", &StageTimes::objects}};
+    return columns;
+}
+
+std::string csv_header() {
+    std::string header = "k,threads,width,height,points,fps_median,ms_median,peak_rss_mb";
+    for (const auto& column : stage_columns()) header += std::string(",ms_") + column.first;
+    return header;
+}
+
+/// A comma-separated list of integers, each in [lo, hi], in the order given.
+std::vector<int> parse_int_list(const std::string& text, const char* flag, int lo, int hi) {
+    std::vector<int> values;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        try {
+            std::size_t used = 0;
+            const int v = std::stoi(item, &used);
+            if (used != item.size() || v < lo || v > hi) throw std::invalid_argument(item);
+            values.push_back(v);
+        } catch (const std::exception&) {
+            const std::string range =
+                hi == std::numeric_limits<int>::max()
+                    ? " >= " + std::to_string(lo)
+                    : " in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+            throw ParamError(std::string(flag) + " '" + text + "': '" + item +
+                             "' is not an integer" + range);
+        }
+    }
+    if (values.empty() || text.back() == ',')
+        throw ParamError(std::string(flag) + " '" + text + "': expected a comma-separated list");
+    return values;
+}
 
 /// --decimate, or its default: the library's for the object pipeline, every pixel for the
 /// paper's steps (the paper clusters every point).
@@ -124,7 +169,8 @@ void measure_one(const BenchOptions& o) {
     params.detect_objects = o.pipeline == "objects";
     if (!o.segmenter.empty()) params.segmentation.segmenter = parse_segmenter(o.segmenter);
     params.decimation = decimation_of(o);
-    if (o.threads > 0) wul3d::set_num_threads(o.threads);
+    const int threads = parse_int_list(o.threads, "--threads", 0, kMaxThreads).front();
+    if (threads > 0) wul3d::set_num_threads(threads);
     Pipeline pipeline(params);
     try {
         pipeline.process(frames.front());  // seeding is a one-off: not timed
@@ -134,6 +180,7 @@ void measure_one(const BenchOptions& o) {
         throw InputError(name + ": " + what);
     }
     std::vector<double> ms;
+    std::vector<std::vector<double>> stage_ms(stage_columns().size());
     std::size_t points = 0;
     for (int pass = 0; pass < o.passes; ++pass)
         for (const RgbdFrame& f : frames) {
@@ -141,13 +188,18 @@ void measure_one(const BenchOptions& o) {
             const FrameResult& r = pipeline.process(f);
             ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
             points = std::max(points, r.stats.points);
+            for (std::size_t s = 0; s < stage_columns().size(); ++s)
+                stage_ms[s].push_back(r.times.*stage_columns()[s].second);
         }
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     const double m = median(ms);
-    std::cout << o.single_k << ',' << frames.front().width() << ',' << frames.front().height() << ','
-              << points << ',' << std::fixed << std::setprecision(2) << 1000.0 / m << ',' << m
-              << ',' << std::setprecision(1) << static_cast<double>(usage.ru_maxrss) / 1024.0 << '\n';
+    std::cout << o.single_k << ',' << wul3d::num_threads() << ',' << frames.front().width() << ','
+              << frames.front().height() << ',' << points << ',' << std::fixed
+              << std::setprecision(2) << 1000.0 / m << ',' << m << ',' << std::setprecision(1)
+              << static_cast<double>(usage.ru_maxrss) / 1024.0 << std::setprecision(3);
+    for (const auto& values : stage_ms) std::cout << ',' << median(values);
+    std::cout << '\n';
 }
 
 /// Reads `fd` to its end.
@@ -166,7 +218,7 @@ std::string read_all(int fd) {
 /// Runs this program again as `bench ... --single-k k` and returns the row it printed. A
 /// failed measurement throws the child's own one-line error with its kind (so its exit code:
 /// 2 bad input, 3 lost device, 1 otherwise), with the k it was measuring.
-std::string run_child(const BenchOptions& o, int k) {
+std::string run_child(const BenchOptions& o, int threads, int k) {
     int out[2], err[2];
     if (::pipe(out) != 0) throw Error("bench: cannot create a pipe");
     if (::pipe(err) != 0) {
@@ -184,7 +236,7 @@ std::string run_child(const BenchOptions& o, int k) {
                                          "--resolution", o.resolution, "--frames",
                                          std::to_string(o.frames), "--passes",
                                          std::to_string(o.passes), "--pipeline", o.pipeline,
-                                         "--threads", std::to_string(o.threads),
+                                         "--threads", std::to_string(threads),
                                          "--decimate", std::to_string(decimation_of(o)),
                                          "--max-pixels", std::to_string(max_image_pixels())};
         if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
@@ -205,7 +257,8 @@ std::string run_child(const BenchOptions& o, int k) {
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    const std::string what = " (bench, measuring k = " + std::to_string(k) + ")";
+    const std::string what = " (bench, measuring k = " + std::to_string(k) + " on " +
+                             std::to_string(threads) + " threads)";
     if (WIFSIGNALED(status))
         throw Error("bench: the measurement of k = " + std::to_string(k) + " was killed by signal " +
                     std::to_string(WTERMSIG(status)));
@@ -234,30 +287,18 @@ void run(const BenchOptions& o) {
     if (o.pipeline != "objects" && o.pipeline != "paper")
         throw ParamError("--pipeline '" + o.pipeline + "': expected objects or paper");
     if (!o.segmenter.empty()) parse_segmenter(o.segmenter);
-    std::vector<int> ks;
-    {
-        std::stringstream ss(o.ks);
-        std::string item;
-        while (std::getline(ss, item, ',')) {
-            try {
-                std::size_t used = 0;
-                const int k = std::stoi(item, &used);
-                if (used != item.size() || k < 1) throw std::invalid_argument(item);
-                ks.push_back(k);
-            } catch (const std::exception&) {
-                throw ParamError("--k '" + o.ks + "': '" + item + "' is not a positive integer");
-            }
-        }
-    }
+    const std::vector<int> ks = parse_int_list(o.ks, "--k", 1, std::numeric_limits<int>::max());
+    const std::vector<int> threads = parse_int_list(o.threads, "--threads", 0, kMaxThreads);
     open_source(o.input, SourceOptions{});  // a bad input fails here, once, with its message
     if (!o.csv.empty()) check_write_target(o.csv, WriteTarget::File, {o.input}, "--csv");
-    const std::string header = "k,width,height,points,fps_median,ms_median,peak_rss_mb";
+    const std::string header = csv_header();
     std::vector<std::string> rows;
     std::cout << header << std::endl;
-    for (int k : ks) {
-        rows.push_back(run_child(o, k));
-        std::cout << rows.back() << std::endl;
-    }
+    for (int t : threads)
+        for (int k : ks) {
+            rows.push_back(run_child(o, t, k));
+            std::cout << rows.back() << std::endl;
+        }
     if (!o.csv.empty()) {
         std::ostringstream text;
         text << header << '\n';
@@ -271,7 +312,9 @@ void run(const BenchOptions& o) {
 void add_bench_command(CLI::App& app) {
     auto opts = std::make_shared<BenchOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "bench", "Frames per second and peak memory against k, one process per k (paper Figure 7)");
+        "bench",
+        "Frames per second, peak memory and each stage's time against k and threads, one "
+        "process per (threads, k) (paper Figure 7)");
     cmd->add_option("input", opts->input, "Frame folder(s) or TUM sequence")->required();
     cmd->add_option("--k", opts->ks, "Comma-separated k values")->capture_default_str();
     cmd->add_option("--resolution", opts->resolution,
@@ -289,8 +332,9 @@ void add_bench_command(CLI::App& app) {
                     "(back-projection to eq. 9 colours)")
         ->capture_default_str();
     cmd->add_option("--segmenter", opts->segmenter, "geometric|kmeans|hybrid (default: hybrid)");
-    cmd->add_option("--threads", opts->threads, "Worker threads, [1, 1024] (default: all cores)")
-        ->check(NumberIn(0, wul3d::kMaxThreads));
+    cmd->add_option("--threads", opts->threads,
+                    "Comma-separated worker thread counts, each in [1, 1024], e.g. 1,2,4,8 "
+                    "for the scaling curve (default: all cores)");
     cmd->add_option("--decimate", opts->decimate,
                     "Run the stages on every N-th pixel in u and v, results at the input's size "
                     "(default: 2 with --pipeline objects, 1 with paper)")
