@@ -86,11 +86,7 @@ constexpr int kExt = 12;
 }  // namespace
 
 void ObjectParams::validate() const {
-    if (!(psi > 0 && psi <= 1.0f)) {
-        std::ostringstream msg;
-        msg << "--object-psi " << psi << ": must be in (0, 1] (paper eq. 2)";
-        throw ParamError(msg.str());
-    }
+    require(psi > 0 && psi <= 1.0f, "psi", psi, "in (0, 1] (paper eq. 2)");
     require(max_tracks >= 2 && max_tracks <= 255, "max_tracks", max_tracks, "in [2, 255]");
     require(min_overlap > 0 && min_overlap <= 1, "min_overlap", min_overlap, "in (0, 1]");
     require(max_jump_m >= 0, "max_jump_m", max_jump_m, ">= 0");

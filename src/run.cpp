@@ -22,6 +22,7 @@
 #include "wul3d/io.hpp"
 #include "wul3d/objects.hpp"
 #include "wul3d/output.hpp"
+#include "wul3d/parameters.hpp"
 #include "wul3d/stop.hpp"
 #include "wul3d/threads.hpp"
 #include "wul3d/write_guard.hpp"
@@ -45,27 +46,14 @@ double peak_rss_mb() {
     return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
 }
 
-/// summary.json's "parameters": what the frames were processed with.
+/// summary.json's "parameters": what the frames were processed with, every row of the
+/// table (parameters.hpp) under its summary_key, and the preset.
 nlohmann::json parameters_json(const PipelineParams& params, const std::string& preset) {
-    const auto& c = params.cluster;
-    return {{"k", c.k},
-            {"alpha", c.alpha},
-            {"delta", c.delta},
-            {"gamma", c.gamma},
-            {"psi", c.psi},
-            {"iters", c.iters},
-            {"stride", c.stride},
-            {"seed", c.seed},
-            {"zmin_m", params.range.zmin_m},
-            {"zmax_m", params.range.zmax_m},
-            {"normal_radius_px", params.normals.radius_px},
-            {"segmenter", segmenter_name(params.segmentation.segmenter)},
-            {"scope", scope_name(params.segmentation.scope)},
-            {"remove_plane", params.remove_plane},
-            {"min_points", params.segmentation.min_points},
-            {"object_psi", params.objects.psi},
-            {"decimate", params.decimation},
-            {"preset", preset.empty() ? "default" : preset}};
+    nlohmann::json out = nlohmann::json::object();
+    for (const ParamSpec& spec : pipeline_parameters())
+        std::visit([&](const auto& value) { out[summary_key(spec)] = value; }, spec.get(params));
+    out["preset"] = preset.empty() ? "default" : preset;
+    return out;
 }
 
 /// One frame's line of OUT/frames.jsonl.

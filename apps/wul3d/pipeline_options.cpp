@@ -7,6 +7,7 @@
 
 #include "wul3d/capture.hpp"
 #include "wul3d/error.hpp"
+#include "wul3d/parameters.hpp"
 #include "wul3d/parse.hpp"
 #include "wul3d/segmentation.hpp"
 #include "wul3d/threads.hpp"
@@ -30,6 +31,34 @@ void add_max_pixels_option(CLI::App* cmd) {
         "Largest image read, width x height (default 2^24 = 16777216; at most 2^30)");
 }
 
+namespace {
+
+/// One option per row of the table (parameters.hpp), its help the row's with its range and
+/// default, the text kept as typed for make_pipeline_params.
+void add_parameter_options(CLI::App* cmd, PipelineOptions& o) {
+    const PipelineParams defaults;
+    for (const ParamSpec& spec : pipeline_parameters()) {
+        const std::string name = spec.name;
+        if (spec.kind == ParamKind::Switch) {
+            cmd->add_flag_callback(flag_of(spec), [&o, name] { o.given[name] = "false"; },
+                                   spec.flag_help ? spec.flag_help : spec.help);
+            continue;
+        }
+        std::string help = spec.help;
+        if (spec.kind != ParamKind::Choice) help += ", " + range_text(spec);  // a choice's help names them
+        const ParamValue value = spec.get(defaults);
+        const std::string* name_value = std::get_if<std::string>(&value);
+        help += " (default " + (name_value ? *name_value : value_text(value)) + ")";
+        cmd->add_option_function<std::string>(
+               flag_of(spec), [&o, name](const std::string& text) { o.given[name] = text; }, help)
+            ->type_name(spec.kind == ParamKind::Choice ? "TEXT"
+                        : spec.kind == ParamKind::Float ? "FLOAT"
+                                                        : "INT");
+    }
+}
+
+}  // namespace
+
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     add_max_pixels_option(cmd);
     cmd->add_option("input", o.input,
@@ -43,34 +72,14 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     cmd->add_option("--format", o.format, "auto|frames|tum|unregistered|bag|ocid|pcd")->capture_default_str();
     cmd->add_option("--topics", o.topics,
                     "ROS bag topics COLOR,DEPTH[,INFO] (default: detected; docs/INPUTS.md)");
-    cmd->add_option("--preset", o.preset, "paper: the paper's parameters");
-    cmd->add_option("--k", o.k, "Number of clusters (default 7)");
-    cmd->add_option("--alpha", o.alpha, "Colour scale, eq. 4, [0.002, 0.1] (default 0.0033)");
-    cmd->add_option("--delta", o.delta, "Position scale, eq. 4, alpha + delta <= 1 (default 1 - alpha)");
-    cmd->add_option("--gamma", o.gamma, "Normal scale, eq. 6, [0.0001, 0.01] (default 0.0001)");
-    cmd->add_option("--psi", o.psi, "Weight increment, eq. 2, (0, 1] (default 1)");
-    cmd->add_option("--iters", o.iters, "k-means iterations per frame (default 1)");
-    cmd->add_option("--stride", o.stride, "Sampling stride in pixels (default 1)");
-    cmd->add_option("--seed", o.seed, "k-means++ seed (default 1)");
-    cmd->add_option("--zmin", o.zmin, "Nearest depth kept, metres (default 0.2)");
-    cmd->add_option("--zmax", o.zmax, "Farthest depth kept, metres (default 4.5)");
-    cmd->add_option("--normal-radius", o.normal_radius, "Normal neighbour distance, px (default 2)");
+    std::string presets;
+    for (const auto& [name, help] : preset_names_and_help())
+        presets += (presets.empty() ? "" : "; ") + name + ": " + help;
+    cmd->add_option("--preset", o.preset, presets);
+    add_parameter_options(cmd, o);
     cmd->add_option("--select", o.select, "U,V: follow the object under this pixel of the first frame");
-    cmd->add_option("--segmenter", o.segmenter,
-                    "Object segmentation: geometric|kmeans|hybrid (default hybrid)");
-    cmd->add_option("--scope", o.scope,
-                    "Objects: support (what the support holds; the default, the whole scene "
-                    "when no support is found) or scene (every segment)");
-    cmd->add_flag("--no-plane", o.no_plane,
-                  "Keep the support plane (the paper's background step: depth range only)");
-    cmd->add_option("--min-points", o.min_points, "Smallest object, pixels (default 300)");
-    cmd->add_option("--object-psi", o.object_psi,
-                    "Weight increment of eq. 2 for object tracks, (0, 1] (default 0.5; 1 = no smoothing)");
     cmd->add_option("--threads", o.threads, "Worker threads, [1, 1024] (default: all cores)")
         ->check(NumberIn(1, wul3d::kMaxThreads));
-    cmd->add_option("--decimate", o.decimate,
-                    "N in [1, 8]: run the stages on every N-th pixel in u and v (N^2 times fewer "
-                    "points), results at the input's size (default 2; 1 with --preset paper)");
     cmd->add_option("--tum-camera", o.tum_camera,
                     "TUM intrinsics preset: kinect_v1|tum_fr1|tum_fr2|tum_fr3 (default: from folder name)");
     cmd->add_option("--intrinsics", o.intrinsics, "fx,fy,cx,cy: override every frame's intrinsics");
@@ -81,34 +90,23 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
 }
 
 PipelineParams make_pipeline_params(const PipelineOptions& o) {
-    PipelineParams p;
-    if (o.preset == "paper") {
-        p = PipelineParams::paper();
-    } else if (!o.preset.empty()) {
-        throw ParamError("--preset '" + o.preset + "': unknown (known: paper)");
+    try {
+        std::vector<std::pair<std::string, ParamValue>> given;
+        for (const ParamSpec& spec : pipeline_parameters()) {
+            const auto it = o.given.find(spec.name);
+            if (it == o.given.end()) continue;
+            // A switch's flag turns it off (--no-plane); the others carry their value.
+            given.emplace_back(spec.name, spec.kind == ParamKind::Switch
+                                              ? ParamValue{false}
+                                              : parse_parameter(spec, it->second));
+        }
+        return make_params(o.preset, given);
+    } catch (const ParamError& e) {
+        if (e.parameter().empty()) throw;
+        const ParamSpec* spec = find_parameter(e.parameter());
+        const std::string flag = spec ? flag_of(*spec) : "--" + e.parameter();
+        throw ParamError(flag + " " + e.value() + ": " + e.requirement());
     }
-    if (o.k) p.cluster.k = *o.k;
-    if (o.alpha) {
-        p.cluster.alpha = *o.alpha;
-        if (!o.delta) p.cluster.delta = 1.0f - *o.alpha;  // eq. (5) at equality, as the paper
-    }
-    if (o.delta) p.cluster.delta = *o.delta;
-    if (o.gamma) p.cluster.gamma = *o.gamma;
-    if (o.psi) p.cluster.psi = *o.psi;
-    if (o.iters) p.cluster.iters = *o.iters;
-    if (o.stride) p.cluster.stride = *o.stride;
-    if (o.seed) p.cluster.seed = *o.seed;
-    if (o.zmin) p.range.zmin_m = *o.zmin;
-    if (o.zmax) p.range.zmax_m = *o.zmax;
-    if (o.normal_radius) p.normals.radius_px = *o.normal_radius;
-    if (!o.segmenter.empty()) p.segmentation.segmenter = parse_segmenter(o.segmenter);
-    if (!o.scope.empty()) p.segmentation.scope = parse_scope(o.scope);
-    if (o.no_plane) p.remove_plane = false;
-    if (o.min_points) p.segmentation.min_points = *o.min_points;
-    if (o.object_psi) p.objects.psi = *o.object_psi;
-    if (o.decimate) p.decimation = *o.decimate;
-    p.validate();
-    return p;
 }
 
 SourceOptions make_source_options(const PipelineOptions& o) {

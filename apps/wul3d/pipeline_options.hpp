@@ -3,7 +3,7 @@
 // parameters. One place registers them on a subcommand and turns them into library structs,
 // so the two commands cannot drift apart.
 #include <CLI/CLI.hpp>
-#include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -27,14 +27,10 @@ struct PipelineOptions {
     std::string topics;  // --topics COLOR,DEPTH[,INFO] of a ROS bag
     std::string registration = "depth-to-color";
     std::string select;
-    std::string segmenter;
-    std::string scope;
-    bool no_plane = false;
     int threads = 0;  // 0 = all cores
-    // Parameters given on the command line override the preset; kept apart so we know.
-    std::optional<int> k, iters, stride, normal_radius, min_points, decimate;
-    std::optional<float> alpha, delta, gamma, psi, zmin, zmax, object_psi;
-    std::optional<std::uint64_t> seed;
+    // The table's parameters given on the command line (parameters.hpp), name -> text as
+    // typed; they override the preset. Read in the table's order by make_pipeline_params.
+    std::map<std::string, std::string> given;
 };
 
 /// Registers --max-pixels on `cmd`: the largest image the readers decode (io.hpp), set as
@@ -44,7 +40,8 @@ void add_max_pixels_option(CLI::App* cmd);
 /// Registers the input positional (or --camera) and every shared option on `cmd`.
 void add_pipeline_options(CLI::App* cmd, PipelineOptions& o);
 
-/// The preset, then every parameter given; validated (ParamError names the flag's field).
+/// The preset, then every parameter given (wul3d::make_params); validated. A ParamError
+/// that names a parameter of the table names its flag instead ("--object-psi 2: ...").
 PipelineParams make_pipeline_params(const PipelineOptions& o);
 SourceOptions make_source_options(const PipelineOptions& o);
 /// --select U,V, if given.

@@ -25,6 +25,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/output.hpp"
+#include "wul3d/parameters.hpp"
 #include "wul3d/pipeline.hpp"
 #include "wul3d/ros_image.hpp"
 #include "wul3d/segmentation.hpp"
@@ -35,39 +36,59 @@ namespace {
 using sensor_msgs::CameraInfoConstPtr;
 using sensor_msgs::ImageConstPtr;
 
-/// The command's parameters as private ROS parameters (~k, ~alpha, ...: docs/ROS.md), over
-/// the preset (~preset); validated by the library, as `wul3d run` validates its flags.
+/// A row's ROS parameter: its name, or for a switch its flag's ("--no-plane": no_plane).
+std::string ros_name(const wul3d::ParamSpec& spec) {
+    if (spec.kind != wul3d::ParamKind::Switch) return spec.name;
+    std::string name = wul3d::flag_of(spec).substr(2);
+    for (char& c : name)
+        if (c == '-') c = '_';
+    return name;
+}
+
+/// The command's parameters as private ROS parameters, one per row of the library's table
+/// (parameters.hpp: ~k, ~alpha, ..., ~object_psi; the plane switch as ~no_plane, like
+/// --no-plane), over the preset (~preset); checked by the library, as `wul3d run` checks its
+/// flags, and a ParamError names the ROS parameter.
 wul3d::PipelineParams pipeline_params(const ros::NodeHandle& pnh) {
-    wul3d::PipelineParams p;
-    std::string text;
-    if (pnh.getParam("preset", text) && !text.empty()) {
-        if (text != "paper") throw wul3d::ParamError("~preset '" + text + "': unknown (known: paper)");
-        p = wul3d::PipelineParams::paper();
+    using wul3d::ParamKind;
+    std::vector<std::pair<std::string, wul3d::ParamValue>> given;
+    std::string preset;
+    pnh.getParam("preset", preset);
+    try {
+        for (const wul3d::ParamSpec& spec : wul3d::pipeline_parameters()) {
+            int i = 0;
+            double d = 0;
+            bool b = false;
+            std::string text;
+            switch (spec.kind) {
+                case ParamKind::Int:
+                    if (pnh.getParam(spec.name, i)) given.emplace_back(spec.name, std::int64_t{i});
+                    break;
+                case ParamKind::UInt64:  // XmlRpc has 32-bit ints only
+                    if (pnh.getParam(spec.name, i)) {
+                        if (i < 0)
+                            throw wul3d::ParamError(spec.name, std::to_string(i), "must be >= 0");
+                        given.emplace_back(spec.name, std::uint64_t(i));
+                    }
+                    break;
+                case ParamKind::Float:
+                    if (pnh.getParam(spec.name, d)) given.emplace_back(spec.name, d);
+                    break;
+                case ParamKind::Choice:
+                    if (pnh.getParam(spec.name, text)) given.emplace_back(spec.name, text);
+                    break;
+                case ParamKind::Switch:  // ~no_plane: true turns the switch off, as its flag
+                    if (pnh.getParam(ros_name(spec), b)) given.emplace_back(spec.name, wul3d::ParamValue{!b});
+                    break;
+            }
+        }
+        return wul3d::make_params(preset, given);
+    } catch (const wul3d::ParamError& e) {
+        if (e.parameter().empty()) throw;
+        const wul3d::ParamSpec* spec = wul3d::find_parameter(e.parameter());
+        const std::string name = spec ? ros_name(*spec) : e.parameter();
+        throw wul3d::ParamError("~" + name + " " + e.value() + ": " + e.requirement());
     }
-    int i = 0;
-    double d = 0;
-    bool b = false;
-    if (pnh.getParam("k", i)) p.cluster.k = i;
-    if (pnh.getParam("alpha", d)) {
-        p.cluster.alpha = float(d);
-        p.cluster.delta = 1.0f - float(d);  // eq. (5) at equality, as `wul3d run --alpha`
-    }
-    if (pnh.getParam("delta", d)) p.cluster.delta = float(d);
-    if (pnh.getParam("gamma", d)) p.cluster.gamma = float(d);
-    if (pnh.getParam("psi", d)) p.cluster.psi = float(d);
-    if (pnh.getParam("iters", i)) p.cluster.iters = i;
-    if (pnh.getParam("stride", i)) p.cluster.stride = i;
-    if (pnh.getParam("seed", i)) p.cluster.seed = std::uint64_t(std::max(i, 0));
-    if (pnh.getParam("zmin", d)) p.range.zmin_m = float(d);
-    if (pnh.getParam("zmax", d)) p.range.zmax_m = float(d);
-    if (pnh.getParam("normal_radius", i)) p.normals.radius_px = i;
-    if (pnh.getParam("segmenter", text)) p.segmentation.segmenter = wul3d::parse_segmenter(text);
-    if (pnh.getParam("scope", text)) p.segmentation.scope = wul3d::parse_scope(text);
-    if (pnh.getParam("no_plane", b)) p.remove_plane = !b;
-    if (pnh.getParam("min_points", i)) p.segmentation.min_points = i;
-    if (pnh.getParam("decimate", i)) p.decimation = i;
-    p.validate();
-    return p;
 }
 
 /// A distinct colour per track id, for the boxes.

@@ -462,72 +462,33 @@ the next process().
 }
 
 void bind_pipeline(py::module_& m) {
-    py::class_<PyPipeline>(m, "Pipeline", R"doc(
+    // The keywords' lines come from the table (params_doc), so they cannot drift from it.
+    static const std::string doc = std::string(R"doc(
 The wul3d pipeline: the paper's weighted clustering of an RGB-D stream, then the support
 plane, object segments and object tracks. Holds state across frames (clusters and tracks):
 use one Pipeline per stream, feed its frames in order.
 
-Every argument is a flag of `wul3d run` (`wul3d run --help`) and None keeps the preset's value;
-values outside their range raise ValueError with the same message as the command.
+Every keyword is a flag of `wul3d run` (`wul3d run --help`), from the library's one table of
+parameters (wul3d/parameters.hpp); None keeps the preset's value. A value outside its range
+raises ValueError naming the keyword, with the command's message otherwise.
 
 Args:
-    preset (str): "default" or "paper" (the paper's parameters, every pixel).
-    k (int): number of clusters (default 7).
-    alpha (float): colour scale, eq. 4, [0.002, 0.1] (default 0.0033); without delta, delta
-        becomes 1 - alpha.
-    delta (float): position scale, eq. 4, alpha + delta <= 1.
-    gamma (float): normal scale, eq. 6, [0.0001, 0.01] (default 0.0001).
-    psi (float): weight increment, eq. 2, (0, 1] (default 1).
-    iters (int): k-means iterations per frame (default 1).
-    stride (int): sampling stride in pixels (default 1).
-    seed (int): k-means++ seed (default 1).
-    zmin (float): nearest depth kept, metres (default 0.2).
-    zmax (float): farthest depth kept, metres (default 4.5).
-    normal_radius (int): normal neighbour distance, pixels (default 2).
-    segmenter (str): "geometric", "kmeans" or "hybrid" (default).
-    scope (str): "support" (default: the objects the support surface holds; the whole scene
-        when no support is found) or "scene" (every segment).
-    remove_plane (bool): False keeps the support plane (`--no-plane`).
-    min_points (int): smallest object, pixels (default 300).
-    object_psi (float): eq. 2's increment for object tracks, (0, 1] (default 0.5).
-    decimate (int): N in [1, 8], run the stages on every N-th pixel (default 2).
-
-Example:
+)doc") + params_doc() + R"doc(Example:
     >>> p = wul3d.Pipeline(k=7, decimate=2)
     >>> r = p.process(color, depth, wul3d.Intrinsics(525, 525, 319.5, 239.5))
     >>> [(i.id, i.pixels) for i in r.instances]
-)doc")
-        .def(py::init([](const py::object& preset, const py::object& k, const py::object& alpha,
-                         const py::object& delta, const py::object& gamma, const py::object& psi,
-                         const py::object& iters, const py::object& stride, const py::object& seed,
-                         const py::object& zmin, const py::object& zmax,
-                         const py::object& normal_radius, const py::object& segmenter,
-                         const py::object& scope, const py::object& remove_plane,
-                         const py::object& min_points, const py::object& object_psi,
-                         const py::object& decimate) {
-                 // Each converted by name (params.hpp): a wrong type is a TypeError naming it.
-                 py::dict d(py::arg("preset") = preset, py::arg("k") = k, py::arg("alpha") = alpha,
-                            py::arg("delta") = delta, py::arg("gamma") = gamma, py::arg("psi") = psi,
-                            py::arg("iters") = iters, py::arg("stride") = stride,
-                            py::arg("seed") = seed, py::arg("zmin") = zmin, py::arg("zmax") = zmax,
-                            py::arg("normal_radius") = normal_radius,
-                            py::arg("segmenter") = segmenter, py::arg("scope") = scope,
-                            py::arg("min_points") = min_points, py::arg("object_psi") = object_psi,
-                            py::arg("decimate") = decimate);
+)doc";
+    py::class_<PyPipeline>(m, "Pipeline", doc.c_str())
+        .def(py::init([](const py::kwargs& kwargs) {
+                 // Each keyword converted by its row's kind (params.hpp): a wrong type is a
+                 // TypeError naming it; a keyword that is not a parameter, a TypeError too.
+                 py::dict d(kwargs);
                  ParamArgs a = take_param_args(d);
-                 a.remove_plane = to_bool(remove_plane, "remove_plane");
+                 if (!d.empty())
+                     throw py::type_error("Pipeline() got an unexpected keyword argument '" +
+                                          py::str(d.begin()->first).cast<std::string>() + "'");
                  return std::make_unique<PyPipeline>(a);
-             }),
-             py::kw_only(), py::arg("preset") = py::none(), py::arg("k") = py::none(),
-             py::arg("alpha") = py::none(), py::arg("delta") = py::none(),
-             py::arg("gamma") = py::none(), py::arg("psi") = py::none(),
-             py::arg("iters") = py::none(), py::arg("stride") = py::none(),
-             py::arg("seed") = py::none(), py::arg("zmin") = py::none(),
-             py::arg("zmax") = py::none(), py::arg("normal_radius") = py::none(),
-             py::arg("segmenter") = py::none(), py::arg("scope") = py::none(),
-             py::arg("remove_plane") = true,
-             py::arg("min_points") = py::none(), py::arg("object_psi") = py::none(),
-             py::arg("decimate") = py::none())
+             }))
         .def("process", &PyPipeline::process, py::arg("color"), py::arg("depth"),
              py::arg("intrinsics"), py::arg("depth_scale") = 0.001, R"doc(
 Runs every stage on one registered frame and returns a Result.
@@ -638,6 +599,34 @@ PYBIND11_MODULE(_wul3d, m) {
     bind_intrinsics(m);
     bind_result(m);
     bind_pipeline(m);
+    m.def(
+        "parameters",
+        [] {
+            static const char* const kKind[] = {"int", "int", "float", "str", "bool"};
+            const wul3d::PipelineParams defaults;
+            const py::dict values = params_dict(defaults);
+            py::list rows;
+            for (const wul3d::ParamSpec& s : wul3d::pipeline_parameters()) {
+                py::dict row;
+                row["name"] = s.name;
+                row["stage"] = s.stage;
+                row["type"] = kKind[static_cast<int>(s.kind)];
+                // A float row's default as its float's digits (0.0033, as --help says).
+                row["default"] = s.kind == wul3d::ParamKind::Float
+                                     ? py::object(py::float_(std::stod(wul3d::value_text(s.get(defaults)))))
+                                     : py::object(values[s.name]);
+                row["range"] = wul3d::range_text(s);
+                row["help"] = s.help;
+                row["flag"] = wul3d::flag_of(s);
+                row["summary_key"] = wul3d::summary_key(s);
+                rows.append(row);
+            }
+            return rows;
+        },
+        R"doc(The pipeline's parameters, one dict per row of the library's table: name (the
+keyword of Pipeline and run), stage, type ("int", "float", "str", "bool"), default, range,
+help, flag (`wul3d run`'s) and summary_key (summary.json's). The presets are "default" and
+"paper".)doc");
     bind_reading(m);
     bind_eval(m);
     bind_run(m);

@@ -1,84 +1,80 @@
 #include "params.hpp"
 
-#include "wul3d/error.hpp"
-#include "wul3d/segmentation.hpp"
+#include <variant>
 
 namespace wul3d::python {
 
 ParamArgs take_param_args(py::dict& o) {
     ParamArgs a;
-    a.preset = take<std::string>(o, "preset");
-    a.k = take<int>(o, "k");
-    a.alpha = take<float>(o, "alpha");
-    a.delta = take<float>(o, "delta");
-    a.gamma = take<float>(o, "gamma");
-    a.psi = take<float>(o, "psi");
-    a.iters = take<int>(o, "iters");
-    a.stride = take<int>(o, "stride");
-    a.seed = take<std::uint64_t>(o, "seed");
-    a.zmin = take<float>(o, "zmin");
-    a.zmax = take<float>(o, "zmax");
-    a.normal_radius = take<int>(o, "normal_radius");
-    a.segmenter = take<std::string>(o, "segmenter");
-    a.scope = take<std::string>(o, "scope");
-    a.min_points = take<int>(o, "min_points");
-    a.object_psi = take<float>(o, "object_psi");
-    a.decimate = take<int>(o, "decimate");
+    a.preset = take<std::string>(o, "preset").value_or("");
+    for (const ParamSpec& s : pipeline_parameters()) {
+        if (!o.contains(s.name)) continue;
+        const py::object v = o[s.name];
+        PyDict_DelItemString(o.ptr(), s.name);
+        if (v.is_none()) continue;
+        switch (s.kind) {
+            case ParamKind::Int: a.given.emplace_back(s.name, std::int64_t{to_value<long long>(v, s.name)}); break;
+            case ParamKind::UInt64: a.given.emplace_back(s.name, to_value<std::uint64_t>(v, s.name)); break;
+            case ParamKind::Float: a.given.emplace_back(s.name, to_value<double>(v, s.name)); break;
+            case ParamKind::Choice: a.given.emplace_back(s.name, to_value<std::string>(v, s.name)); break;
+            case ParamKind::Switch: a.given.emplace_back(s.name, to_value<bool>(v, s.name)); break;
+        }
+    }
     return a;
 }
 
-PipelineParams make_params(const ParamArgs& a) {
-    PipelineParams p;
-    if (a.preset && *a.preset == "paper") {
-        p = PipelineParams::paper();
-    } else if (a.preset && *a.preset != "default") {
-        throw ParamError("preset '" + *a.preset + "': unknown (known: default, paper)");
-    }
-    if (a.k) p.cluster.k = *a.k;
-    if (a.alpha) {
-        p.cluster.alpha = *a.alpha;
-        if (!a.delta) p.cluster.delta = 1.0f - *a.alpha;
-    }
-    if (a.delta) p.cluster.delta = *a.delta;
-    if (a.gamma) p.cluster.gamma = *a.gamma;
-    if (a.psi) p.cluster.psi = *a.psi;
-    if (a.iters) p.cluster.iters = *a.iters;
-    if (a.stride) p.cluster.stride = *a.stride;
-    if (a.seed) p.cluster.seed = *a.seed;
-    if (a.zmin) p.range.zmin_m = *a.zmin;
-    if (a.zmax) p.range.zmax_m = *a.zmax;
-    if (a.normal_radius) p.normals.radius_px = *a.normal_radius;
-    if (a.segmenter) p.segmentation.segmenter = parse_segmenter(*a.segmenter);
-    if (a.scope) p.segmentation.scope = parse_scope(*a.scope);
-    p.remove_plane = a.remove_plane;
-    if (a.min_points) p.segmentation.min_points = *a.min_points;
-    if (a.object_psi) p.objects.psi = *a.object_psi;
-    if (a.decimate) p.decimation = *a.decimate;
-    p.validate();
-    return p;
-}
+PipelineParams make_params(const ParamArgs& a) { return wul3d::make_params(a.preset, a.given); }
 
 py::dict params_dict(const PipelineParams& p) {
-    const auto& c = p.cluster;
     py::dict d;
-    d["k"] = c.k;
-    d["alpha"] = c.alpha;
-    d["delta"] = c.delta;
-    d["gamma"] = c.gamma;
-    d["psi"] = c.psi;
-    d["iters"] = c.iters;
-    d["stride"] = c.stride;
-    d["seed"] = c.seed;
-    d["zmin"] = p.range.zmin_m;
-    d["zmax"] = p.range.zmax_m;
-    d["normal_radius"] = p.normals.radius_px;
-    d["segmenter"] = segmenter_name(p.segmentation.segmenter);
-    d["scope"] = scope_name(p.segmentation.scope);
-    d["remove_plane"] = p.remove_plane;
-    d["min_points"] = p.segmentation.min_points;
-    d["object_psi"] = p.objects.psi;
-    d["decimate"] = p.decimation;
+    for (const ParamSpec& s : pipeline_parameters())
+        std::visit([&](const auto& value) { d[s.name] = value; }, s.get(p));
     return d;
+}
+
+namespace {
+
+/// `text`'s last line wrapped at 92 columns, continued with 8 spaces (a docstring's Args:).
+std::string wrap_last_line(const std::string& text) {
+    const std::size_t start = text.rfind('\n') == std::string::npos ? 0 : text.rfind('\n') + 1;
+    std::string out = text.substr(0, start), line;
+    std::size_t pos = start;
+    while (pos < text.size()) {
+        std::size_t end = text.find(' ', pos + 1);
+        if (end == std::string::npos) end = text.size();
+        const std::string word = text.substr(pos, end - pos);  // with its leading space
+        if (line.size() + word.size() > 92 && !line.empty()) {
+            out += line + "\n";
+            line = "        " + word.substr(word[0] == ' ' ? 1 : 0);
+        } else {
+            line += word;
+        }
+        pos = end;
+    }
+    return out + line;
+}
+
+}  // namespace
+
+std::string params_doc() {
+    static const char* const kPythonType[] = {"int", "int", "float", "str", "bool"};
+    const PipelineParams defaults;
+    std::string presets, doc;
+    for (const auto& [name, help] : preset_names_and_help())
+        presets += (presets.empty() ? "" : "; ") + ("\"" + name + "\": " + help);
+    doc = wrap_last_line("    preset (str): " + presets + ".") + "\n";
+    for (const ParamSpec& s : pipeline_parameters()) {
+        const ParamValue def = s.get(defaults);
+        const std::string* name = std::get_if<std::string>(&def);
+        const bool* on = std::get_if<bool>(&def);
+        doc += std::string("    ") + s.name + " (" + kPythonType[static_cast<int>(s.kind)] + "): " +
+               s.help;
+        if (s.kind == ParamKind::Int || s.kind == ParamKind::Float) doc += ", " + range_text(s);
+        const std::string shown = name ? "\"" + *name + "\"" : on ? (*on ? "True" : "False") : value_text(def);
+        doc += " (default " + shown + "; `wul3d run " + flag_of(s) + "`).";
+        doc = wrap_last_line(doc) + "\n";
+    }
+    return doc;
 }
 
 }  // namespace wul3d::python

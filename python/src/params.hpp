@@ -1,26 +1,24 @@
 #pragma once
-// wul3d.Pipeline's keyword arguments and wul3d.run's options: the flags of `wul3d run`,
-// turned into library parameters by the same rules as the command.
+// wul3d.Pipeline's keyword arguments and wul3d.run's options: the rows of the library's table
+// of parameters (wul3d/parameters.hpp), as the command takes them.
 #include <pybind11/pybind11.h>
 
-#include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "convert.hpp"
+#include "wul3d/parameters.hpp"
 #include "wul3d/pipeline.hpp"
 
 namespace wul3d::python {
 namespace py = pybind11;
 
-/// The keyword arguments of wul3d.Pipeline, as the flags of `wul3d run`: None keeps the
-/// preset's value.
+/// The preset and the parameters given (None: not given, the preset's value stays).
 struct ParamArgs {
-    std::optional<std::string> preset, segmenter, scope;
-    std::optional<int> k, iters, stride, normal_radius, min_points, decimate;
-    std::optional<float> alpha, delta, gamma, psi, zmin, zmax, object_psi;
-    std::optional<std::uint64_t> seed;
-    bool remove_plane = true;
+    std::string preset;  ///< empty: "default"
+    std::vector<std::pair<std::string, ParamValue>> given;
 };
 
 /// Removes `key` from `options` and returns its value as T (None or absent: nullopt); a
@@ -33,16 +31,18 @@ std::optional<T> take(py::dict& options, const char* key) {
     return to_optional<T>(v, key);
 }
 
-/// The pipeline's parameters among `options` (preset, k, alpha, ..., decimate; not the
-/// plane switch, which Pipeline and run spell apart), removed from it as they are taken.
+/// "preset" and every row of the table among `options`, each converted by its kind (a
+/// wrong type: TypeError naming it), removed from `options` as they are taken.
 ParamArgs take_param_args(py::dict& options);
 
-/// The same rules as `wul3d run`'s options (apps/wul3d/pipeline_options.cpp), so that a
-/// Pipeline built from the same settings gives the same outputs: the preset first, then each
-/// given parameter; alpha without delta sets delta = 1 - alpha (eq. 5 at equality).
+/// wul3d::make_params: the preset, then each given parameter, as `wul3d run` does
+/// (ParamError, a ValueError in Python, names the keyword).
 PipelineParams make_params(const ParamArgs& a);
 
-/// The parameters in force as a dict (summary.json's names, without units).
+/// The parameters in force as a dict, one key per row (without units: "zmin").
 py::dict params_dict(const PipelineParams& p);
+
+/// The "Args:" lines of a docstring, one per row and the preset, from the table.
+std::string params_doc();
 
 }  // namespace wul3d::python

@@ -53,10 +53,9 @@ std::optional<py::object> pop(py::dict& o, const char* key) {
 RunOptions run_options(const std::string& input, const std::string& out, py::dict o) {
     RunOptions r;
     ParamArgs a = take_param_args(o);
-    if (take<bool>(o, "no_plane").value_or(false)) a.remove_plane = false;
+    if (take<bool>(o, "no_plane").value_or(false)) a.given.emplace_back("remove_plane", false);
     r.params = make_params(a);
-    r.preset = a.preset.value_or("");
-    if (r.preset == "default") r.preset.clear();
+    r.preset = a.preset == "default" ? "" : a.preset;
 
     r.feed.input = input;
     SourceOptions& s = r.feed.source;

@@ -36,6 +36,7 @@ from ._wul3d import (  # noqa: F401  (re-exported)
     Result,
     get_max_pixels,
     get_num_threads,
+    parameters,
     read_color_image,
     read_label_image,
     set_max_pixels,
@@ -46,7 +47,7 @@ from ._wul3d import __version__  # noqa: F401  (CMake's project(VERSION))
 
 __all__ = [
     "Frame", "InputError", "Instance", "Intrinsics", "IoError", "Pipeline", "Result",
-    "Reader", "evaluate", "get_max_pixels", "get_num_threads", "read", "read_color_image",
+    "Reader", "evaluate", "get_max_pixels", "get_num_threads", "parameters", "read", "read_color_image",
     "read_label_image", "run", "set_max_pixels", "set_num_threads",
 ]
 

@@ -54,15 +54,27 @@ FRAME_OUTPUT_FILES = frozenset({
 MAX_DEPTH = 64  # folders below ROOT that discovery descends (a path stays under PATH_MAX)
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 EXIT_SIGNAL_BASE = 128  # 130 after SIGINT, 143 after SIGTERM, as a shell reports them
-# Options of `wul3d run` that pass through (flag name -> wul3d.run keyword).
-RUN_OPTIONS = {
-    "preset": str, "k": int, "alpha": float, "delta": float, "gamma": float, "psi": float,
-    "iters": int, "stride": int, "seed": int, "zmin": float, "zmax": float,
-    "normal_radius": int, "segmenter": str, "scope": str, "min_points": int, "object_psi": float,
-    "decimate": int, "format": str, "tum_camera": str, "intrinsics": str, "calibration": str,
-    "registration": str, "select": str, "frames": int,
-}
 RUN_FLAGS = {"no_plane", "ply", "overlay"}
+
+
+def run_options():
+    """The options of `wul3d run` that pass through, keyword -> (type, help): the pipeline's
+    parameters from the library's table (wul3d.parameters(); its switch, remove_plane, is the
+    command's --no-plane flag, in RUN_FLAGS), then the run's own options. Imported when
+    called: the discovery above needs the standard library only (fuzz_batch_discovery.py
+    loads this file alone)."""
+    from . import _wul3d
+    types = {"int": int, "float": float, "str": str}
+    options = {"preset": (str, 'as `wul3d run --preset`: "default" or "paper"')}
+    for p in _wul3d.parameters():
+        if p["type"] != "bool":
+            options[p["name"]] = (types[p["type"]],
+                                  f"{p['help']}, {p['range']} (default {p['default']})")
+    for name, kind in (("format", str), ("tum_camera", str), ("intrinsics", str),
+                       ("calibration", str), ("registration", str), ("select", str),
+                       ("frames", int)):
+        options[name] = (kind, f"as `wul3d run --{name.replace('_', '-')}`")
+    return options
 
 
 class BatchError(ValueError):
@@ -968,10 +980,9 @@ def _parser():
     p.add_argument("--no-score", action="store_true",
                    help="no UOIS table even where frames carry label.png")
     run = p.add_argument_group("run options (as `wul3d run`)")
-    for name, kind in RUN_OPTIONS.items():
-        flag = "--" + name.replace("_", "-")
-        run.add_argument(flag, dest=name, type=kind, metavar=kind.__name__.upper(),
-                         help=f"as `wul3d run {flag}`")
+    for name, (kind, help) in run_options().items():
+        run.add_argument("--" + name.replace("_", "-"), dest=name, type=kind,
+                         metavar=kind.__name__.upper(), help=help)
     run.add_argument("--no-plane", action="store_true", help="as `wul3d run --no-plane`")
     run.add_argument("--ply", action="store_true", help="as `wul3d run --ply`")
     run.add_argument("--overlay", action="store_true", help="as `wul3d run --overlay`")
@@ -999,7 +1010,7 @@ def _main(argv) -> int:
         value = getattr(args, name)
         if value is not None and value < 1:
             parser.error(f"--{name.replace('_', '-')} {value}: must be >= 1")
-    options = {k: getattr(args, k) for k in RUN_OPTIONS if getattr(args, k) is not None}
+    options = {k: getattr(args, k) for k in run_options() if getattr(args, k) is not None}
     options.update({k: True for k in RUN_FLAGS if getattr(args, k)})
     try:
         report = run_batch(args.root, args.out, scheduler=args.scheduler, workers=args.workers,

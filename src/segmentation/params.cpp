@@ -11,7 +11,7 @@ namespace wul3d {
 Scope parse_scope(const std::string& name) {
     if (name == "support") return Scope::Support;
     if (name == "scene") return Scope::Scene;
-    throw ParamError("--scope '" + name + "': unknown (known: support, scene)");
+    throw ParamError("scope", "'" + name + "'", "unknown (known: support, scene)");
 }
 
 const char* scope_name(Scope s) { return s == Scope::Support ? "support" : "scene"; }
@@ -20,7 +20,7 @@ Segmenter parse_segmenter(const std::string& name) {
     if (name == "geometric") return Segmenter::Geometric;
     if (name == "kmeans") return Segmenter::Kmeans;
     if (name == "hybrid") return Segmenter::Hybrid;
-    throw ParamError("--segmenter '" + name + "': unknown (known: geometric, kmeans, hybrid)");
+    throw ParamError("segmenter", "'" + name + "'", "unknown (known: geometric, kmeans, hybrid)");
 }
 
 const char* segmenter_name(Segmenter s) {
@@ -40,11 +40,7 @@ void require(bool ok, const char* name, T value, const char* range) {
 }  // namespace
 
 void SegmentParams::validate() const {
-    if (min_points < 1) {
-        std::ostringstream msg;
-        msg << "--min-points " << min_points << ": must be >= 1";
-        throw ParamError(msg.str());
-    }
+    require(min_points >= 1, "min_points", min_points, ">= 1");
     require(depth_jump_m > 0, "depth_jump_m", depth_jump_m, "> 0");
     require(depth_jump_rel >= 0, "depth_jump_rel", depth_jump_rel, ">= 0");
     require(normal_smooth_px >= 0 && normal_smooth_px <= 16, "normal_smooth_px", normal_smooth_px, "in [0, 16]");

@@ -243,7 +243,16 @@ TEST(RosNode, BadParameter_OneLineAndExit2) {
     wul3d::test::TempDir dir;
     RosCore core(dir.path());
     // `wul3d run --k 0`'s check, through the ROS parameter ~k.
-    const auto r = wul3d::test::run_command({"timeout", "60", WUL3D_ROS_NODE_BIN, "_k:=0"});
+    // The library's check names the ROS parameter, as the command names its flag.
+    auto r = wul3d::test::run_command({"timeout", "60", WUL3D_ROS_NODE_BIN, "_k:=0"});
     EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
-    EXPECT_NE((r.out + r.err).find("k = 0: must be in"), std::string::npos) << r.out << r.err;
+    EXPECT_NE((r.out + r.err).find("wul3d: ~k 0: must be in [1, 65535]"), std::string::npos)
+        << r.out << r.err;
+    // Every row of the table is a ROS parameter: ~object_psi too (~k reset: the parameter
+    // server keeps the last run's).
+    r = wul3d::test::run_command(
+        {"timeout", "60", WUL3D_ROS_NODE_BIN, "_k:=7", "_object_psi:=2.0"});
+    EXPECT_EQ(r.exit_code, 2) << r.out << r.err;
+    EXPECT_NE((r.out + r.err).find("wul3d: ~object_psi 2: must be in (0, 1]"), std::string::npos)
+        << r.out << r.err;
 }
