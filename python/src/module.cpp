@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "buffer_pool.hpp"
 #include "convert.hpp"
 #include "params.hpp"
 #include "run_binding.hpp"
@@ -38,7 +39,7 @@ namespace {
 /// One object of a result; the mask is cut from the result's objects image on demand.
 struct Instance {
     DetectedObject object;
-    py::array_t<std::uint16_t> objects;  ///< the result's objects image (shared, not copied)
+    py::object objects;  ///< the result's objects image (shared, not copied), or None
 };
 
 template <std::size_t N>
@@ -48,22 +49,73 @@ py::array_t<float> floats(const std::array<float, N>& a) {
     return out;
 }
 
-/// Everything process() returns; owns copies of the frame's images.
+/// Everything process() returns; owns copies of the frame's images (None for an image
+/// that process(outputs=...) left out).
 struct Result {
-    py::array_t<std::uint16_t> labels, objects;
-    py::array_t<std::uint8_t> colors;
+    int width = 0, height = 0;
+    py::object labels, objects, colors;
     py::list instances;
     py::object plane;
     py::dict times, stats;
 };
 
-Result make_result(const FrameResult& r) {
+/// The images process() copies out: all by default, or those named by `outputs`.
+struct ImageSelection {
+    bool labels = true, objects = true, colors = true;
+};
+
+ImageSelection to_selection(const py::object& outputs) {
+    ImageSelection s;
+    if (outputs.is_none()) return s;
+    if (PyUnicode_Check(outputs.ptr()) || PyBytes_Check(outputs.ptr()) ||
+        !py::isinstance<py::iterable>(outputs))
+        throw py::type_error("outputs: expected a tuple of names ('labels', 'objects', "
+                             "'colors') or None, got " +
+                             py::str(py::type::of(outputs).attr("__name__")).cast<std::string>());
+    s = ImageSelection{false, false, false};
+    for (const py::handle name : outputs) {
+        const std::string n = to_string(name, "outputs[]");
+        if (n == "labels") s.labels = true;
+        else if (n == "objects") s.objects = true;
+        else if (n == "colors") s.colors = true;
+        else throw py::value_error("outputs: '" + n + "' is not one of 'labels', 'objects', 'colors'");
+    }
+    return s;
+}
+
+/// The result's images copied into buffers of the pipeline's pool (buffer_pool.hpp).
+py::array_t<std::uint16_t> copy_out(BufferPool& pool, const LabelImage& image) {
+    auto out = pool.array<std::uint16_t>({image.height, image.width});
+    std::copy(image.labels.begin(), image.labels.end(), out.mutable_data());
+    return out;
+}
+
+py::array_t<std::uint8_t> copy_out(BufferPool& pool, const ColorImage& image) {
+    auto out = pool.array<std::uint8_t>({image.height, image.width, 3});
+    std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+    return out;
+}
+
+/// The images asked for, copied out of the pipeline (whose buffers the next frame reuses).
+void copy_images(const FrameResult& r, const ImageSelection& selection, BufferPool& pool, Result& out) {
+    out.width = r.labels.width;
+    out.height = r.labels.height;
+    out.labels = selection.labels ? py::object(copy_out(pool, r.labels)) : py::none();
+    out.colors = selection.colors ? py::object(copy_out(pool, r.colors)) : py::none();
+    if (!selection.objects) {
+        out.objects = py::none();
+    } else if (r.objects.labels.empty()) {  // objects not detected: all background
+        auto zeros = pool.array<std::uint16_t>({r.labels.height, r.labels.width});
+        std::fill_n(zeros.mutable_data(), zeros.size(), 0);
+        out.objects = zeros;
+    } else {
+        out.objects = copy_out(pool, r.objects);
+    }
+}
+
+Result make_result(const FrameResult& r, const ImageSelection& selection, BufferPool& pool) {
     Result out;
-    out.labels = to_array(r.labels);
-    out.colors = to_array(r.colors);
-    out.objects = r.objects.labels.empty() ? py::array_t<std::uint16_t>({r.labels.height, r.labels.width})
-                                           : to_array(r.objects);
-    if (r.objects.labels.empty()) std::fill_n(out.objects.mutable_data(), out.objects.size(), 0);
+    copy_images(r, selection, pool, out);
     for (const DetectedObject& d : r.object_list) out.instances.append(Instance{d, out.objects});
     if (r.plane.found) {
         const Plane& pl = r.plane.support;
@@ -145,13 +197,15 @@ public:
     explicit PyPipeline(const ParamArgs& args) : pipeline_(make_params(args)) {}
 
     Result process(const py::object& color, const py::object& depth,
-                   const py::object& intrinsics, const py::object& depth_scale_arg) {
+                   const py::object& intrinsics, const py::object& depth_scale_arg,
+                   const py::object& outputs) {
         const double depth_scale = to_double(depth_scale_arg, "depth_scale");
         if (!(depth_scale > 0) || !std::isfinite(depth_scale) || depth_scale > 1e3)
             throw py::value_error("depth_scale = " + std::to_string(depth_scale) +
                                   ": must be a positive number of metres per unit");
         const FrameArrays arrays = check_frame_arrays(color, depth);
         const PinholeIntrinsics K = to_intrinsics(intrinsics, arrays.width, arrays.height);
+        const ImageSelection selection = to_selection(outputs);
         const FrameResult* r = nullptr;
         double call_ms = 0;
         // Held until the result is copied: it is valid until the next process(). A thread
@@ -179,7 +233,7 @@ public:
             }
             call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
-        Result out = make_result(*r);
+        Result out = make_result(*r, selection, *pool_);
         out.times["call"] = call_ms;
         return out;
     }
@@ -190,6 +244,8 @@ private:
     Pipeline pipeline_;
     RgbdFrame frame_;
     std::mutex mutex_;
+    /// The results' memory; shared with their arrays' leases, which may outlive the pipeline.
+    std::shared_ptr<BufferPool> pool_ = std::make_shared<BufferPool>();
 };
 
 /// One frame read from disk (wul3d.read), registered when the input is unregistered.
@@ -420,14 +476,19 @@ fields as an entry of objects.json.
                                "This frame's segments that fed it.")
         .def("mask",
              [](const Instance& i) {
-                 py::array_t<bool> out({i.objects.shape(0), i.objects.shape(1)});
-                 const std::uint16_t* o = i.objects.data();
+                 if (i.objects.is_none())
+                     throw py::value_error("mask(): the result has no objects image (process() "
+                                           "with outputs= that leaves out 'objects')");
+                 const auto objects = py::reinterpret_borrow<py::array_t<std::uint16_t>>(i.objects);
+                 py::array_t<bool> out({objects.shape(0), objects.shape(1)});
+                 const std::uint16_t* o = objects.data();
                  bool* dst = out.mutable_data();
                  const auto id = static_cast<std::uint16_t>(i.object.id);
-                 for (py::ssize_t p = 0; p < i.objects.size(); ++p) dst[p] = o[p] == id;
+                 for (py::ssize_t p = 0; p < objects.size(); ++p) dst[p] = o[p] == id;
                  return out;
              },
-             "(H, W) bool: its pixels, cut from Result.objects on each call.")
+             "(H, W) bool: its pixels, cut from Result.objects on each call (ValueError when "
+             "process(outputs=...) left out 'objects').")
         .def("__repr__", [](const Instance& i) {
             return "Instance(id=" + std::to_string(i.object.id) +
                    ", pixels=" + std::to_string(i.object.pixels) + ")";
@@ -435,7 +496,7 @@ fields as an entry of objects.json.
 
     py::class_<Result>(m, "Result", R"doc(
 Everything one frame produced, at the input's size. Owns its arrays: it stays valid after
-the next process().
+the next process(). An image that process(outputs=...) left out is None.
 )doc")
         .def_readonly("labels", &Result::labels,
                       "(H, W) uint16: the paper's clusters, 0 = no point, 1..k (labels.png).")
@@ -443,6 +504,8 @@ the next process().
                       "(H, W) uint16: objects, 0 = background, else the track id (objects.png).")
         .def_readonly("colors", &Result::colors,
                       "(H, W, 3) uint8 RGB: eq. (9) display colours over the scene (colors.png).")
+        .def_readonly("width", &Result::width, "The frame's width, pixels.")
+        .def_readonly("height", &Result::height, "The frame's height, pixels.")
         .def_readonly("instances", &Result::instances, "list of Instance, one per object.")
         .def_readonly("plane", &Result::plane,
                       "The support plane n . X + d = 0 as {'normal': (nx, ny, nz), 'd_m': d}, "
@@ -455,9 +518,8 @@ the next process().
                       "What the frame did: points clustered, active points, seeding, segments "
                       "(summary.json's per-frame entry).")
         .def("__repr__", [](const Result& r) {
-            return "Result(" + std::to_string(r.labels.shape(1)) + "x" +
-                   std::to_string(r.labels.shape(0)) + ", " + std::to_string(r.instances.size()) +
-                   " objects)";
+            return "Result(" + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " +
+                   std::to_string(r.instances.size()) + " objects)";
         });
 }
 
@@ -529,7 +591,8 @@ Example:
              py::arg("min_points") = py::none(), py::arg("object_psi") = py::none(),
              py::arg("decimate") = py::none())
         .def("process", &PyPipeline::process, py::arg("color"), py::arg("depth"),
-             py::arg("intrinsics"), py::arg("depth_scale") = 0.001, R"doc(
+             py::arg("intrinsics"), py::arg("depth_scale") = 0.001, py::kw_only(),
+             py::arg("outputs") = py::none(), R"doc(
 Runs every stage on one registered frame and returns a Result.
 
 Args:
@@ -538,6 +601,10 @@ Args:
         (NaN, inf and <= 0 = no depth).
     intrinsics: wul3d.Intrinsics, or a dict with fx, fy, cx, cy (as intrinsics.json).
     depth_scale (float): metres per unit of a uint16 depth (default 0.001, millimetres).
+    outputs (keyword only): the images to copy into the Result, a tuple of names from
+        'labels', 'objects', 'colors'; None (default) copies all three. The others are None
+        in the Result; the stages, instances, plane, times and stats are the same. Each image
+        left out saves its copy (a 640x480 frame's three images are 2.1 MB).
 
 C-contiguous arrays are required (TypeError for a wrong dtype, ValueError for a wrong shape
 or order). uint16 depth and RGB colour are read in place, not copied; float32 depth is
