@@ -8,13 +8,49 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <utility>
 #include <vector>
 
 namespace wul3d::python {
+
+/// memcpy with streaming stores: the destination's lines are written whole, not read into
+/// the cache first. A result's buffers were last touched frames ago and its 2.1 MB would not
+/// stay in a core's cache anyway; written the usual way, each line is first fetched from
+/// memory (as much traffic again as the copy), and the copy evicts the pipeline's own data.
+/// bench/python/binding_overhead.py measures it (docs/PYTHON.md).
+inline void copy_streaming(void* dst, const void* src, std::size_t bytes) {
+#if defined(__SSE2__)
+    auto* d = static_cast<unsigned char*>(dst);
+    const auto* s = static_cast<const unsigned char*>(src);
+    const auto misaligned = static_cast<std::size_t>(reinterpret_cast<std::uintptr_t>(d) % 16);
+    const std::size_t head = std::min(bytes, misaligned ? 16 - misaligned : 0);
+    std::memcpy(d, s, head);
+    d += head;
+    s += head;
+    bytes -= head;
+    const std::size_t lines = bytes / 64;  // four 16-byte stores fill a 64-byte line
+    for (std::size_t i = 0; i < lines; ++i, d += 64, s += 64) {
+        for (int k = 0; k < 4; ++k) {
+            const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + 16 * k));
+            _mm_stream_si128(reinterpret_cast<__m128i*>(d + 16 * k), v);
+        }
+    }
+    _mm_sfence();  // the streamed stores are seen before anything after the copy
+    std::memcpy(d, s, bytes - lines * 64);
+#else
+    std::memcpy(dst, src, bytes);
+#endif
+}
 
 class BufferPool : public std::enable_shared_from_this<BufferPool> {
 public:

@@ -86,13 +86,13 @@ ImageSelection to_selection(const py::object& outputs) {
 /// The result's images copied into buffers of the pipeline's pool (buffer_pool.hpp).
 py::array_t<std::uint16_t> copy_out(BufferPool& pool, const LabelImage& image) {
     auto out = pool.array<std::uint16_t>({image.height, image.width});
-    std::copy(image.labels.begin(), image.labels.end(), out.mutable_data());
+    copy_streaming(out.mutable_data(), image.labels.data(), image.labels.size() * sizeof(std::uint16_t));
     return out;
 }
 
 py::array_t<std::uint8_t> copy_out(BufferPool& pool, const ColorImage& image) {
     auto out = pool.array<std::uint8_t>({image.height, image.width, 3});
-    std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+    copy_streaming(out.mutable_data(), image.rgb.data(), image.rgb.size());
     return out;
 }
 

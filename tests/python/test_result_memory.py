@@ -130,3 +130,25 @@ def test_bad_outputs_raise_before_the_frame_is_processed(frames, reference):
     # None of the refused calls ran a frame: the stream is where a fresh pipeline's is.
     for k, g in enumerate(frames):
         assert_images_equal(process(p, g), reference[k][0])
+
+
+def test_odd_sizes_are_copied_to_the_last_byte(frames):
+    # 631 x 475: rows of neither 16 nor 64 bytes, images not a whole number of cache lines.
+    f = frames[0]
+    color = np.ascontiguousarray(f.color[:475, :631])
+    depth = np.ascontiguousarray(f.depth[:475, :631])
+    K = {"fx": f.intrinsics.fx, "fy": f.intrinsics.fy, "cx": f.intrinsics.cx, "cy": f.intrinsics.cy}
+    p = wul3d.Pipeline()
+    r = p.process(color, depth, K, f.depth_scale)
+    for name in IMAGES:  # scribbled over, then given back to the pool for the next result
+        getattr(r, name).fill(0xEE)
+    del r
+    r = p.process(color, depth, K, f.depth_scale)
+    assert r.objects.shape == r.labels.shape == (475, 631) and r.colors.shape == (475, 631, 3)
+    assert r.instances
+    assert set(np.unique(r.objects)) == {0} | {i.id for i in r.instances}
+    for inst in r.instances:
+        assert int(inst.mask().sum()) == inst.pixels
+    assert int(r.labels.max()) <= p.params["k"]
+    assert int((r.labels > 0).sum()) == r.stats["active_points"]
+    assert not (r.colors == 0xEE).all(axis=2).any()
