@@ -12,7 +12,9 @@ stages, result.times["total"], plus the library's own untimed work; nothing of t
 overhead = wall - call, call by call: what Python adds to the same C++ work on the same frame
 (argument checks, the GIL hand-over, the images copied out, the instances and dicts, and the
 previous result freed, which a `r = pipeline.process(...)` loop does inside the call's
-statement). The frames are read and decoded before the timing.
+statement). The frames are read and decoded before the timing. `reads`: the first read of
+r.instances, r.plane, r.times and r.stats after the call, timed apart: the binding makes
+those Python objects on first read, so a loop that reads them pays this too.
 
 --outputs: the selections measured, comma separated: `all` (process() as called by default,
 the three images), `none` (outputs=()), or image names joined by "+" ("objects",
@@ -47,8 +49,9 @@ def selection(text):
 
 
 def measure(frames, pipelines, passes):
-    """Per selection: (walls, calls, overheads) in ms over passes x frames calls, alternated."""
-    timings = {name: ([], [], []) for name in pipelines}
+    """Per selection: (walls, calls, overheads, reads) in ms over passes x frames calls,
+    alternated."""
+    timings = {name: ([], [], [], []) for name in pipelines}
     last = dict.fromkeys(pipelines)  # each selection's previous result, freed in its next call
     for pass_ in range(passes + 1):
         for f in frames:
@@ -59,9 +62,13 @@ def measure(frames, pipelines, passes):
                                               **kwargs)
                 wall = (time.perf_counter() - t0) * 1e3
                 r = last[name]
+                t0 = time.perf_counter()
+                r.instances, r.plane, r.times, r.stats  # noqa: B018 (made on first read)
+                read = (time.perf_counter() - t0) * 1e3
                 if pass_ == 0:
                     continue  # warm-up: first allocations
-                walls, calls, overheads = timings[name]
+                walls, calls, overheads, reads = timings[name]
+                reads.append(read)
                 walls.append(wall)
                 calls.append(r.times["call"])
                 overheads.append(wall - r.times["call"])
@@ -69,13 +76,14 @@ def measure(frames, pipelines, passes):
 
 
 def report(timings):
-    print(f"{'outputs':<18} {'python wall':>11} {'C++ call':>9} {'difference':>10}   "
-          f"overhead per call: median (p10, p90)   [ms, medians]")
-    for name, (walls, calls, overheads) in timings.items():
+    print(f"{'outputs':<16} {'python wall':>11} {'C++ call':>9} {'difference':>10}   "
+          f"{'overhead per call: median (p10, p90)':<37} {'reads':>6}   [ms, medians]")
+    for name, (walls, calls, overheads, reads) in timings.items():
         q = statistics.quantiles(overheads, n=10)
         wall, call = statistics.median(walls), statistics.median(calls)
-        print(f"{name:<18} {wall:>11.3f} {call:>9.3f} {wall - call:>10.3f}   "
-              f"{statistics.median(overheads):.3f} ({q[0]:.3f}, {q[-1]:.3f})")
+        overhead = f"{statistics.median(overheads):.3f} ({q[0]:.3f}, {q[-1]:.3f})"
+        print(f"{name:<16} {wall:>11.3f} {call:>9.3f} {wall - call:>10.3f}   "
+              f"{overhead:<37} {statistics.median(reads):>6.3f}")
 
 
 def run_cli(args, n_frames):

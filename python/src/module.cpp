@@ -50,13 +50,20 @@ py::array_t<float> floats(const std::array<float, N>& a) {
 }
 
 /// Everything process() returns; owns copies of the frame's images (None for an image
-/// that process(outputs=...) left out).
+/// that process(outputs=...) left out). The instances, plane, times and stats are kept as
+/// the library's values and made Python objects on first read (then the same object on each
+/// read): a loop that reads none of them does not pay for some sixty objects a frame.
 struct Result {
     int width = 0, height = 0;
     py::object labels, objects, colors;
-    py::list instances;
-    py::object plane;
-    py::dict times, stats;
+    std::vector<DetectedObject> object_list;
+    PlaneResult plane;
+    StageTimes times;
+    double call_ms = 0;  ///< the C++ Pipeline::process call, timed by the binding
+    FrameStats stats;
+    std::size_t active_points = 0;
+    SegmentStats segment_stats;
+    py::object instances_py, plane_py, times_py, stats_py;  ///< made on first read
 };
 
 /// The images process() copies out: all by default, or those named by `outputs`.
@@ -116,39 +123,68 @@ void copy_images(const FrameResult& r, const ImageSelection& selection, BufferPo
 Result make_result(const FrameResult& r, const ImageSelection& selection, BufferPool& pool) {
     Result out;
     copy_images(r, selection, pool, out);
-    for (const DetectedObject& d : r.object_list) out.instances.append(Instance{d, out.objects});
-    if (r.plane.found) {
-        const Plane& pl = r.plane.support;
-        py::dict plane;
-        plane["normal"] = py::make_tuple(pl.nx, pl.ny, pl.nz);
-        plane["d_m"] = pl.d;
-        out.plane = plane;
-    } else {
-        out.plane = py::none();
-    }
+    out.object_list = r.object_list;
+    out.plane.found = r.plane.found;
+    out.plane.support = r.plane.support;
+    out.times = r.times;
+    out.stats = r.stats;
+    out.active_points = r.active_points;
+    out.segment_stats = r.segment_stats;
+    return out;
+}
+
+py::list instances_list(const Result& r) {
+    py::list out;
+    for (const DetectedObject& d : r.object_list) out.append(Instance{d, r.objects});
+    return out;
+}
+
+py::object plane_dict(const Result& r) {
+    if (!r.plane.found) return py::none();
+    const Plane& pl = r.plane.support;
+    py::dict plane;
+    plane["normal"] = py::make_tuple(pl.nx, pl.ny, pl.nz);
+    plane["d_m"] = pl.d;
+    return plane;
+}
+
+py::dict times_dict(const Result& r) {
     const StageTimes& t = r.times;
     const std::pair<const char*, double> stages[] = {
         {"registration", t.registration}, {"decimation", t.decimation},
         {"backprojection", t.backprojection}, {"normals", t.normals},
         {"background", t.background}, {"clustering", t.clustering}, {"colors", t.colors},
         {"plane", t.plane}, {"segmentation", t.segmentation}, {"objects", t.objects},
-        {"overlap", t.overlap}, {"total", t.total()}};
-    for (const auto& [name, ms] : stages) out.times[name] = ms;
-    out.stats["points"] = r.stats.points;
-    out.stats["active_points"] = r.active_points;
-    out.stats["seeded"] = r.stats.seeded;
-    out.stats["reseeded"] = r.stats.reseeded;
-    out.stats["mean_f"] = r.stats.mean_f;
-    out.stats["segments"] = r.segment_stats.segments;
-    out.stats["merges"] = r.segment_stats.merges;
-    out.stats["containers"] = r.segment_stats.containers;
-    out.stats["islands_kept"] = r.segment_stats.islands_kept;
-    out.stats["occluded_joins"] = r.segment_stats.occluded;
-    out.stats["gaps_filled"] = r.segment_stats.gaps_filled;
-    out.stats["color_splits"] = r.segment_stats.color_splits;
-    out.stats["texture_splits"] = r.segment_stats.texture_splits;
-    out.stats["stack_splits"] = r.segment_stats.stack_splits;
+        {"overlap", t.overlap}, {"total", t.total()}, {"call", r.call_ms}};
+    py::dict out;
+    for (const auto& [name, ms] : stages) out[name] = ms;
     return out;
+}
+
+py::dict stats_dict(const Result& r) {
+    py::dict out;
+    out["points"] = r.stats.points;
+    out["active_points"] = r.active_points;
+    out["seeded"] = r.stats.seeded;
+    out["reseeded"] = r.stats.reseeded;
+    out["mean_f"] = r.stats.mean_f;
+    out["segments"] = r.segment_stats.segments;
+    out["merges"] = r.segment_stats.merges;
+    out["containers"] = r.segment_stats.containers;
+    out["islands_kept"] = r.segment_stats.islands_kept;
+    out["occluded_joins"] = r.segment_stats.occluded;
+    out["gaps_filled"] = r.segment_stats.gaps_filled;
+    out["color_splits"] = r.segment_stats.color_splits;
+    out["texture_splits"] = r.segment_stats.texture_splits;
+    out["stack_splits"] = r.segment_stats.stack_splits;
+    return out;
+}
+
+/// A field of Result made on its first read, the same object after.
+template <py::object Result::*Field, class Make>
+py::object made_once(Result& r, Make make) {
+    if (!(r.*Field)) r.*Field = make(r);
+    return r.*Field;
 }
 
 /// process() calls running now without the GIL, and the most seen at once: shows in tests
@@ -234,7 +270,7 @@ public:
             call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
         Result out = make_result(*r, selection, *pool_);
-        out.times["call"] = call_ms;
+        out.call_ms = call_ms;
         return out;
     }
 
@@ -506,20 +542,25 @@ the next process(). An image that process(outputs=...) left out is None.
                       "(H, W, 3) uint8 RGB: eq. (9) display colours over the scene (colors.png).")
         .def_readonly("width", &Result::width, "The frame's width, pixels.")
         .def_readonly("height", &Result::height, "The frame's height, pixels.")
-        .def_readonly("instances", &Result::instances, "list of Instance, one per object.")
-        .def_readonly("plane", &Result::plane,
+        .def_property_readonly(
+            "instances", [](Result& r) { return made_once<&Result::instances_py>(r, instances_list); },
+            "list of Instance, one per object.")
+        .def_property_readonly(
+            "plane", [](Result& r) { return made_once<&Result::plane_py>(r, plane_dict); },
                       "The support plane n . X + d = 0 as {'normal': (nx, ny, nz), 'd_m': d}, "
                       "or None when none was found (objects.json's support_plane).")
-        .def_readonly("times", &Result::times,
+        .def_property_readonly(
+            "times", [](Result& r) { return made_once<&Result::times_py>(r, times_dict); },
                       "Milliseconds per stage, 'overlap' (counted twice), 'total' (the stages, as "
                       "`wul3d run` reports them) and 'call' (the whole C++ Pipeline::process "
                       "call; process() from Python costs this plus the binding's overhead).")
-        .def_readonly("stats", &Result::stats,
+        .def_property_readonly(
+            "stats", [](Result& r) { return made_once<&Result::stats_py>(r, stats_dict); },
                       "What the frame did: points clustered, active points, seeding, segments "
                       "(summary.json's per-frame entry).")
         .def("__repr__", [](const Result& r) {
             return "Result(" + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " +
-                   std::to_string(r.instances.size()) + " objects)";
+                   std::to_string(r.object_list.size()) + " objects)";
         });
 }
 

@@ -152,3 +152,19 @@ def test_odd_sizes_are_copied_to_the_last_byte(frames):
     assert int(r.labels.max()) <= p.params["k"]
     assert int((r.labels > 0).sum()) == r.stats["active_points"]
     assert not (r.colors == 0xEE).all(axis=2).any()
+
+
+def test_fields_read_late_are_the_frames_own(frames, reference):
+    # instances, plane, times and stats become Python objects on first read: read after
+    # the whole sequence (and the pipeline gone), they are still each frame's.
+    p = wul3d.Pipeline()
+    results = [process(p, f) for f in frames + frames]
+    del p
+    gc.collect()
+    for r, (_, instances, plane) in zip(results, reference):
+        assert [(i.id, i.pixels, i.box_px) for i in r.instances] == instances
+        assert r.plane == plane
+        assert r.instances is r.instances and r.times is r.times and r.stats is r.stats
+        assert set(r.times) >= {"total", "call", "segmentation"}
+        assert r.stats["segments"] >= len(r.instances)
+    assert len({r.stats["active_points"] for r in results[:len(frames)]}) > 1
