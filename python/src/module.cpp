@@ -532,7 +532,9 @@ fields as an entry of objects.json.
 
     py::class_<Result>(m, "Result", R"doc(
 Everything one frame produced, at the input's size. Owns its arrays: it stays valid after
-the next process(). An image that process(outputs=...) left out is None.
+the next process() and after its pipeline. An image that process(outputs=...) left out is
+None. The images' memory goes back to the pipeline for a later frame when the result is
+dropped; instances, plane, times and stats are made on first read.
 )doc")
         .def_readonly("labels", &Result::labels,
                       "(H, W) uint16: the paper's clusters, 0 = no point, 1..k (labels.png).")
