@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "buffer_pool.hpp"
 #include "convert.hpp"
 #include "params.hpp"
 #include "run_binding.hpp"
@@ -38,7 +39,7 @@ namespace {
 /// One object of a result; the mask is cut from the result's objects image on demand.
 struct Instance {
     DetectedObject object;
-    py::array_t<std::uint16_t> objects;  ///< the result's objects image (shared, not copied)
+    py::object objects;  ///< the result's objects image (shared, not copied), or None
 };
 
 template <std::size_t N>
@@ -48,55 +49,142 @@ py::array_t<float> floats(const std::array<float, N>& a) {
     return out;
 }
 
-/// Everything process() returns; owns copies of the frame's images.
+/// Everything process() returns; owns copies of the frame's images (None for an image
+/// that process(outputs=...) left out). The instances, plane, times and stats are kept as
+/// the library's values and made Python objects on first read (then the same object on each
+/// read): a loop that reads none of them does not pay for some sixty objects a frame.
 struct Result {
-    py::array_t<std::uint16_t> labels, objects;
-    py::array_t<std::uint8_t> colors;
-    py::list instances;
-    py::object plane;
-    py::dict times, stats;
+    int width = 0, height = 0;
+    py::object labels, objects, colors;
+    std::vector<DetectedObject> object_list;
+    PlaneResult plane;
+    StageTimes times;
+    double call_ms = 0;  ///< the C++ Pipeline::process call, timed by the binding
+    FrameStats stats;
+    std::size_t active_points = 0;
+    SegmentStats segment_stats;
+    py::object instances_py, plane_py, times_py, stats_py;  ///< made on first read
 };
 
-Result make_result(const FrameResult& r) {
-    Result out;
-    out.labels = to_array(r.labels);
-    out.colors = to_array(r.colors);
-    out.objects = r.objects.labels.empty() ? py::array_t<std::uint16_t>({r.labels.height, r.labels.width})
-                                           : to_array(r.objects);
-    if (r.objects.labels.empty()) std::fill_n(out.objects.mutable_data(), out.objects.size(), 0);
-    for (const DetectedObject& d : r.object_list) out.instances.append(Instance{d, out.objects});
-    if (r.plane.found) {
-        const Plane& pl = r.plane.support;
-        py::dict plane;
-        plane["normal"] = py::make_tuple(pl.nx, pl.ny, pl.nz);
-        plane["d_m"] = pl.d;
-        out.plane = plane;
-    } else {
-        out.plane = py::none();
+/// The images process() copies out: all by default, or those named by `outputs`.
+struct ImageSelection {
+    bool labels = true, objects = true, colors = true;
+};
+
+ImageSelection to_selection(const py::object& outputs) {
+    ImageSelection s;
+    if (outputs.is_none()) return s;
+    if (PyUnicode_Check(outputs.ptr()) || PyBytes_Check(outputs.ptr()) ||
+        !py::isinstance<py::iterable>(outputs))
+        throw py::type_error("outputs: expected a tuple of names ('labels', 'objects', "
+                             "'colors') or None, got " +
+                             py::str(py::type::of(outputs).attr("__name__")).cast<std::string>());
+    s = ImageSelection{false, false, false};
+    for (const py::handle name : outputs) {
+        const std::string n = to_string(name, "outputs[]");
+        if (n == "labels") s.labels = true;
+        else if (n == "objects") s.objects = true;
+        else if (n == "colors") s.colors = true;
+        else throw py::value_error("outputs: '" + n + "' is not one of 'labels', 'objects', 'colors'");
     }
+    return s;
+}
+
+/// The result's images copied into buffers of the pipeline's pool (buffer_pool.hpp).
+py::array_t<std::uint16_t> copy_out(BufferPool& pool, const LabelImage& image) {
+    auto out = pool.array<std::uint16_t>({image.height, image.width});
+    copy_streaming(out.mutable_data(), image.labels.data(), image.labels.size() * sizeof(std::uint16_t));
+    return out;
+}
+
+py::array_t<std::uint8_t> copy_out(BufferPool& pool, const ColorImage& image) {
+    auto out = pool.array<std::uint8_t>({image.height, image.width, 3});
+    copy_streaming(out.mutable_data(), image.rgb.data(), image.rgb.size());
+    return out;
+}
+
+/// The images asked for, copied out of the pipeline (whose buffers the next frame reuses).
+void copy_images(const FrameResult& r, const ImageSelection& selection, BufferPool& pool, Result& out) {
+    out.width = r.labels.width;
+    out.height = r.labels.height;
+    out.labels = selection.labels ? py::object(copy_out(pool, r.labels)) : py::none();
+    out.colors = selection.colors ? py::object(copy_out(pool, r.colors)) : py::none();
+    if (!selection.objects) {
+        out.objects = py::none();
+    } else if (r.objects.labels.empty()) {  // objects not detected: all background
+        auto zeros = pool.array<std::uint16_t>({r.labels.height, r.labels.width});
+        std::fill_n(zeros.mutable_data(), zeros.size(), 0);
+        out.objects = zeros;
+    } else {
+        out.objects = copy_out(pool, r.objects);
+    }
+}
+
+Result make_result(const FrameResult& r, const ImageSelection& selection, BufferPool& pool) {
+    Result out;
+    copy_images(r, selection, pool, out);
+    out.object_list = r.object_list;
+    out.plane.found = r.plane.found;
+    out.plane.support = r.plane.support;
+    out.times = r.times;
+    out.stats = r.stats;
+    out.active_points = r.active_points;
+    out.segment_stats = r.segment_stats;
+    return out;
+}
+
+py::list instances_list(const Result& r) {
+    py::list out;
+    for (const DetectedObject& d : r.object_list) out.append(Instance{d, r.objects});
+    return out;
+}
+
+py::object plane_dict(const Result& r) {
+    if (!r.plane.found) return py::none();
+    const Plane& pl = r.plane.support;
+    py::dict plane;
+    plane["normal"] = py::make_tuple(pl.nx, pl.ny, pl.nz);
+    plane["d_m"] = pl.d;
+    return plane;
+}
+
+py::dict times_dict(const Result& r) {
     const StageTimes& t = r.times;
     const std::pair<const char*, double> stages[] = {
         {"registration", t.registration}, {"decimation", t.decimation},
         {"backprojection", t.backprojection}, {"normals", t.normals},
         {"background", t.background}, {"clustering", t.clustering}, {"colors", t.colors},
         {"plane", t.plane}, {"segmentation", t.segmentation}, {"objects", t.objects},
-        {"overlap", t.overlap}, {"total", t.total()}};
-    for (const auto& [name, ms] : stages) out.times[name] = ms;
-    out.stats["points"] = r.stats.points;
-    out.stats["active_points"] = r.active_points;
-    out.stats["seeded"] = r.stats.seeded;
-    out.stats["reseeded"] = r.stats.reseeded;
-    out.stats["mean_f"] = r.stats.mean_f;
-    out.stats["segments"] = r.segment_stats.segments;
-    out.stats["merges"] = r.segment_stats.merges;
-    out.stats["containers"] = r.segment_stats.containers;
-    out.stats["islands_kept"] = r.segment_stats.islands_kept;
-    out.stats["occluded_joins"] = r.segment_stats.occluded;
-    out.stats["gaps_filled"] = r.segment_stats.gaps_filled;
-    out.stats["color_splits"] = r.segment_stats.color_splits;
-    out.stats["texture_splits"] = r.segment_stats.texture_splits;
-    out.stats["stack_splits"] = r.segment_stats.stack_splits;
+        {"overlap", t.overlap}, {"total", t.total()}, {"call", r.call_ms}};
+    py::dict out;
+    for (const auto& [name, ms] : stages) out[name] = ms;
     return out;
+}
+
+py::dict stats_dict(const Result& r) {
+    py::dict out;
+    out["points"] = r.stats.points;
+    out["active_points"] = r.active_points;
+    out["seeded"] = r.stats.seeded;
+    out["reseeded"] = r.stats.reseeded;
+    out["mean_f"] = r.stats.mean_f;
+    out["segments"] = r.segment_stats.segments;
+    out["merges"] = r.segment_stats.merges;
+    out["containers"] = r.segment_stats.containers;
+    out["islands_kept"] = r.segment_stats.islands_kept;
+    out["occluded_joins"] = r.segment_stats.occluded;
+    out["gaps_filled"] = r.segment_stats.gaps_filled;
+    out["color_splits"] = r.segment_stats.color_splits;
+    out["texture_splits"] = r.segment_stats.texture_splits;
+    out["stack_splits"] = r.segment_stats.stack_splits;
+    return out;
+}
+
+/// A field of Result made on its first read, the same object after.
+template <py::object Result::*Field, class Make>
+py::object made_once(Result& r, Make make) {
+    if (!(r.*Field)) r.*Field = make(r);
+    return r.*Field;
 }
 
 /// process() calls running now without the GIL, and the most seen at once: shows in tests
@@ -145,13 +233,15 @@ public:
     explicit PyPipeline(const ParamArgs& args) : pipeline_(make_params(args)) {}
 
     Result process(const py::object& color, const py::object& depth,
-                   const py::object& intrinsics, const py::object& depth_scale_arg) {
+                   const py::object& intrinsics, const py::object& depth_scale_arg,
+                   const py::object& outputs) {
         const double depth_scale = to_double(depth_scale_arg, "depth_scale");
         if (!(depth_scale > 0) || !std::isfinite(depth_scale) || depth_scale > 1e3)
             throw py::value_error("depth_scale = " + std::to_string(depth_scale) +
                                   ": must be a positive number of metres per unit");
         const FrameArrays arrays = check_frame_arrays(color, depth);
         const PinholeIntrinsics K = to_intrinsics(intrinsics, arrays.width, arrays.height);
+        const ImageSelection selection = to_selection(outputs);
         const FrameResult* r = nullptr;
         double call_ms = 0;
         // Held until the result is copied: it is valid until the next process(). A thread
@@ -179,8 +269,8 @@ public:
             }
             call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
-        Result out = make_result(*r);
-        out.times["call"] = call_ms;
+        Result out = make_result(*r, selection, *pool_);
+        out.call_ms = call_ms;
         return out;
     }
 
@@ -190,6 +280,8 @@ private:
     Pipeline pipeline_;
     RgbdFrame frame_;
     std::mutex mutex_;
+    /// The results' memory; shared with their arrays' leases, which may outlive the pipeline.
+    std::shared_ptr<BufferPool> pool_ = std::make_shared<BufferPool>();
 };
 
 /// One frame read from disk (wul3d.read), registered when the input is unregistered.
@@ -420,14 +512,19 @@ fields as an entry of objects.json.
                                "This frame's segments that fed it.")
         .def("mask",
              [](const Instance& i) {
-                 py::array_t<bool> out({i.objects.shape(0), i.objects.shape(1)});
-                 const std::uint16_t* o = i.objects.data();
+                 if (i.objects.is_none())
+                     throw py::value_error("mask(): the result has no objects image (process() "
+                                           "with outputs= that leaves out 'objects')");
+                 const auto objects = py::reinterpret_borrow<py::array_t<std::uint16_t>>(i.objects);
+                 py::array_t<bool> out({objects.shape(0), objects.shape(1)});
+                 const std::uint16_t* o = objects.data();
                  bool* dst = out.mutable_data();
                  const auto id = static_cast<std::uint16_t>(i.object.id);
-                 for (py::ssize_t p = 0; p < i.objects.size(); ++p) dst[p] = o[p] == id;
+                 for (py::ssize_t p = 0; p < objects.size(); ++p) dst[p] = o[p] == id;
                  return out;
              },
-             "(H, W) bool: its pixels, cut from Result.objects on each call.")
+             "(H, W) bool: its pixels, cut from Result.objects on each call (ValueError when "
+             "process(outputs=...) left out 'objects').")
         .def("__repr__", [](const Instance& i) {
             return "Instance(id=" + std::to_string(i.object.id) +
                    ", pixels=" + std::to_string(i.object.pixels) + ")";
@@ -435,7 +532,9 @@ fields as an entry of objects.json.
 
     py::class_<Result>(m, "Result", R"doc(
 Everything one frame produced, at the input's size. Owns its arrays: it stays valid after
-the next process().
+the next process() and after its pipeline. An image that process(outputs=...) left out is
+None. The images' memory goes back to the pipeline for a later frame when the result is
+dropped; instances, plane, times and stats are made on first read.
 )doc")
         .def_readonly("labels", &Result::labels,
                       "(H, W) uint16: the paper's clusters, 0 = no point, 1..k (labels.png).")
@@ -443,21 +542,27 @@ the next process().
                       "(H, W) uint16: objects, 0 = background, else the track id (objects.png).")
         .def_readonly("colors", &Result::colors,
                       "(H, W, 3) uint8 RGB: eq. (9) display colours over the scene (colors.png).")
-        .def_readonly("instances", &Result::instances, "list of Instance, one per object.")
-        .def_readonly("plane", &Result::plane,
+        .def_readonly("width", &Result::width, "The frame's width, pixels.")
+        .def_readonly("height", &Result::height, "The frame's height, pixels.")
+        .def_property_readonly(
+            "instances", [](Result& r) { return made_once<&Result::instances_py>(r, instances_list); },
+            "list of Instance, one per object.")
+        .def_property_readonly(
+            "plane", [](Result& r) { return made_once<&Result::plane_py>(r, plane_dict); },
                       "The support plane n . X + d = 0 as {'normal': (nx, ny, nz), 'd_m': d}, "
                       "or None when none was found (objects.json's support_plane).")
-        .def_readonly("times", &Result::times,
+        .def_property_readonly(
+            "times", [](Result& r) { return made_once<&Result::times_py>(r, times_dict); },
                       "Milliseconds per stage, 'overlap' (counted twice), 'total' (the stages, as "
                       "`wul3d run` reports them) and 'call' (the whole C++ Pipeline::process "
                       "call; process() from Python costs this plus the binding's overhead).")
-        .def_readonly("stats", &Result::stats,
+        .def_property_readonly(
+            "stats", [](Result& r) { return made_once<&Result::stats_py>(r, stats_dict); },
                       "What the frame did: points clustered, active points, seeding, segments "
                       "(summary.json's per-frame entry).")
         .def("__repr__", [](const Result& r) {
-            return "Result(" + std::to_string(r.labels.shape(1)) + "x" +
-                   std::to_string(r.labels.shape(0)) + ", " + std::to_string(r.instances.size()) +
-                   " objects)";
+            return "Result(" + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " +
+                   std::to_string(r.object_list.size()) + " objects)";
         });
 }
 
@@ -490,7 +595,8 @@ Args:
                  return std::make_unique<PyPipeline>(a);
              }))
         .def("process", &PyPipeline::process, py::arg("color"), py::arg("depth"),
-             py::arg("intrinsics"), py::arg("depth_scale") = 0.001, R"doc(
+             py::arg("intrinsics"), py::arg("depth_scale") = 0.001, py::kw_only(),
+             py::arg("outputs") = py::none(), R"doc(
 Runs every stage on one registered frame and returns a Result.
 
 Args:
@@ -499,6 +605,10 @@ Args:
         (NaN, inf and <= 0 = no depth).
     intrinsics: wul3d.Intrinsics, or a dict with fx, fy, cx, cy (as intrinsics.json).
     depth_scale (float): metres per unit of a uint16 depth (default 0.001, millimetres).
+    outputs (keyword only): the images to copy into the Result, a tuple of names from
+        'labels', 'objects', 'colors'; None (default) copies all three. The others are None
+        in the Result; the stages, instances, plane, times and stats are the same. Each image
+        left out saves its copy (a 640x480 frame's three images are 2.1 MB).
 
 C-contiguous arrays are required (TypeError for a wrong dtype, ValueError for a wrong shape
 or order). uint16 depth and RGB colour are read in place, not copied; float32 depth is
