@@ -3,12 +3,19 @@
 // FrameSource allocates nothing per frame once the first frame has been read.
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "wul3d/clustering.hpp"
 #include "wul3d/frame.hpp"
+
+namespace wul3d {
+class FrameSource;
+struct SourceOptions;
+}  // namespace wul3d
 
 namespace wul3d::detail {
 
@@ -53,5 +60,34 @@ inline std::string number_str(double v) {
     std::snprintf(text, sizeof text, "%g", v);
     return text;
 }
+
+// ---- shared by the sequence readers (io_sources.cpp, io_osd.cpp, io_bop.cpp) -------------
+
+bool is_file(const std::filesystem::path& p);  ///< a regular file (links followed)
+bool is_dir(const std::filesystem::path& p);
+/// Whether the optional file `p` is there. Something there that is not a regular file (a
+/// FIFO, a device, a folder) is an error, not an absent file.
+bool present(const std::filesystem::path& p);
+/// InputError "`dir`: colour is WxH but depth is WxH" unless the sizes agree.
+void check_same_size(const std::string& what, int w, int h, int depth_w, int depth_h);
+void clear_colour(ColorImage& c);  ///< no colour, capacity kept
+/// std::out_of_range unless i < n.
+void check_index(std::size_t i, std::size_t n);
+/// The PNG files of `dir` by stem, sorted; InputError if it cannot be listed.
+std::vector<std::filesystem::path> list_pngs(const std::filesystem::path& dir);
+
+/// OSD-0.2-depth (io_osd.cpp): a folder holding image_color/.
+bool is_osd_tree(const std::filesystem::path& root);
+std::unique_ptr<FrameSource> open_osd(const std::string& path, const std::filesystem::path& root,
+                                      const SourceOptions& options);
+
+/// BOP (io_bop.cpp): a scene folder (scene_camera.json, or depth/ beside rgb/ or gray/ and
+/// BOP's ground truth).
+bool is_bop_scene(const std::filesystem::path& dir);
+std::unique_ptr<FrameSource> open_bop(const std::string& path, const std::filesystem::path& scene,
+                                      const SourceOptions& options);
+/// The first BOP scene at most `levels` folders below `root` (a split folder holds scenes,
+/// a dataset folder splits), or empty.
+std::filesystem::path find_bop_scene(const std::filesystem::path& root, int levels);
 
 }  // namespace wul3d::detail

@@ -22,19 +22,18 @@ namespace wul3d {
 namespace fs = std::filesystem;
 using detail::size_str;
 
-namespace {
-
-constexpr const char* kNoFramesHint =
-    "expected depth.png in the folder or in its sub-folders, or rgb.txt and depth.txt of a "
-    "TUM RGB-D sequence";
+namespace detail {
 
 bool is_file(const fs::path& p) {
     std::error_code ec;
     return fs::is_regular_file(p, ec);
 }
 
-/// Whether the optional file `p` (color.png, intrinsics.json) is there. Something there that
-/// is not a regular file (a FIFO, a device, a folder) is an error, not an absent file.
+bool is_dir(const fs::path& p) {
+    std::error_code ec;
+    return fs::is_directory(p, ec);
+}
+
 bool present(const fs::path& p) {
     std::error_code ec;
     const auto status = fs::status(p, ec);
@@ -44,16 +43,53 @@ bool present(const fs::path& p) {
     return true;
 }
 
+void check_same_size(const std::string& what, int w, int h, int depth_w, int depth_h) {
+    if (w != depth_w || h != depth_h)
+        throw InputError(what + ": colour is " + size_str(w, h) + " but depth is " +
+                         size_str(depth_w, depth_h));
+}
+
+void clear_colour(ColorImage& c) {
+    c.width = c.height = 0;
+    c.rgb.clear();  // keeps the capacity for the next frame that has colour
+}
+
+void check_index(std::size_t i, std::size_t n) {
+    if (i >= n) {
+        throw std::out_of_range("frame " + std::to_string(i) + " of a sequence of " +
+                                std::to_string(n));
+    }
+}
+
+std::vector<fs::path> list_pngs(const fs::path& dir) {
+    std::vector<fs::path> files;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+        if (e.path().extension() == ".png") files.push_back(e.path());
+    if (ec) throw InputError(dir.string() + ": cannot list the folder (" + ec.message() + ")");
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::check_index;
+using detail::clear_colour;
+using detail::is_dir;
+using detail::is_file;
+using detail::present;
+
+constexpr const char* kNoFramesHint =
+    "expected depth.png in the folder or in its sub-folders, or rgb.txt and depth.txt of a "
+    "TUM RGB-D sequence";
+
 /// Anything at `p`: a file a reader then opens, or refuses by its type with a clear message
 /// (a FIFO named depth.png is an error, not a folder without frames).
 bool something_at(const fs::path& p) {
     std::error_code ec;
     return fs::exists(p, ec);
-}
-
-bool is_dir(const fs::path& p) {
-    std::error_code ec;
-    return fs::is_directory(p, ec);
 }
 
 /// `p` made absolute and without a trailing separator, so that filename() and
@@ -124,18 +160,6 @@ void check_colour_size(const fs::path& dir, int w, int h, int depth_w, int depth
 
 /// Thrown by a header check to stop a read before its pixels; never leaves read().
 struct StopBeforePixels {};
-
-void clear_colour(ColorImage& c) {
-    c.width = c.height = 0;
-    c.rgb.clear();  // keeps the capacity for the next frame that has colour
-}
-
-void check_index(std::size_t i, std::size_t n) {
-    if (i >= n) {
-        throw std::out_of_range("frame " + std::to_string(i) + " of a sequence of " +
-                                std::to_string(n));
-    }
-}
 
 /// Registered frame folders: depth.png, intrinsics.json and optional color.png per frame.
 class FramesSource final : public FrameSource {
@@ -640,6 +664,8 @@ const char* input_format_name(InputFormat f) {
         case InputFormat::Bag: return "bag";
         case InputFormat::Ocid: return "ocid";
         case InputFormat::Pcd: return "pcd";
+        case InputFormat::Osd: return "osd";
+        case InputFormat::Bop: return "bop";
     }
     return "?";
 }
@@ -652,8 +678,10 @@ InputFormat parse_input_format(const std::string& name) {
     if (name == "bag") return InputFormat::Bag;
     if (name == "ocid") return InputFormat::Ocid;
     if (name == "pcd") return InputFormat::Pcd;
+    if (name == "osd") return InputFormat::Osd;
+    if (name == "bop") return InputFormat::Bop;
     throw ParamError("unknown input format '" + name +
-                     "' (known: auto, frames, tum, unregistered, bag, ocid, pcd)");
+                     "' (known: auto, frames, tum, unregistered, bag, ocid, pcd, osd, bop)");
 }
 
 bool is_bag_file(const std::string& path) {
@@ -693,6 +721,14 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
             throw InputError(path + ": not an OCID sequence (expected rgb/ and depth/ holding "
                                     "result_*.png)");
     }
+    if (options.format == InputFormat::Osd ||
+        (options.format == InputFormat::Auto && detail::is_osd_tree(root))) {
+        return detail::open_osd(path, root, options);
+    }
+    if (options.format == InputFormat::Bop ||
+        (options.format == InputFormat::Auto && detail::is_bop_scene(root))) {
+        return detail::open_bop(path, root, options);
+    }
 
     InputFormat format = options.format;
     if (format == InputFormat::Auto && something_at(root / "rgb.txt") && something_at(root / "depth.txt")) {
@@ -710,11 +746,17 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
     try {
         dirs = find_frame_dirs(path, root);
     } catch (const InputError&) {
-        // An OCID tree above its sequences: one sequence at a time.
+        // An OCID tree above its sequences, a BOP split or dataset above its scenes: one
+        // sequence at a time.
         const fs::path seq = find_ocid_sequence(root, 4);
-        if (seq.empty()) throw;
-        throw InputError(path + ": an OCID tree; give one sequence folder (one with rgb/ and "
-                                "depth/, e.g. " + seq.string() + ")");
+        if (!seq.empty())
+            throw InputError(path + ": an OCID tree; give one sequence folder (one with rgb/ "
+                                    "and depth/, e.g. " + seq.string() + ")");
+        const fs::path scene = detail::find_bop_scene(root, 2);
+        if (!scene.empty())
+            throw InputError(path + ": holds BOP scenes; give one scene folder (e.g. " +
+                             scene.string() + "), or run them all with python3 -m wul3d.batch");
+        throw;
     }
     // "Beside the frames": in the folder of a sequence's frame folders; for a single frame
     // folder, in it or in its parent.

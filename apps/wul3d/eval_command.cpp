@@ -46,6 +46,7 @@ struct FramePair {
     std::string name;
     fs::path gt;
     fs::path pred;
+    std::optional<BopImageMasks> bop;  ///< a BOP image: its masks make the ground truth
 };
 
 bool is_file(const fs::path& p) {
@@ -70,6 +71,29 @@ int ocid_background_max(const fs::path& seq) {
     return 2;
 }
 
+/// An OSD-0.2-depth tree: image_color/ and annotation/ (labels, 0 background).
+bool is_osd_tree(const fs::path& p) { return is_dir(p / "image_color") && is_dir(p / "annotation"); }
+
+/// A BOP scene: scene_camera.json (list_bop_masks then wants mask_visib/).
+bool is_bop_scene(const fs::path& p) { return is_file(p / "scene_camera.json"); }
+
+/// The PNGs of `dir` (stems starting with `prefix`) as ground-truth frames named by stem.
+std::vector<FramePair> label_files(const std::string& what, const fs::path& dir,
+                                   const std::string& prefix) {
+    std::vector<FramePair> frames;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string n = e.path().filename().string();
+        if (n.rfind(prefix, 0) == 0 && e.path().extension() == ".png" && is_file(e.path()))
+            frames.push_back({e.path().stem().string(), e.path(), {}, {}});
+    }
+    if (ec) throw InputError(dir.string() + ": cannot list the folder (" + ec.message() + ")");
+    if (frames.empty()) throw InputError(what + ": no " + prefix + "*.png in " + dir.string());
+    std::sort(frames.begin(), frames.end(),
+              [](const FramePair& a, const FramePair& b) { return a.name < b.name; });
+    return frames;
+}
+
 bool kept(const EvalOptions& o, const std::string& name) {
     if (o.only.empty()) return true;
     return std::any_of(o.only.begin(), o.only.end(),
@@ -84,21 +108,26 @@ std::vector<FramePair> pair_frames(const EvalOptions& o) {
     if (!is_file(gt) && !is_dir(gt)) throw InputError(o.gt + ": ground truth not found");
     if (!is_file(pred) && !is_dir(pred)) throw InputError(o.pred + ": prediction not found");
 
+    if (is_dir(gt / "image_color") && !is_dir(gt / "annotation"))
+        throw InputError(o.gt + ": an OSD tree without annotation/ (its labels)");
     std::vector<FramePair> frames;
-    const bool single = !is_ocid_sequence(gt) && (is_file(gt) || is_file(gt / o.gt_file));
+    const bool dataset = is_ocid_sequence(gt) || is_osd_tree(gt) || is_bop_scene(gt);
+    const bool single = !dataset && (is_file(gt) || is_file(gt / o.gt_file));
     if (is_ocid_sequence(gt)) {
-        // OCID as downloaded: label/result_*.png, named by their stem as `wul3d run` names
-        // the frames.
-        std::error_code ec;
-        for (const auto& e : fs::directory_iterator(gt / "label", ec)) {
-            const std::string n = e.path().filename().string();
-            if (n.rfind("result_", 0) == 0 && e.path().extension() == ".png" && is_file(e.path()))
-                frames.push_back({e.path().stem().string(), e.path(), {}});
+        // Datasets as downloaded, their frames named as `wul3d run` names them: OCID's
+        // label/result_*.png and OSD's annotation/NAME.png by their stem, BOP's images by
+        // the image id of mask_visib/IMID_GTID.png.
+        frames = label_files(o.gt, gt / "label", "result_");
+    } else if (is_osd_tree(gt)) {
+        frames = label_files(o.gt, gt / "annotation", "");
+    } else if (is_bop_scene(gt)) {
+        for (BopImageMasks& m : list_bop_masks(o.gt)) {
+            FramePair f;
+            f.name = m.name;
+            f.gt = gt / "mask_visib" / (m.name + "_*.png");
+            f.bop = std::move(m);
+            frames.push_back(std::move(f));
         }
-        if (ec) throw InputError(o.gt + "/label: cannot list the folder (" + ec.message() + ")");
-        if (frames.empty()) throw InputError(o.gt + ": OCID sequence without label/result_*.png");
-        std::sort(frames.begin(), frames.end(),
-                  [](const FramePair& a, const FramePair& b) { return a.name < b.name; });
     } else if (single) {
         FramePair f;
         f.gt = is_file(gt) ? gt : gt / o.gt_file;
@@ -110,7 +139,7 @@ std::vector<FramePair> pair_frames(const EvalOptions& o) {
         std::error_code ec;
         for (const auto& e : fs::directory_iterator(gt, ec))
             if (e.is_directory() && is_file(e.path() / o.gt_file))
-                frames.push_back({e.path().filename().string(), e.path() / o.gt_file, {}});
+                frames.push_back({e.path().filename().string(), e.path() / o.gt_file, {}, {}});
         if (ec) throw InputError(o.gt + ": cannot list the folder (" + ec.message() + ")");
         if (frames.empty())
             throw InputError(o.gt + ": no " + o.gt_file +
@@ -188,7 +217,7 @@ void run(EvalOptions o) {
     nlohmann::json images = nlohmann::json::array();
     int missing = 0;
     for (const FramePair& f : frames) {
-        LabelImage gt = read_label_png(f.gt.string());
+        LabelImage gt = f.bop ? combine_bop_masks(*f.bop) : read_label_png(f.gt.string());
         if (o.gt_background_max > 0)
             for (std::uint16_t& l : gt.labels)
                 if (l <= o.gt_background_max) l = 0;
@@ -305,8 +334,9 @@ void add_eval_command(CLI::App& app) {
         ->required();
     cmd->add_option("gt", opts->gt,
                     "Ground truth: a folder of frame folders with label.png, one frame folder, "
-                    "one label PNG, or an OCID sequence (label/result_*.png; ids 0-2 on "
-                    "tables, 0-1 on the floor are background)")
+                    "one label PNG, an OCID sequence (label/result_*.png; ids 0-2 on "
+                    "tables, 0-1 on the floor are background), an OSD-0.2-depth tree "
+                    "(annotation/) or a BOP scene (mask_visib/ combined, gt id g -> label g+1)")
         ->required();
     cmd->add_option("--pred-file", opts->pred_file,
                     "Prediction file in each frame folder (labels.png scores raw clusters)")

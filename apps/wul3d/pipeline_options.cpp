@@ -69,7 +69,7 @@ void add_pipeline_options(CLI::App* cmd, PipelineOptions& o) {
     cmd->add_flag("--lossless", o.lossless,
                   "With --camera: capture waits for processing instead of dropping frames "
                   "(for replays: fakenect, .oni)");
-    cmd->add_option("--format", o.format, "auto|frames|tum|unregistered|bag|ocid|pcd")->capture_default_str();
+    cmd->add_option("--format", o.format, "auto|frames|tum|unregistered|bag|ocid|pcd|osd|bop")->capture_default_str();
     cmd->add_option("--topics", o.topics,
                     "ROS bag topics COLOR,DEPTH[,INFO] (default: detected; docs/INPUTS.md)");
     std::string presets;

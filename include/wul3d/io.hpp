@@ -85,6 +85,27 @@ enum class PcdData { Ascii, Binary, BinaryCompressed };
 /// the format read_pcd_frame reads: for tests, fuzz seeds and users' tools.
 void write_pcd(const std::string& path, const RgbdFrame& frame, PcdData data, bool with_rgb);
 
+// ---- BOP ground truth ----------------------------------------------------------------
+
+/// The largest scene_camera.json read: 64 MiB (a scene of some 100,000 images).
+inline constexpr std::uint64_t kMaxBopJsonBytes = std::uint64_t{1} << 26;
+
+/// One image of a BOP scene with ground truth: its name (the image id's file stem, as a
+/// FrameSource of the scene names the frame) and its masks, mask_visib/NAME_GTID.png, by
+/// gt id.
+struct BopImageMasks {
+    std::string name;
+    std::vector<int> gt_ids;          ///< ascending
+    std::vector<std::string> masks;   ///< the files, in the order of gt_ids
+};
+/// The images of the BOP scene folder `scene` that have masks in mask_visib/, sorted by
+/// name. InputError if mask_visib/ is missing or holds no IMID_GTID.png.
+std::vector<BopImageMasks> list_bop_masks(const std::string& scene);
+/// The masks of one image combined into an instance label image: the mask of gt id g
+/// (8 or 16-bit, non-zero inside) is label g + 1, 0 elsewhere; where masks overlap, the
+/// lowest gt id wins. InputError for masks of different sizes, or a gt id over 65534.
+LabelImage combine_bop_masks(const BopImageMasks& image);
+
 // ---- outputs (atomic: temporary name, then rename) ------------------------------------
 
 void write_label_png(const std::string& path, const LabelImage& labels);      ///< 16-bit
@@ -116,8 +137,10 @@ enum class InputFormat {
     Bag,           ///< a ROS 1 bag (wul3d/bag.hpp; only where built with librosbag)
     Ocid,          ///< one OCID sequence as downloaded: rgb/, depth/ [, label/, pcd/] of result_*.png
     Pcd,           ///< one organized PCD file (read_pcd_frame)
+    Osd,           ///< an OSD-0.2-depth tree: image_color/, disparity/ (mm) [, annotation/, pcd/]
+    Bop,           ///< one BOP scene: scene_camera.json, rgb/ or gray/, depth/ [, mask_visib/]
 };
-/// auto|frames|tum|unregistered|bag|ocid|pcd
+/// auto|frames|tum|unregistered|bag|ocid|pcd|osd|bop
 InputFormat parse_input_format(const std::string& name);
 const char* input_format_name(InputFormat format);       ///< the inverse of parse_input_format
 
@@ -163,8 +186,10 @@ public:
 /// Opens `path`. Auto-detection: a file that starts as a ROS bag does is a bag (bag.hpp);
 /// a file that starts with a PCD header is one frame (read_pcd_frame); a folder with rgb/
 /// and depth/ holding result_*.png is an OCID sequence (depth in mm, intrinsics from
-/// pcd/<first frame>.pcd or SourceOptions::intrinsics); a folder with rgb.txt and depth.txt
-/// is TUM; a folder
+/// pcd/<first frame>.pcd or SourceOptions::intrinsics); a folder with image_color/ is an
+/// OSD-0.2-depth tree (disparity/ in mm, intrinsics from pcd/<first frame>.pcd, else
+/// Kinect v1's); a folder with scene_camera.json is a BOP scene (per-image cam_K and
+/// depth_scale); a folder with rgb.txt and depth.txt is TUM; a folder
 /// with depth.png is one frame; a folder whose sub-folders hold depth.png is a sequence
 /// (sorted by name); either of the last two is Unregistered when a calibration is given or
 /// `calibration.json` lies beside the frames, else Frames. Throws InputError for a missing

@@ -2,8 +2,8 @@
 
     python3 -m wul3d.batch ROOT --out OUT [--scheduler ADDRESS | --workers N] [run options]
 
-Finds every sequence under ROOT (a TUM sequence, a folder of frame folders, or ROOT itself
-when it is one frame), runs each as one Dask task with wul3d.run (the library's run loop, the
+Finds every sequence under ROOT (a TUM sequence, an OCID sequence, an OSD-0.2-depth tree, a
+BOP scene, a folder of frame folders, or ROOT itself when it is one frame), runs each as one Dask task with wul3d.run (the library's run loop, the
 same outputs as `wul3d run`), and writes OUT/<sequence path relative to ROOT>/ in the layout
 of `wul3d run`, and OUT/batch.json with per-sequence and total figures and, where the
 frames carry label.png, the UOIS table.
@@ -130,6 +130,27 @@ def _is_tum(d) -> bool:
     return _is_file(os.path.join(d, "rgb.txt")) and _is_file(os.path.join(d, "depth.txt"))
 
 
+def _is_dir(path) -> bool:
+    st = _stat(path)
+    return st is not None and stat.S_ISDIR(st.st_mode)
+
+
+def _is_dataset_sequence(d) -> bool:
+    """A dataset as downloaded that `wul3d run` takes whole: an OCID sequence (rgb/ and
+    depth/ holding result_*.png), an OSD-0.2-depth tree (image_color/) or a BOP scene
+    (scene_camera.json)."""
+    if _is_dir(os.path.join(d, "image_color")) or _is_file(os.path.join(d, "scene_camera.json")):
+        return True
+    depth = os.path.join(d, "depth")
+    if not (_is_dir(os.path.join(d, "rgb")) and _is_dir(depth)):
+        return False
+    try:
+        with os.scandir(depth) as it:
+            return any(e.name.startswith("result_") and e.name.endswith(".png") for e in it)
+    except OSError:
+        return False
+
+
 class Discovery:
     """What discover found under a root: `sequences` (paths relative to the root, "/"
     separated, "." for the root itself; str as os.fsdecode gives them), `links` (the folders
@@ -145,7 +166,7 @@ def _discover(root) -> Discovery:
     st = _stat(root)
     if st is None or not stat.S_ISDIR(st.st_mode):
         raise FileNotFoundError(f"{text(root)}: no such folder")
-    if _is_tum(root) or _is_frame(root):
+    if _is_tum(root) or _is_frame(root) or _is_dataset_sequence(root):
         return Discovery(["."], [], [])
     # Every folder is listed once, by (device, inode): a link back into the tree (a loop)
     # or a second link to one folder adds nothing. Real folders first, then the folders
@@ -175,7 +196,7 @@ def _discover(root) -> Discovery:
             except OSError:
                 continue
             subdirs.append((e.name, (cst.st_dev, cst.st_ino), is_link))
-        if _is_tum(path):
+        if _is_tum(path) or _is_dataset_sequence(path):
             found.append(rel)
             return
         frames = {name for name, _, _ in subdirs if _is_frame(os.path.join(path, name))}
@@ -215,7 +236,8 @@ def _discover(root) -> Discovery:
 def discover(root) -> list:
     """The sequences under `root`, as paths relative to it ("." for root itself), sorted.
 
-    A TUM sequence (rgb.txt and depth.txt) is one sequence; a folder whose sub-folders are
+    A TUM sequence (rgb.txt and depth.txt), an OCID sequence, an OSD-0.2-depth tree or a
+    BOP scene (docs/INPUTS.md, sections 5 and 6) is one sequence; a folder whose sub-folders are
     frames (depth.png) is one sequence of those frames, as `wul3d run FOLDER` reads it; root
     itself being one frame is a sequence of one. Other folders are searched further (a
     folder can hold frames and sequences of its own). Hidden folders are skipped.
