@@ -2,11 +2,14 @@
 // the way back (expand_result) against the back-projection at the input's size.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 
 #include "bench_support.hpp"
 #include "wul3d/backprojection.hpp"
 #include "wul3d/decimation.hpp"
+#include "wul3d/io.hpp"
 #include "wul3d/pipeline.hpp"
 
 using namespace wul3d;
@@ -24,12 +27,14 @@ BENCHMARK(BM_DecimateFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 namespace {
 
-/// The four tabletop frames at the default decimation 2, each through the stages once on its
-/// decimated frame (a Pipeline at decimation 1 with the default's stage parameters, past its
-/// first frame): expand_result's inputs.
+/// The four tabletop frames (or the first 8 of the sequence WUL3D_BENCH_EXPAND_INPUT names,
+/// e.g. ../shared/data/osd_mosd) at the default decimation 2, each through the stages once
+/// on its decimated frame (a Pipeline at decimation 1 with the default's stage parameters,
+/// past its first frame): expand_result's inputs.
 struct ExpandInputs {
     PipelineParams params;  ///< the default: decimation 2
     ExpandParams expand;    ///< what expand_result takes of it, as the pipeline sets it
+    std::vector<RgbdFrame> frames;
     std::vector<RgbdFrame> decimated;
     std::vector<FrameResult> small;
 };
@@ -46,7 +51,17 @@ const ExpandInputs& expand_inputs() {
         PipelineParams stages = in.params.stage_params();
         stages.decimation = 1;
         Pipeline pipeline(stages);
-        for (const RgbdFrame& f : bench::tabletop_frames()) {
+        if (const char* input = std::getenv("WUL3D_BENCH_EXPAND_INPUT")) {
+            auto source = open_source(input, SourceOptions{});
+            SourceItem item;
+            for (std::size_t i = 0; i < std::min<std::size_t>(8, source->size()); ++i) {
+                source->read(i, item);
+                in.frames.push_back(item.frame);
+            }
+        } else {
+            in.frames = bench::tabletop_frames();
+        }
+        for (const RgbdFrame& f : in.frames) {
             RgbdFrame d;
             decimate_frame(f, in.params.decimation, d, &in.params.range);
             pipeline.process(d);
@@ -65,7 +80,7 @@ const ExpandInputs& expand_inputs() {
 // their per-iteration quotient (the way back should cost no more: ratio <= 1).
 static void BM_ExpandVsBackProject(benchmark::State& state) {
     const ExpandInputs& in = expand_inputs();
-    const std::vector<RgbdFrame>& frames = bench::tabletop_frames();
+    const std::vector<RgbdFrame>& frames = in.frames;
     ExpandWorkspace ws;
     FrameResult out;
     OrganizedCloud cloud;
