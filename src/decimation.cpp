@@ -192,94 +192,18 @@ void DecimatedSource::use_colour_at_edges(const std::uint8_t* input_rgb,
     vote(block_labels, block_source.data());
 }
 
-namespace {
-
-// The vote's grid: offsets -4, -2, 0, 2, 4 blocks in each direction. On the OSD learn frames
-// it scored as the whole 9 x 9 window did, with a third of the votes (docs/DESIGN.md).
-constexpr int kVoteStep = 2, kVoteReach = 4, kVotes = 25;
-
-/// One edge block's vote as it runs: its label, depth tolerance and colour, the weight of
-/// its own label and of the others, and the block nearest in colour among the others'.
-struct VoteState {
-    std::int32_t b;
-    float z, tolerance;
-    int c0, c1, c2;
-    std::uint16_t own;
-    float own_total, other_total;
-    int nearest_d;
-    std::int32_t nearest;
-};
-
-/// The images and limits the vote reads.
-struct VoteInputs {
-    const std::uint16_t* small;
-    const std::uint8_t* small_rgb;
-    const std::uint16_t* labels;
-    const float* weight;
-    float same, same_rel;
-};
-
-VoteState start_vote(const VoteInputs& in, std::int32_t b) {
-    const float z = in.small[b];
-    const std::uint8_t* const c = in.small_rgb + 3 * static_cast<std::size_t>(b);
-    return {b, z, in.same + in.same_rel * z * z, c[0], c[1], c[2], in.labels[b], 0.0f, 0.0f,
-            std::numeric_limits<int>::max(), b};
-}
-
-/// Block q's vote into s. Without a branch (pick, masks): whether a block is on the surface
-/// or of the label follows no pattern a predictor learns. A vote off the surface adds 0,
-/// which leaves a sum as it is: the same sums as with a skip.
-inline void add_vote(const VoteInputs& in, std::int32_t q, VoteState& s) {
-    const float depth = in.small[q];
-    const bool on = (depth != 0) & (std::fabs(depth - s.z) <= s.tolerance);
-    const std::uint8_t* const c = in.small_rgb + 3 * static_cast<std::size_t>(q);
-    const int dr = s.c0 - c[0], dg = s.c1 - c[1], db = s.c2 - c[2];
-    const int d = dr * dr + dg * dg + db * db;
-    const float wq = in.weight[std::min(d >> kWeightShift, kWeights - 1)];
-    const bool mine = in.labels[q] == s.own;
-    s.own_total += detail::pick(on & mine, wq, 0.0f);
-    s.other_total += detail::pick(on & !mine, wq, 0.0f);
-    const int nearer = -static_cast<int>(on & !mine & (d < s.nearest_d));
-    s.nearest_d = (d & nearer) | (s.nearest_d & ~nearer);
-    s.nearest = (q & nearer) | (s.nearest & ~nearer);
-}
-
-/// Another label wins only with more weight than its own.
-std::int32_t vote_result(const VoteState& s) { return s.other_total > s.own_total ? s.nearest : s.b; }
-
-}  // namespace
-
 void DecimatedSource::vote(const std::uint16_t* labels, std::int32_t* source) const {
-    const VoteInputs in{small_, small_rgb_, labels, vote_weights().data(), same_, same_rel_};
+    // The grid: offsets -4, -2, 0, 2, 4 blocks in each direction. On the OSD learn frames
+    // it scored as the whole 9 x 9 window did, with a third of the votes (docs/DESIGN.md).
+    constexpr int kStep = 2, kReach = 4;
+    const float* const weight = vote_weights().data();
+    // Locals: members read after each store could have changed (char aliasing).
     const int w = w_, h = h_;
-    const std::uint8_t* const edges = edges_;
-    // The grid's offsets of a block whose whole grid lies in the image, in the votes' order.
-    std::array<std::int32_t, kVotes> offsets{};
-    for (int k = 0; k < kVotes; ++k)
-        offsets[static_cast<std::size_t>(k)] =
-            (k / 5 * kVoteStep - kVoteReach) * w + (k % 5 * kVoteStep - kVoteReach);
+    const float same = same_, same_rel = same_rel_;
+    const std::uint16_t* const small = small_;
+    const std::uint8_t *const small_rgb = small_rgb_, *const edges = edges_;
 #pragma omp parallel for schedule(dynamic, 8)
     for (int bv = 0; bv < h; ++bv) {
-        // The other labels vote together (an outline mostly parts two; counting each apart
-        // scored the same on osd_mosd), and the block nearest in colour among theirs speaks
-        // for them. Blocks inside the image by the grid's reach vote in batches of kLanes:
-        // one vote of each in turn, so that their sums (each a chain of dependent adds)
-        // advance side by side; each block's own votes keep their order: the same sums.
-        constexpr int kLanes = 8;
-        std::array<VoteState, kLanes> lanes;
-        int n_lanes = 0;
-        auto run_lanes = [&] {
-            for (int k = 0; k < kVotes; ++k)
-                for (int l = 0; l < n_lanes; ++l)
-                    add_vote(in, lanes[static_cast<std::size_t>(l)].b + offsets[static_cast<std::size_t>(k)],
-                             lanes[static_cast<std::size_t>(l)]);
-            for (int l = 0; l < n_lanes; ++l) {
-                const VoteState& st = lanes[static_cast<std::size_t>(l)];
-                source[st.b] = vote_result(st);
-            }
-            n_lanes = 0;
-        };
-        const bool inner_row = bv >= kVoteReach && bv + kVoteReach < h;
         // Only edge blocks are looked up (search): found by memchr, not a test per block.
         const std::uint8_t* const row = edges + static_cast<std::size_t>(bv) * w;
         for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(row, 1, static_cast<std::size_t>(w)));
@@ -288,22 +212,42 @@ void DecimatedSource::vote(const std::uint16_t* labels, std::int32_t* source) co
             const int bu = static_cast<int>(at - row);
             const std::int32_t b = bv * w + bu;
             source[b] = b;
-            if (in.small[b] == 0) continue;
-            if (inner_row && bu >= kVoteReach && bu + kVoteReach < w) {
-                lanes[static_cast<std::size_t>(n_lanes++)] = start_vote(in, b);
-                if (n_lanes == kLanes) run_lanes();
-                continue;
-            }
-            // Near the border: the grid's offsets that stay inside the image.
-            VoteState st = start_vote(in, b);
-            const int v_first = bv - std::min(kVoteReach, bv / kVoteStep * kVoteStep);
-            const int u_first = bu - std::min(kVoteReach, bu / kVoteStep * kVoteStep);
-            const int v_last = std::min(h - 1, bv + kVoteReach), u_last = std::min(w - 1, bu + kVoteReach);
-            for (int qv = v_first; qv <= v_last; qv += kVoteStep)
-                for (int qu = u_first; qu <= u_last; qu += kVoteStep) add_vote(in, qv * w + qu, st);
-            source[b] = vote_result(st);
+            if (small[b] == 0) continue;
+            const float z = small[b], tolerance = same + same_rel * z * z;
+            const std::uint8_t* const c = small_rgb + 3 * static_cast<std::size_t>(b);
+            const int c0 = c[0], c1 = c[1], c2 = c[2];
+            const std::uint16_t own = labels[b];
+            // The other labels vote together (an outline mostly parts two; counting each apart
+            // scored the same on osd_mosd), and the block nearest in colour among theirs
+            // speaks for them. Without a branch per vote (pick, masks): whether a block is on
+            // the surface or of the label follows no pattern a predictor learns. A vote off
+            // the surface adds 0, which leaves a sum as it is: the same sums as with a skip.
+            float own_total = 0, other_total = 0;
+            int nearest_d = std::numeric_limits<int>::max();
+            std::int32_t nearest = b;
+            // The grid's offsets that stay inside the image.
+            const int v_first = bv - std::min(kReach, bv / kStep * kStep);
+            const int u_first = bu - std::min(kReach, bu / kStep * kStep);
+            const int v_last = std::min(h - 1, bv + kReach), u_last = std::min(w - 1, bu + kReach);
+            for (int qv = v_first; qv <= v_last; qv += kStep)
+                for (int qu = u_first; qu <= u_last; qu += kStep) {
+                    const std::int32_t q = qv * w + qu;
+                    const float depth = small[q];
+                    const bool on = (depth != 0) & (std::fabs(depth - z) <= tolerance);
+                    const std::uint8_t* const s = small_rgb + 3 * static_cast<std::size_t>(q);
+                    const int dr = c0 - s[0], dg = c1 - s[1], db = c2 - s[2];
+                    const int d = dr * dr + dg * dg + db * db;
+                    const float wq = weight[std::min(d >> kWeightShift, kWeights - 1)];
+                    const bool mine = labels[q] == own;
+                    own_total += detail::pick(on & mine, wq, 0.0f);
+                    other_total += detail::pick(on & !mine, wq, 0.0f);
+                    const int nearer = -static_cast<int>(on & !mine & (d < nearest_d));
+                    nearest_d = (d & nearer) | (nearest_d & ~nearer);
+                    nearest = (q & nearer) | (nearest & ~nearer);
+                }
+            // Another label wins only with more weight than its own.
+            if (other_total > own_total) source[b] = nearest;
         }
-        run_lanes();
     }
 }
 
@@ -548,15 +492,6 @@ void blend_row16(const std::uint8_t* __restrict code, const std::uint16_t* __res
         out[u] = static_cast<std::uint16_t>((own[u] & m) | (none & ~m));
     }
 }
-WUL3D_AVX2_CLONES
-void blend_row8(const std::uint8_t* __restrict code, const std::uint8_t* __restrict own, std::uint8_t none,
-                int W, std::uint8_t* __restrict out) {
-    for (int u = 0; u < W; ++u) {
-        const auto m = static_cast<std::uint8_t>(-static_cast<int>(code[u] == kOwnBlock));
-        out[u] = static_cast<std::uint8_t>((own[u] & m) | (none & ~m));
-    }
-}
-
 /// active[u] = 1 on the pixels that take their own block (an active block: the others are
 /// not taken as they are), else 0 (a searched pixel is written again); returns their count.
 WUL3D_AVX2_CLONES
@@ -566,6 +501,32 @@ unsigned active_row(const std::uint8_t* __restrict code, int W, std::uint8_t* __
         const std::uint8_t a = code[u] == kOwnBlock;
         active[u] = a;
         count += a;
+    }
+    return count;
+}
+
+/// The object stages' results and the active flags of a row in one pass (blend_row16 on
+/// each, and active_row): the block row's labels, segments, objects and plane
+/// classes where code[u] is kOwnBlock, else 0 (kPlaneRemoved for the classes). Returns the
+/// pixels made active.
+WUL3D_AVX2_CLONES
+unsigned object_row(const std::uint8_t* __restrict code, const std::uint16_t* __restrict labels,
+                    const std::uint16_t* __restrict segments, const std::uint16_t* __restrict objects,
+                    const std::uint8_t* __restrict classes, int W, std::uint16_t* __restrict out_labels,
+                    std::uint16_t* __restrict out_segments, std::uint16_t* __restrict out_objects,
+                    std::uint8_t* __restrict out_classes, std::uint8_t* __restrict active) {
+    static_assert(kPlaneRemoved == 0, "no point's class is the masks' 0");
+    unsigned count = 0;
+    for (int u = 0; u < W; ++u) {
+        const std::uint8_t own = code[u] == kOwnBlock;
+        const auto m16 = static_cast<std::uint16_t>(-static_cast<int>(own));
+        const auto m8 = static_cast<std::uint8_t>(-static_cast<int>(own));
+        out_labels[u] = static_cast<std::uint16_t>(labels[u] & m16);
+        out_segments[u] = static_cast<std::uint16_t>(segments[u] & m16);
+        out_objects[u] = static_cast<std::uint16_t>(objects[u] & m16);
+        out_classes[u] = static_cast<std::uint8_t>(classes[u] & m8);
+        active[u] = own;
+        count += own;
     }
     return count;
 }
@@ -671,14 +632,12 @@ void widen_block_row(const PixelArrays& a, int bv, int w, int factor, int W, Exp
 /// it made active.
 unsigned write_row(const PixelArrays& a, ExpandBuffers::BlockRow& b, std::size_t row, int W) {
     const std::uint8_t* const code = b.code.data();
-    blend_row16(code, b.labels.data(), 0, W, a.labels + row);
     colour_row(code, b.rgb.data(), a.frame_rgb ? a.frame_rgb + 3 * row : nullptr, W, b.grey.data(), b.mask3.data(),
                b.grey3.data(), a.colors + 3 * row);
-    if (a.with_objects) {
-        blend_row8(code, b.classes.data(), kPlaneRemoved, W, a.classes + row);
-        blend_row16(code, b.segments.data(), 0, W, a.segments + row);
-        blend_row16(code, b.objects.data(), 0, W, a.objects + row);
-    }
+    if (a.with_objects)
+        return object_row(code, b.labels.data(), b.segments.data(), b.objects.data(), b.classes.data(), W,
+                          a.labels + row, a.segments + row, a.objects + row, a.classes + row, a.active + row);
+    blend_row16(code, b.labels.data(), 0, W, a.labels + row);
     return active_row(code, W, a.active + row);
 }
 
