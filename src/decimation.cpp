@@ -5,11 +5,14 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "branch_free.hpp"
+#include "decimated_source.hpp"
 #include "param_check.hpp"
 #include "wul3d/error.hpp"
-#include "wul3d/pipeline.hpp"
+#include "wul3d/frame_result.hpp"
 #include "wul3d/visualization.hpp"
 
 namespace wul3d {
@@ -38,7 +41,23 @@ const std::array<float, kWeights>& vote_weights() {
 /// default factor 2 has its own loop, which the compiler vectorizes; others go one column
 /// of each block at a time (no division per column).
 template <int channels, class T>
-void widen_row(const T* blocks, int factor, int n, T* out) {
+void widen_row(const T* __restrict blocks, int factor, int n, T* __restrict out) {
+    if (channels == 3 && sizeof(T) == 1 && factor == 2 && n >= 4) {
+        // RGB bytes, which GCC does not load as vectors: each block's triple read as 4 bytes
+        // and stored twice as 4, overlapping (the 4th byte of each store is overwritten by
+        // the next one). The last block goes by the loop below: nothing read or written
+        // past the rows.
+        const int last = (n - 1) / 2;
+        for (int b = 0; b < last; ++b) {
+            std::uint32_t x;
+            std::memcpy(&x, blocks + 3 * b, 4);
+            std::memcpy(out + 6 * b, &x, 4);
+            std::memcpy(out + 6 * b + 3, &x, 4);
+        }
+        for (int u = 2 * last; u < n; ++u)
+            for (int c = 0; c < channels; ++c) out[channels * u + c] = blocks[channels * last + c];
+        return;
+    }
     if (factor == 2) {
         for (int b = 0; b < n / 2; ++b)
             for (int c = 0; c < channels; ++c)
@@ -50,26 +69,6 @@ void widen_row(const T* blocks, int factor, int n, T* out) {
     for (int k = 0; k < factor; ++k)
         for (int b = 0, u = k; u < n; ++b, u += factor)
             for (int c = 0; c < channels; ++c) out[channels * u + c] = blocks[channels * b + c];
-}
-
-/// The limits of takes_own_block's test.
-struct OwnBlockTest {
-    float same, same_rel, scale, zmin, zmax;
-};
-
-/// takes_own[u] = 1 where pixel u's depth `full[u]` (units) and its block's `block[u]` are
-/// both there, on one surface (same_surface) and in range (DepthRange::contains), with the
-/// same float operations: the same answers. `&`, not `&&`: a branch per pixel would keep
-/// the loop from vectorizing. Built for AVX2 and baseline x86-64 (no FMA either way).
-/// Cost: one pass over the W pixels.
-WUL3D_AVX2_CLONES
-void takes_own_block(const std::uint16_t* __restrict full, const float* __restrict block, int W, OwnBlockTest t,
-                     std::uint8_t* __restrict takes_own) {
-    for (int u = 0; u < W; ++u) {
-        const float z = full[u], b = block[u], metres = z * t.scale;
-        takes_own[u] = (z != 0) & (b != 0) & (std::fabs(b - z) <= t.same + t.same_rel * z * z) &
-                       (metres >= t.zmin) & (metres <= t.zmax);
-    }
 }
 
 }  // namespace
@@ -198,45 +197,58 @@ void DecimatedSource::vote(const std::uint16_t* labels, std::int32_t* source) co
     // it scored as the whole 9 x 9 window did, with a third of the votes (docs/DESIGN.md).
     constexpr int kStep = 2, kReach = 4;
     const float* const weight = vote_weights().data();
+    // Locals: members read after each store could have changed (char aliasing).
+    const int w = w_, h = h_;
+    const float same = same_, same_rel = same_rel_;
+    const std::uint16_t* const small = small_;
+    const std::uint8_t *const small_rgb = small_rgb_, *const edges = edges_;
 #pragma omp parallel for schedule(dynamic, 8)
-    for (int bv = 0; bv < h_; ++bv)
-        for (int bu = 0; bu < w_; ++bu) {
-            const std::int32_t b = bv * w_ + bu;
-            if (!edges_[b]) continue;  // only edge blocks are looked up (search)
+    for (int bv = 0; bv < h; ++bv) {
+        // Only edge blocks are looked up (search): found by memchr, not a test per block.
+        const std::uint8_t* const row = edges + static_cast<std::size_t>(bv) * w;
+        for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(row, 1, static_cast<std::size_t>(w)));
+             at != nullptr;
+             at = static_cast<const std::uint8_t*>(std::memchr(at + 1, 1, static_cast<std::size_t>(row + w - at - 1)))) {
+            const int bu = static_cast<int>(at - row);
+            const std::int32_t b = bv * w + bu;
             source[b] = b;
-            if (small_[b] == 0) continue;
-            const float z = small_[b], tolerance = same_ + same_rel_ * z * z;
-            const std::uint8_t* const c = small_rgb_ + 3 * static_cast<std::size_t>(b);
+            if (small[b] == 0) continue;
+            const float z = small[b], tolerance = same + same_rel * z * z;
+            const std::uint8_t* const c = small_rgb + 3 * static_cast<std::size_t>(b);
+            const int c0 = c[0], c1 = c[1], c2 = c[2];
             const std::uint16_t own = labels[b];
             // The other labels vote together (an outline mostly parts two; counting each apart
             // scored the same on osd_mosd), and the block nearest in colour among theirs
-            // speaks for them.
+            // speaks for them. Without a branch per vote (pick, masks): whether a block is on
+            // the surface or of the label follows no pattern a predictor learns. A vote off
+            // the surface adds 0, which leaves a sum as it is: the same sums as with a skip.
             float own_total = 0, other_total = 0;
             int nearest_d = std::numeric_limits<int>::max();
             std::int32_t nearest = b;
             // The grid's offsets that stay inside the image.
             const int v_first = bv - std::min(kReach, bv / kStep * kStep);
             const int u_first = bu - std::min(kReach, bu / kStep * kStep);
-            const int v_last = std::min(h_ - 1, bv + kReach), u_last = std::min(w_ - 1, bu + kReach);
+            const int v_last = std::min(h - 1, bv + kReach), u_last = std::min(w - 1, bu + kReach);
             for (int qv = v_first; qv <= v_last; qv += kStep)
                 for (int qu = u_first; qu <= u_last; qu += kStep) {
-                    const std::int32_t q = qv * w_ + qu;
-                    const float depth = small_[q];
-                    const bool on = depth != 0 && std::fabs(depth - z) <= tolerance;
-                    const std::uint8_t* const s = small_rgb_ + 3 * static_cast<std::size_t>(q);
-                    const int dr = c[0] - s[0], dg = c[1] - s[1], db = c[2] - s[2];
+                    const std::int32_t q = qv * w + qu;
+                    const float depth = small[q];
+                    const bool on = (depth != 0) & (std::fabs(depth - z) <= tolerance);
+                    const std::uint8_t* const s = small_rgb + 3 * static_cast<std::size_t>(q);
+                    const int dr = c0 - s[0], dg = c1 - s[1], db = c2 - s[2];
                     const int d = dr * dr + dg * dg + db * db;
-                    const float w = on ? weight[std::min(d >> kWeightShift, kWeights - 1)] : 0.0f;
+                    const float wq = weight[std::min(d >> kWeightShift, kWeights - 1)];
                     const bool mine = labels[q] == own;
-                    own_total += mine ? w : 0.0f;
-                    other_total += mine ? 0.0f : w;
-                    const bool nearer = on && !mine && d < nearest_d;
-                    nearest_d = nearer ? d : nearest_d;
-                    nearest = nearer ? q : nearest;
+                    own_total += detail::pick(on & mine, wq, 0.0f);
+                    other_total += detail::pick(on & !mine, wq, 0.0f);
+                    const int nearer = -static_cast<int>(on & !mine & (d < nearest_d));
+                    nearest_d = (d & nearer) | (nearest_d & ~nearer);
+                    nearest = (q & nearer) | (nearest & ~nearer);
                 }
             // Another label wins only with more weight than its own.
             if (other_total > own_total) source[b] = nearest;
         }
+    }
 }
 
 std::int32_t DecimatedSource::search(int u, int v, int bu, int bv, float z, bool on_own) const {
@@ -288,30 +300,6 @@ std::int32_t DecimatedSource::nearest_in_depth(int bu, int bv, float z, const st
     return best;
 }
 
-void DecimatedSource::own_blocks_of_row(int v, const std::uint8_t* usable, const DepthRange* range,
-                                        float* scratch, std::uint8_t* takes_own) const {
-    // Locals: members read after each byte stored could have changed (char aliasing).
-    const int factor = factor_, W = W_;
-    const float same = same_, same_rel = same_rel_, scale = scale_;
-    const float zmin = range ? range->zmin_m : -std::numeric_limits<float>::infinity();
-    const float zmax = range ? range->zmax_m : std::numeric_limits<float>::infinity();
-    const std::size_t first_block = static_cast<std::size_t>(v / factor) * w_;
-    const std::uint16_t* const small = small_ + first_block;
-    const std::uint8_t* const edges = edges_ ? edges_ + first_block : nullptr;
-    if (usable) usable += first_block;
-    // Each block's depth, 0 where its pixels cannot take it as it is: no depth (no
-    // surface), an edge block (searched) or not usable; into scratch's tail, then over the
-    // block's columns.
-    float* const per_block = scratch + W;
-    for (int bu = 0; bu < w_; ++bu) {
-        const bool as_is = !(edges && edges[bu]) && !(usable && !usable[bu]);
-        per_block[bu] = as_is ? static_cast<float>(small[bu]) : 0.0f;
-    }
-    widen_row<1>(per_block, factor, W, scratch);
-    takes_own_block(full_ + static_cast<std::size_t>(v) * W, scratch, W, {same, same_rel, scale, zmin, zmax},
-                    takes_own);
-}
-
 // ---- the way back: expand_result --------------------------------------------------------
 
 namespace {
@@ -348,13 +336,16 @@ struct ExpandBuffers {
     std::vector<std::uint16_t> edge_lo, edge_hi;  ///< their 3-wide row minima and maxima
     std::vector<std::int32_t> block_source;       ///< each edge block's source after the colour vote
     /// One block row's results repeated over the input's columns (each block's over its
-    /// factor columns): each input row of the block row starts as a copy of it. One per band.
+    /// factor columns), and its depth where its pixels may take it as it is: what each input
+    /// row of the block row takes from its own block. One per band.
     struct BlockRow {
         int bv = -1;  ///< the block row it holds
         std::vector<std::uint16_t> labels, segments, objects;
-        std::vector<std::uint8_t> rgb, active, classes;
-        std::vector<float> scratch;           ///< own_blocks_of_row's (W + w)
-        std::vector<std::uint8_t> takes_own;  ///< own_blocks_of_row's
+        std::vector<std::uint8_t> rgb, classes;
+        std::vector<float> depth;         ///< 0 where the block cannot be taken as it is
+        std::vector<float> block_depth;   ///< depth, one per block (w)
+        std::vector<std::uint8_t> code;   ///< per input column: a PixelSource
+        std::vector<std::uint8_t> grey, mask3, grey3;  ///< colour_row's (W, 3 W, 3 W)
     };
     std::vector<BlockRow> band_rows;
 };
@@ -450,10 +441,142 @@ void prepare_bands(const std::vector<DetectedObject>& objects, int W, int H, int
         b.segments.resize(with_objects ? n_row : 0);
         b.objects.resize(with_objects ? n_row : 0);
         b.rgb.resize(3 * n_row);
-        b.active.resize(n_row);
         b.classes.resize(with_objects ? n_row : 0);
-        b.scratch.resize(n_row + static_cast<std::size_t>(w));
-        b.takes_own.resize(n_row);
+        b.depth.resize(n_row);
+        b.block_depth.resize(static_cast<std::size_t>(w));
+        b.code.resize(n_row);
+        b.grey.resize(n_row);
+        b.mask3.resize(3 * n_row);
+        b.grey3.resize(3 * n_row);
+    }
+}
+
+/// Where an input pixel takes its results from (expand_bands' code per column).
+enum PixelSource : std::uint8_t {
+    kNoPoint = 0,   ///< no depth, or out of the range: no point
+    kOwnBlock = 1,  ///< its own block as it is (nearly every pixel with depth)
+    kSearch = 2,    ///< another block, or none: DecimatedSource's search, one pixel at a time
+};
+
+/// The limits of source_codes' test.
+struct SourceTest {
+    float same, same_rel, scale, zmin, zmax;
+};
+
+/// code[u] for pixel u of a row: kOwnBlock where its depth `full[u]` (units) and its block's
+/// `block[u]` (0: not to be taken as it is) are both there, on one surface (same_surface) and
+/// in range (DepthRange::contains), with the same float operations: the same answers; else
+/// kNoPoint without depth or out of range; else kSearch. `&`, not `&&`: a branch per pixel
+/// would keep the loop from vectorizing. Built for AVX2 and baseline x86-64 (no FMA either
+/// way). Cost: one pass over the W pixels.
+WUL3D_AVX2_CLONES
+void source_codes(const std::uint16_t* __restrict full, const float* __restrict block, int W, SourceTest t,
+                  std::uint8_t* __restrict code) {
+    for (int u = 0; u < W; ++u) {
+        const float z = full[u], b = block[u], metres = z * t.scale;
+        const int point = (z != 0) & (metres >= t.zmin) & (metres <= t.zmax);
+        const int own = point & (b != 0) & (std::fabs(b - z) <= t.same + t.same_rel * z * z);
+        code[u] = static_cast<std::uint8_t>(point + point - own);  // 0, 1 (own) or 2
+    }
+}
+
+/// out[u] = own[u] where code[u] is kOwnBlock, else `none`: the block row's values on the
+/// pixels that take their own block, the no-point value on the others (the searched ones are
+/// written again). By a mask, not `?:`, which GCC makes a branch around the load: the loops
+/// vectorize (AVX2 and baseline clones).
+WUL3D_AVX2_CLONES
+void blend_row16(const std::uint8_t* __restrict code, const std::uint16_t* __restrict own, std::uint16_t none,
+                 int W, std::uint16_t* __restrict out) {
+    for (int u = 0; u < W; ++u) {
+        const auto m = static_cast<std::uint16_t>(-static_cast<int>(code[u] == kOwnBlock));
+        out[u] = static_cast<std::uint16_t>((own[u] & m) | (none & ~m));
+    }
+}
+/// active[u] = 1 on the pixels that take their own block (an active block: the others are
+/// not taken as they are), else 0 (a searched pixel is written again); returns their count.
+WUL3D_AVX2_CLONES
+unsigned active_row(const std::uint8_t* __restrict code, int W, std::uint8_t* __restrict active) {
+    unsigned count = 0;
+    for (int u = 0; u < W; ++u) {
+        const std::uint8_t a = code[u] == kOwnBlock;
+        active[u] = a;
+        count += a;
+    }
+    return count;
+}
+
+/// The object stages' results and the active flags of a row in one pass (blend_row16 on
+/// each, and active_row): the block row's labels, segments, objects and plane
+/// classes where code[u] is kOwnBlock, else 0 (kPlaneRemoved for the classes). Returns the
+/// pixels made active.
+WUL3D_AVX2_CLONES
+unsigned object_row(const std::uint8_t* __restrict code, const std::uint16_t* __restrict labels,
+                    const std::uint16_t* __restrict segments, const std::uint16_t* __restrict objects,
+                    const std::uint8_t* __restrict classes, int W, std::uint16_t* __restrict out_labels,
+                    std::uint16_t* __restrict out_segments, std::uint16_t* __restrict out_objects,
+                    std::uint8_t* __restrict out_classes, std::uint8_t* __restrict active) {
+    static_assert(kPlaneRemoved == 0, "no point's class is the masks' 0");
+    unsigned count = 0;
+    for (int u = 0; u < W; ++u) {
+        const std::uint8_t own = code[u] == kOwnBlock;
+        const auto m16 = static_cast<std::uint16_t>(-static_cast<int>(own));
+        const auto m8 = static_cast<std::uint8_t>(-static_cast<int>(own));
+        out_labels[u] = static_cast<std::uint16_t>(labels[u] & m16);
+        out_segments[u] = static_cast<std::uint16_t>(segments[u] & m16);
+        out_objects[u] = static_cast<std::uint16_t>(objects[u] & m16);
+        out_classes[u] = static_cast<std::uint8_t>(classes[u] & m8);
+        active[u] = own;
+        count += own;
+    }
+    return count;
+}
+
+/// The colours of `n` pixels: the block row's (`own`, RGB) where code[u] is kOwnBlock, else
+/// the input pixel's dimmed grey (visualization.hpp; 0 without colour: `frame_rgb`
+/// nullptr). The grey's float operations are dimmed_grey's, in its order: the same bytes.
+/// In passes that vectorize (GCC does not load RGB triples as vectors, but stores them):
+/// the greys into `grey` (n), each pixel's mask and masked grey three times over into
+/// `mask3` and `grey3` (3 n each), then the choice byte by byte.
+WUL3D_AVX2_CLONES
+void colour_pixels(const std::uint8_t* __restrict code, const std::uint8_t* __restrict own,
+                   const std::uint8_t* __restrict frame_rgb, int n, std::uint8_t* __restrict grey,
+                   std::uint8_t* __restrict mask3, std::uint8_t* __restrict grey3, std::uint8_t* __restrict out) {
+    if (frame_rgb == nullptr)
+        std::memset(grey, 0, static_cast<std::size_t>(n));
+    else
+        for (int u = 0; u < n; ++u) {
+            const float g = 0.299f * frame_rgb[3 * u] + 0.587f * frame_rgb[3 * u + 1] + 0.114f * frame_rgb[3 * u + 2];
+            grey[u] = static_cast<std::uint8_t>(g * 0.35f);
+        }
+    for (int u = 0; u < n; ++u) {
+        const auto m = static_cast<std::uint8_t>(-static_cast<int>(code[u] == kOwnBlock));
+        const auto dim = static_cast<std::uint8_t>(grey[u] & ~m);
+        mask3[3 * u] = mask3[3 * u + 1] = mask3[3 * u + 2] = m;
+        grey3[3 * u] = grey3[3 * u + 1] = grey3[3 * u + 2] = dim;
+    }
+    for (int i = 0; i < 3 * n; ++i) out[i] = static_cast<std::uint8_t>((own[i] & mask3[i]) | grey3[i]);
+}
+
+/// Whether all of code[0, n) is kOwnBlock (a reduction that vectorizes).
+WUL3D_AVX2_CLONES
+bool all_own(const std::uint8_t* __restrict code, int n) {
+    unsigned other = 0;
+    for (int u = 0; u < n; ++u) other |= code[u] ^ kOwnBlock;
+    return other == 0;
+}
+
+/// colour_pixels on a row of W pixels, by chunks of 64: a chunk whose pixels all take their
+/// own block is a copy of the block row's colours (no grey to compute): most of a scene.
+void colour_row(const std::uint8_t* code, const std::uint8_t* own, const std::uint8_t* frame_rgb, int W,
+                std::uint8_t* grey, std::uint8_t* mask3, std::uint8_t* grey3, std::uint8_t* out) {
+    constexpr int kChunk = 64;
+    for (int u = 0; u < W; u += kChunk) {
+        const int n = std::min(kChunk, W - u);
+        if (all_own(code + u, n))
+            std::memcpy(out + 3 * u, own + 3 * u, 3 * static_cast<std::size_t>(n));
+        else
+            colour_pixels(code + u, own + 3 * u, frame_rgb ? frame_rgb + 3 * u : nullptr, n, grey, mask3, grey3,
+                          out + 3 * u);
     }
 }
 
@@ -462,37 +585,79 @@ void prepare_bands(const std::vector<DetectedObject>& objects, int W, int H, int
 /// data pointer. Copied by value into each band's closures for the same reason.
 struct PixelArrays {
     const std::uint8_t* frame_rgb;  ///< the input's colour, or nullptr
+    const std::uint16_t* in_depth;  ///< the decimated depth
     const std::uint16_t *in_labels, *in_segments, *in_objects;
     const std::uint8_t *in_rgb, *in_active, *in_classes;
+    const std::uint8_t* edges;  ///< the edge blocks
     std::uint16_t *labels, *segments, *objects;
     std::uint8_t *colors, *active, *classes;
     bool with_objects;
 };
 
-PixelArrays pixel_arrays(const RgbdView& frame, const FrameResult& s, bool with_objects, FrameResult& r) {
+PixelArrays pixel_arrays(const RgbdView& frame, const RgbdFrame& decimated, const FrameResult& s,
+                         const ExpandBuffers& buf, bool with_objects, FrameResult& r) {
     return {frame.has_color() && frame.color_matches() ? frame.rgb : nullptr,
+            decimated.depth.data.data(),
             s.labels.labels.data(), s.segments.labels.data(), s.objects.labels.data(),
             s.colors.rgb.data(), s.active.data(), s.plane_classes.data(),
+            buf.edge_blocks.data(),
             r.labels.labels.data(), r.segments.labels.data(), r.objects.labels.data(),
             r.colors.rgb.data(), r.active.data(), r.plane_classes.data(), with_objects};
 }
 
-/// 4. Every input pixel's results, band by band of rows in parallel. Per row: first every
-/// pixel from its own block (nearly every pixel's source: a plain copy of the block row,
-/// each block's results loaded once), then the pixels whose source is another block or none
-/// (no depth, off their block's surface, at an outline, out of the range or on a block out
-/// of it) written again; last the row's count of active pixels and each object's runs,
-/// into the band's counts and boxes (reduced in band order by count_objects). A pixel is in
-/// the depth range by its own depth, as at every pixel (select_depth_range): the block it
-/// takes can lie on the other side of a limit. In range, on a block that is not, it takes
-/// the nearest in depth of the 3 x 3 blocks that are (its own is: the frame was decimated
-/// to blocks in range where they could be); out of range, none. O(W H), one parallel pass.
+/// Block row bv into `row`: its results over the input's W columns, and its depth (float,
+/// as the surface test reads it) where its pixels may take it as it is: not an edge block
+/// (searched) and active (an inactive block is no pixel's source). O(W).
+void widen_block_row(const PixelArrays& a, int bv, int w, int factor, int W, ExpandBuffers::BlockRow& row) {
+    const std::size_t first = static_cast<std::size_t>(bv) * w;
+    float* const block_depth = row.block_depth.data();
+    for (int bu = 0; bu < w; ++bu) {
+        const std::size_t b = first + static_cast<std::size_t>(bu);
+        const bool as_is = (a.edges[b] == 0) & (a.in_active[b] != 0);
+        block_depth[bu] = detail::pick(as_is, static_cast<float>(a.in_depth[b]), 0.0f);
+    }
+    widen_row<1>(block_depth, factor, W, row.depth.data());
+    widen_row<1>(a.in_labels + first, factor, W, row.labels.data());
+    widen_row<3>(a.in_rgb + 3 * first, factor, W, row.rgb.data());
+    if (a.with_objects) {
+        widen_row<1>(a.in_classes + first, factor, W, row.classes.data());
+        widen_row<1>(a.in_segments + first, factor, W, row.segments.data());
+        widen_row<1>(a.in_objects + first, factor, W, row.objects.data());
+    }
+    row.bv = bv;
+}
+
+/// Input row v's results (row offset `row` = v W) from its block row's, by code: every pixel
+/// from its own block or as no point, a pass per result that vectorizes. Returns the pixels
+/// it made active.
+unsigned write_row(const PixelArrays& a, ExpandBuffers::BlockRow& b, std::size_t row, int W) {
+    const std::uint8_t* const code = b.code.data();
+    colour_row(code, b.rgb.data(), a.frame_rgb ? a.frame_rgb + 3 * row : nullptr, W, b.grey.data(), b.mask3.data(),
+               b.grey3.data(), a.colors + 3 * row);
+    if (a.with_objects)
+        return object_row(code, b.labels.data(), b.segments.data(), b.objects.data(), b.classes.data(), W,
+                          a.labels + row, a.segments + row, a.objects + row, a.classes + row, a.active + row);
+    blend_row16(code, b.labels.data(), 0, W, a.labels + row);
+    return active_row(code, W, a.active + row);
+}
+
+/// 4. Every input pixel's results, band by band of rows in parallel. Per row: each pixel's
+/// source code (source_codes: its own block, no point, or a search), then every result from
+/// the block row by code (write_row), then the searched pixels (another block or none: no
+/// depth on their block's surface, at an outline, or on a block out of the range) one by one
+/// through DecimatedSource; last each object's runs into the band's boxes (reduced in band
+/// order by count_objects). A pixel is in the depth range by its own depth, as at every
+/// pixel (select_depth_range): the block it takes can lie on the other side of a limit. In
+/// range, on a block that is not, it takes the nearest in depth of the 3 x 3 blocks that are
+/// (its own is: the frame was decimated to blocks in range where they could be); out of
+/// range, none. O(W H), one parallel pass, no allocation.
 void expand_bands(const DepthRange& range, const RgbdView& frame, const DecimatedSource& source, int w,
                   const PixelArrays& arrays, ExpandBuffers& buf) {
     const int W = frame.width, H = frame.height;
-    const float scale = frame.depth_scale_m_per_unit;
     const std::uint16_t* const depth = frame.depth;
     const int factor = source.factor();
+    const SourceTest test{source.same_units(), source.same_rel_units(), frame.depth_scale_m_per_unit, range.zmin_m,
+                          range.zmax_m};
     const std::size_t n_obj = buf.band_boxes.size() / ExpandBuffers::kBands;
     const int max_id = static_cast<int>(buf.object_index.size()) - 1;
     const int* const object_index = buf.object_index.data();
@@ -502,92 +667,41 @@ void expand_bands(const DepthRange& range, const RgbdView& frame, const Decimate
     for (int band = 0; band < ExpandBuffers::kBands; ++band) {
         ExpandBuffers::Box* const boxes = buf.band_boxes.data() + static_cast<std::size_t>(band) * n_obj;
         ExpandBuffers::BlockRow& block_row = buf.band_rows[static_cast<std::size_t>(band)];
+        std::uint8_t* const code = block_row.code.data();
         std::size_t active = 0;
-        // Pixel p's results from block q, or "no point" for q < 0.
-        auto take = [=](std::size_t p, std::int32_t q) {
-            std::uint8_t* const rgb = a.colors + 3 * p;
-            if (q < 0) {
-                a.labels[p] = 0;
-                rgb[0] = rgb[1] = rgb[2] = a.frame_rgb ? dimmed_grey(a.frame_rgb + 3 * p) : 0;
-                a.active[p] = 0;
-                if (!objects) return;
-                a.classes[p] = kPlaneRemoved;
-                a.segments[p] = 0;
-                a.objects[p] = 0;
-                return;
-            }
-            const auto sq = static_cast<std::size_t>(q);
-            a.labels[p] = a.in_labels[sq];
-            rgb[0] = a.in_rgb[3 * sq];
-            rgb[1] = a.in_rgb[3 * sq + 1];
-            rgb[2] = a.in_rgb[3 * sq + 2];
-            a.active[p] = a.in_active[sq];
-            if (!objects) return;
-            a.classes[p] = a.in_classes[sq];
-            a.segments[p] = a.in_segments[sq];
-            a.objects[p] = a.in_objects[sq];
-        };
-        std::uint16_t *const row_labels = block_row.labels.data(), *const row_segments = block_row.segments.data(),
-                      *const row_objects = block_row.objects.data();
-        std::uint8_t *const row_rgb = block_row.rgb.data(), *const row_active = block_row.active.data(),
-                     *const row_classes = block_row.classes.data();
-        // Block row bv's results, each block's over its columns.
-        auto widen = [=](int bv) {
-            const std::size_t first = static_cast<std::size_t>(bv) * w;
-            widen_row<1>(a.in_labels + first, factor, W, row_labels);
-            widen_row<3>(a.in_rgb + 3 * first, factor, W, row_rgb);
-            widen_row<1>(a.in_active + first, factor, W, row_active);
-            if (!objects) return;
-            widen_row<1>(a.in_classes + first, factor, W, row_classes);
-            widen_row<1>(a.in_segments + first, factor, W, row_segments);
-            widen_row<1>(a.in_objects + first, factor, W, row_objects);
-        };
-        float* const scratch = block_row.scratch.data();
-        std::uint8_t* const takes_own = block_row.takes_own.data();
         for (int v = band * H / ExpandBuffers::kBands; v < (band + 1) * H / ExpandBuffers::kBands; ++v) {
             const int bv = v / factor;
             const std::size_t row = static_cast<std::size_t>(v) * W;
-            // First every pixel from its own block, copied from the block row.
-            if (block_row.bv != bv) {
-                widen(bv);
-                block_row.bv = bv;
-            }
+            if (block_row.bv != bv) widen_block_row(a, bv, w, factor, W, block_row);
+            source_codes(depth + row, block_row.depth.data(), W, test, code);
+            unsigned in_row = write_row(a, block_row, row, W);
+            // The searched pixels, one by one: in range, with depth, but not on their own
+            // block as it is.
             const auto n_row = static_cast<std::size_t>(W);
-            std::copy_n(row_labels, n_row, a.labels + row);
-            std::copy_n(row_rgb, 3 * n_row, a.colors + 3 * row);
-            std::copy_n(row_active, n_row, a.active + row);
-            if (objects) {
-                std::copy_n(row_classes, n_row, a.classes + row);
-                std::copy_n(row_segments, n_row, a.segments + row);
-                std::copy_n(row_objects, n_row, a.objects + row);
-            }
-            // Then the pixels that do not take their own block as it is (off its surface, out
-            // of range, on a block out of it, or at an outline), one by one.
-            source.own_blocks_of_row(v, a.in_active, &range, scratch, takes_own);
-            const std::uint8_t* const end = takes_own + W;
-            for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(takes_own, 0, n_row)); at != nullptr;
-                 at = static_cast<const std::uint8_t*>(std::memchr(at + 1, 0, static_cast<std::size_t>(end - at - 1)))) {
-                const int u = static_cast<int>(at - takes_own), bu = u / factor;
-                const std::size_t p = row + static_cast<std::size_t>(u);
+            for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(code, kSearch, n_row)); at != nullptr;
+                 at = static_cast<const std::uint8_t*>(
+                     std::memchr(at + 1, kSearch, static_cast<std::size_t>(code + W - at - 1)))) {
+                const int u = static_cast<int>(at - code), bu = u / factor;
                 std::int32_t q = source.in_block(u, v, bu, bv);
-                if (q >= 0) {
-                    if (!range.contains(static_cast<float>(depth[p]) * scale))
-                        q = -1;
-                    else if (!a.in_active[q])
-                        q = source.nearest_in_depth(bu, bv, depth[p], a.in_active);
-                }
-                take(p, q);
+                if (q >= 0 && !a.in_active[q]) q = source.nearest_in_depth(bu, bv, depth[row + u], a.in_active);
+                if (q < 0) continue;  // no point: written so by write_row
+                const std::size_t p = row + static_cast<std::size_t>(u), sq = static_cast<std::size_t>(q);
+                a.labels[p] = a.in_labels[sq];
+                for (int c = 0; c < 3; ++c) a.colors[3 * p + c] = a.in_rgb[3 * sq + c];
+                a.active[p] = 1;  // q is active: the search takes no other
+                ++in_row;
+                if (!objects) continue;
+                a.classes[p] = a.in_classes[sq];
+                a.segments[p] = a.in_segments[sq];
+                a.objects[p] = a.in_objects[sq];
             }
-            // Last the row's counts. A row's count fits in 32 bits, which sum faster.
-            unsigned in_row = 0;
-            for (std::size_t u = 0; u < n_row; ++u) in_row += a.active[row + u];
             active += in_row;
             if (!objects) continue;
             // Each run of one object id adds to its box at once. The runs' starts are found
             // by memchr in a flag per column (0: a run starts), set by a loop that
-            // vectorizes; takes_own is free again to hold them.
+            // vectorizes; the code row is free again to hold them.
             const std::uint16_t* const ids = a.objects + row;
-            std::uint8_t* const continues = takes_own;
+            std::uint8_t* const continues = code;
             continues[0] = 0;
             for (int u = 1; u < W; ++u) continues[u] = ids[u] == ids[u - 1];
             for (int u = 0; u < W;) {
@@ -603,7 +717,6 @@ void expand_bands(const DepthRange& range, const RgbdView& frame, const Decimate
         buf.band_active[static_cast<std::size_t>(band)] = active;
     }
 }
-
 /// 5. The bands' counts reduced in band order: r.active_points, and each object's pixels
 /// and 2D box at the input's size. O(bands x objects).
 void count_objects(int W, int H, const ExpandBuffers& buf, FrameResult& r) {
@@ -657,22 +770,19 @@ ExpandWorkspace::~ExpandWorkspace() = default;
 ExpandWorkspace::ExpandWorkspace(ExpandWorkspace&&) noexcept = default;
 ExpandWorkspace& ExpandWorkspace::operator=(ExpandWorkspace&&) noexcept = default;
 
-void expand_result(const PipelineParams& params, const RgbdView& frame,
-                   const RgbdFrame& decimated, const FrameResult& s, ExpandWorkspace& ws,
-                   FrameResult& r) {
+void expand_result(const ExpandParams& params, const RgbdView& frame, const RgbdFrame& decimated,
+                   const FrameResult& s, ExpandWorkspace& ws, FrameResult& r) {
     ExpandBuffers& buf = *ws.b_;
     const int W = frame.width, H = frame.height;
-    // An input pixel takes a neighbouring block's results across a depth step no larger
-    // than the segmentation's own connection rule over the block's width.
-    const float n = static_cast<float>(params.decimation);
-    DecimatedSource source(frame.depth, W, H, frame.depth_scale_m_per_unit, decimated.depth,
-                           params.decimation,
-                           n * params.segmentation.depth_jump_m,
-                           n * params.segmentation.depth_jump_rel);
+    DecimatedSource source(frame.depth, W, H, frame.depth_scale_m_per_unit, decimated.depth, params.factor,
+                           params.same_m, params.same_rel);
     // At the objects' outlines (without the object stages, the clusters') the input's
     // colour places the outline.
-    const bool objects = params.detect_objects;
+    const bool objects = params.objects;
     const LabelImage& outline = objects ? s.objects : s.labels;
+    if (outline.width != decimated.width() || outline.height != decimated.height() ||
+        s.active.size() != outline.labels.size())
+        throw InputError(std::string(frame.name) + ": the decimated results do not match the decimated frame");
     mark_edge_blocks(outline, buf);
     if (frame.has_color() && !frame.color_matches())
         throw InputError(std::string(frame.name) + ": colour and depth sizes differ");
@@ -680,9 +790,9 @@ void expand_result(const PipelineParams& params, const RgbdView& frame,
                                buf.block_source);
     shape_result(s, W, H, objects, r);
     prepare_bands(r.object_list, W, H, outline.width, objects, buf);
-    expand_bands(params.range, frame, source, outline.width, pixel_arrays(frame, s, objects, r), buf);
+    expand_bands(params.range, frame, source, outline.width, pixel_arrays(frame, decimated, s, buf, objects, r), buf);
     count_objects(W, H, buf, r);
-    drop_small_objects(static_cast<std::size_t>(params.objects.min_points), r);
+    drop_small_objects(params.min_object_pixels, r);
 }
 
 }  // namespace wul3d

@@ -62,6 +62,21 @@ using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
+
+/// What the way back from decimation needs of `p` (the input's parameters, not the stages'):
+/// an input pixel takes a neighbouring block's results across a depth step no larger than
+/// the segmentation's own connection rule over the block's width.
+ExpandParams expand_params(const PipelineParams& p) {
+    const float n = static_cast<float>(p.decimation);
+    ExpandParams e;
+    e.factor = p.decimation;
+    e.same_m = n * p.segmentation.depth_jump_m;
+    e.same_rel = n * p.segmentation.depth_jump_rel;
+    e.range = p.range;
+    e.objects = p.detect_objects;
+    e.min_object_pixels = static_cast<std::size_t>(p.objects.min_points);
+    return e;
+}
 }  // namespace
 
 /// The pipeline's stages, their state across frames and their buffers.
@@ -144,7 +159,7 @@ const FrameResult& Pipeline::Impl::run_stages(const RgbdView& frame, double regi
         double ms = ms_since(t);
         run_on(decimated_.view(), decimated_result_);
         t = Clock::now();
-        expand_result(params_, frame, decimated_, decimated_result_, expand_ws_, result_);
+        expand_result(expand_params(params_), frame, decimated_, decimated_result_, expand_ws_, result_);
         ms += ms_since(t);
         result_.times = decimated_result_.times;
         result_.times.decimation = ms;

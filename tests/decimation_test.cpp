@@ -6,9 +6,13 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <random>
 #include <set>
 #include <utility>
 
+#include <omp.h>
+
+#include "decimated_source.hpp"
 #include "synthetic_scene.hpp"
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
@@ -444,4 +448,273 @@ TEST(Pipeline, Decimated_RealTabletopObjectsMatchFullResolution) {
     // image_0002's spray bottle at both: 20 objects compared, 16 matched.
     EXPECT_GE(compared, 17);
     EXPECT_GE(matched, compared * 80 / 100) << matched << " of " << compared;
+}
+
+namespace {
+
+// expand_result's inputs on a random frame with edges: an input of W x H pixels made of
+// rectangles at different depths (some without depth, some past the range) with noise in
+// depth and colour, decimated by `factor`, and stage results of random rectangles of labels,
+// segments and objects (a few object ids, one of them missing from the list, one small) on
+// the decimated grid.
+struct RandomExpand {
+    RgbdFrame frame, decimated;
+    FrameResult small;
+    ExpandParams params;
+};
+
+RandomExpand random_expand(unsigned seed, int W, int H, int factor, bool objects, bool colour) {
+    std::mt19937 rng(seed);
+    auto uniform = [&rng](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    RandomExpand e;
+    RgbdFrame& f = e.frame;
+    f.name = "random";
+    f.intrinsics = PinholeIntrinsics{W, H, 500.0, 500.0, W / 2.0, H / 2.0};
+    f.depth.width = W;
+    f.depth.height = H;
+    f.depth.scale_m_per_unit = 0.001f;
+    f.depth.data.assign(static_cast<std::size_t>(W) * H, 1500);
+    if (colour) {
+        f.color.width = W;
+        f.color.height = H;
+        f.color.rgb.resize(3 * f.depth.data.size());
+        for (auto& c : f.color.rgb) c = static_cast<std::uint8_t>(uniform(100, 140));
+    }
+    for (int r = 0; r < 12; ++r) {  // rectangles of depth (0: none; 6000: past the range)
+        const int u0 = uniform(0, W - 1), v0 = uniform(0, H - 1), u1 = uniform(u0, W - 1), v1 = uniform(v0, H - 1);
+        const int kind = uniform(0, 5);
+        const int z = kind == 0 ? 0 : kind == 1 ? 6000 : uniform(400, 3000);
+        const std::array<int, 3> rgb{uniform(0, 255), uniform(0, 255), uniform(0, 255)};
+        for (int v = v0; v <= v1; ++v)
+            for (int u = u0; u <= u1; ++u) {
+                const std::size_t p = static_cast<std::size_t>(v) * W + u;
+                f.depth.data[p] = static_cast<std::uint16_t>(z == 0 || z == 6000 ? z : z + uniform(-6, 6));
+                if (colour)
+                    for (int c = 0; c < 3; ++c)
+                        f.color.rgb[3 * p + c] = static_cast<std::uint8_t>(std::clamp(rgb[c] + uniform(-30, 30), 0, 255));
+            }
+    }
+    for (int k = 0; k < W * H / 50; ++k)  // scattered holes
+        f.depth.data[static_cast<std::size_t>(uniform(0, W * H - 1))] = 0;
+    e.params.factor = factor;
+    e.params.same_m = static_cast<float>(factor) * 0.02f;
+    e.params.same_rel = static_cast<float>(factor) * 0.01f;
+    e.params.objects = objects;
+    e.params.min_object_pixels = 40;
+    decimate_frame(f, factor, e.decimated, &e.params.range);
+
+    const int w = e.decimated.width(), h = e.decimated.height();
+    const std::size_t n = static_cast<std::size_t>(w) * h;
+    FrameResult& s = e.small;
+    auto label_image = [&](int ww, int hh) {
+        LabelImage l;
+        l.width = ww;
+        l.height = hh;
+        l.labels.assign(static_cast<std::size_t>(ww) * hh, 0);
+        return l;
+    };
+    s.labels = label_image(w, h);
+    s.colors.width = w;
+    s.colors.height = h;
+    s.colors.rgb.resize(3 * n);
+    for (auto& c : s.colors.rgb) c = static_cast<std::uint8_t>(uniform(0, 255));
+    s.active.resize(n);
+    for (std::size_t q = 0; q < n; ++q) {
+        const float z = static_cast<float>(e.decimated.depth.data[q]) * 0.001f;
+        // Mostly the depth range, with a few blocks off (as the plane or a stage may leave).
+        s.active[q] = e.decimated.depth.data[q] != 0 && e.params.range.contains(z) && uniform(0, 19) != 0;
+    }
+    if (objects) {
+        s.segments = label_image(w, h);
+        s.objects = label_image(w, h);
+        s.plane_classes.resize(n);
+        for (auto& c : s.plane_classes) c = static_cast<std::uint8_t>(uniform(0, 3));
+    }
+    for (int r = 0; r < 10; ++r) {  // rectangles of labels, segments and objects
+        const int u0 = uniform(0, w - 1), v0 = uniform(0, h - 1), u1 = uniform(u0, w - 1), v1 = uniform(v0, h - 1);
+        const auto label = static_cast<std::uint16_t>(uniform(1, 7));
+        const auto id = static_cast<std::uint16_t>(uniform(1, 6));
+        for (int v = v0; v <= v1; ++v)
+            for (int u = u0; u <= u1; ++u) {
+                const std::size_t q = static_cast<std::size_t>(v) * w + u;
+                s.labels.labels[q] = label;
+                if (!objects) continue;
+                s.segments.labels[q] = static_cast<std::uint16_t>(r + 1);
+                s.objects.labels[q] = id;
+            }
+    }
+    if (objects)
+        for (int id = 1; id <= 5; ++id) {  // id 6 is in the image but not in the list
+            DetectedObject d;
+            d.id = id;
+            s.object_list.push_back(d);
+        }
+    s.active_points = 0;
+    return e;
+}
+
+// The rules of expand_result pixel by pixel, straight from DecimatedSource (the reference
+// the row passes must equal): each input pixel's source block, its results copied, each
+// object's pixels and box counted, and the small objects dropped.
+FrameResult reference_expand(const RandomExpand& e) {
+    const RgbdFrame& f = e.frame;
+    const FrameResult& s = e.small;
+    const int W = f.width(), H = f.height(), factor = e.params.factor;
+    DecimatedSource source(f.depth, e.decimated.depth, factor, e.params.same_m, e.params.same_rel);
+    const LabelImage& outline = e.params.objects ? s.objects : s.labels;
+    const int w = outline.width, h = outline.height;
+    std::vector<std::uint8_t> edges(outline.labels.size());
+    for (int bv = 0; bv < h; ++bv)
+        for (int bu = 0; bu < w; ++bu) {
+            const std::uint16_t l = outline.labels[static_cast<std::size_t>(bv) * w + bu];
+            bool edge = false;
+            for (int dv = -1; dv <= 1; ++dv)
+                for (int du = -1; du <= 1; ++du) {
+                    const int nu = std::clamp(bu + du, 0, w - 1), nv = std::clamp(bv + dv, 0, h - 1);
+                    edge = edge || outline.labels[static_cast<std::size_t>(nv) * w + nu] != l;
+                }
+            edges[static_cast<std::size_t>(bv) * w + bu] = edge;
+        }
+    std::vector<std::int32_t> voted;
+    source.use_colour_at_edges(f.color, e.decimated.color, edges.data(), outline.labels.data(), voted);
+
+    FrameResult r;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    const bool objects = e.params.objects;
+    r.labels.width = r.colors.width = W;
+    r.labels.height = r.colors.height = H;
+    r.labels.labels.resize(N);
+    r.colors.rgb.resize(3 * N);
+    r.active.resize(N);
+    if (objects) {
+        r.segments = r.objects = r.labels;
+        r.plane_classes.resize(N);
+    }
+    r.object_list = s.object_list;
+    std::map<int, DetectedObject> boxes;
+    for (int v = 0; v < H; ++v)
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            const std::uint16_t z = f.depth.data[p];
+            std::int32_t q = -1;
+            if (z != 0 && e.params.range.contains(static_cast<float>(z) * f.depth.scale_m_per_unit)) {
+                q = source(u, v);
+                if (q >= 0 && !s.active[static_cast<std::size_t>(q)])
+                    q = source.nearest_in_depth(u / factor, v / factor, z, s.active.data());
+            }
+            if (q < 0) {
+                const std::uint8_t grey = f.color.empty() ? 0 : dimmed_grey(&f.color.rgb[3 * p]);
+                for (int c = 0; c < 3; ++c) r.colors.rgb[3 * p + c] = grey;
+                if (objects) r.plane_classes[p] = kPlaneRemoved;
+                continue;  // the rest 0
+            }
+            const auto sq = static_cast<std::size_t>(q);
+            r.labels.labels[p] = s.labels.labels[sq];
+            for (int c = 0; c < 3; ++c) r.colors.rgb[3 * p + c] = s.colors.rgb[3 * sq + c];
+            r.active[p] = s.active[sq];
+            r.active_points += r.active[p];
+            if (!objects) continue;
+            r.plane_classes[p] = s.plane_classes[sq];
+            r.segments.labels[p] = s.segments.labels[sq];
+            const std::uint16_t id = r.objects.labels[p] = s.objects.labels[sq];
+            if (id == 0) continue;
+            DetectedObject& d = boxes.try_emplace(id, DetectedObject{}).first->second;
+            if (d.pixels == 0) {
+                d.u_min = d.u_max = u;
+                d.v_min = d.v_max = v;
+            }
+            ++d.pixels;
+            d.u_min = std::min(d.u_min, u);
+            d.u_max = std::max(d.u_max, u);
+            d.v_min = std::min(d.v_min, v);
+            d.v_max = std::max(d.v_max, v);
+        }
+    std::vector<DetectedObject> kept;
+    for (DetectedObject d : r.object_list) {
+        const DetectedObject counted = boxes.count(d.id) ? boxes[d.id] : DetectedObject{};
+        d.pixels = counted.pixels;
+        if (d.pixels > 0) {
+            d.u_min = counted.u_min;
+            d.u_max = counted.u_max;
+            d.v_min = counted.v_min;
+            d.v_max = counted.v_max;
+        }
+        if (d.pixels >= e.params.min_object_pixels) {
+            kept.push_back(d);
+            continue;
+        }
+        for (auto& id : r.objects.labels)
+            if (id == d.id) id = 0;
+    }
+    r.object_list = kept;
+    return r;
+}
+
+void expect_same_pixels(const FrameResult& a, const FrameResult& b) {
+    EXPECT_EQ(a.labels.labels, b.labels.labels);
+    EXPECT_EQ(a.colors.rgb, b.colors.rgb);
+    EXPECT_EQ(a.active, b.active);
+    EXPECT_EQ(a.active_points, b.active_points);
+    EXPECT_EQ(a.plane_classes, b.plane_classes);
+    EXPECT_EQ(a.segments.labels, b.segments.labels);
+    EXPECT_EQ(a.objects.labels, b.objects.labels);
+    ASSERT_EQ(a.object_list.size(), b.object_list.size());
+    for (std::size_t i = 0; i < a.object_list.size(); ++i) {
+        const DetectedObject &x = a.object_list[i], &y = b.object_list[i];
+        EXPECT_EQ(x.id, y.id);
+        EXPECT_EQ(x.pixels, y.pixels) << x.id;
+        if (x.pixels == 0) continue;
+        const std::array<int, 4> box_x{x.u_min, x.v_min, x.u_max, x.v_max}, box_y{y.u_min, y.v_min, y.u_max, y.v_max};
+        EXPECT_EQ(box_x, box_y) << x.id;
+    }
+}
+
+}  // namespace
+
+// The row passes of expand_result (a code per pixel, the results by masks, the searched pixels
+// one by one) give what the rules give pixel by pixel, on random frames with edges, holes and
+// depths past the range: every factor, sizes not a multiple of it, with and without colour
+// and the object stages.
+TEST(ExpandResult, EqualsThePixelByPixelRulesOnRandomFrames) {
+    ExpandWorkspace ws;
+    FrameResult out;
+    unsigned seed = 1;
+    for (int factor : {2, 3, 4, 8})
+        for (const auto& [W, H] : {std::pair{97, 61}, std::pair{64, 48}, std::pair{150, 9}})
+            for (int variant = 0; variant < 4; ++variant) {
+                const bool objects = variant % 2 == 0, colour = variant < 2;
+                SCOPED_TRACE(testing::Message() << "factor " << factor << ", " << W << " x " << H << ", objects "
+                                                << objects << ", colour " << colour);
+                const RandomExpand e = random_expand(seed++, W, H, factor, objects, colour);
+                expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, out);
+                expect_same_pixels(out, reference_expand(e));
+            }
+}
+
+// The same bytes on 1, 2 and 3 threads (the bands' counts are reduced in a fixed order).
+TEST(ExpandResult, TheSameOnAnyNumberOfThreads) {
+    const RandomExpand e = random_expand(42, 331, 243, 2, true, true);
+    const int threads = omp_get_max_threads();
+    FrameResult one;
+    ExpandWorkspace ws;
+    omp_set_num_threads(1);
+    expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, one);
+    for (int n : {2, 3}) {
+        SCOPED_TRACE(n);
+        omp_set_num_threads(n);
+        FrameResult many;
+        ExpandWorkspace fresh;
+        expand_result(e.params, e.frame.view(), e.decimated, e.small, fresh, many);
+        expect_same_pixels(many, one);
+    }
+    omp_set_num_threads(threads);
+}
+
+TEST(ExpandResult, RejectsResultsThatDoNotMatchTheDecimatedFrame) {
+    RandomExpand e = random_expand(7, 40, 30, 2, true, true);
+    e.small.objects.labels.pop_back();
+    e.small.objects.height -= 1;
+    ExpandWorkspace ws;
+    FrameResult out;
+    EXPECT_THROW(expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, out), InputError);
 }

@@ -4,13 +4,10 @@
 /// shrinks by N in u and v before back-projection, every later stage runs on N^2 times fewer
 /// pixels, and each per-pixel result is carried back to the input's pixels at the end.
 /// The speed/quality trade-off is measured in docs/SPEED.md ("Decimation").
-#include <algorithm>
-#include <cmath>
-#include <cstdint>
+#include <cstddef>
 #include <memory>
-#include <vector>
 
-#include "wul3d/background.hpp"
+#include "wul3d/depth_range.hpp"
 #include "wul3d/frame.hpp"
 
 namespace wul3d {
@@ -33,103 +30,20 @@ inline void decimate_frame(const RgbdFrame& in, int factor, RgbdFrame& out,
     decimate_frame(in.view(), factor, out, range);
 }
 
-/// Which pixel of the decimated frame an input pixel takes its results from (the pipeline
-/// copies every per-pixel result through it: expand_result). An input pixel
-/// without depth has none (-1). One with depth z is on the surface of a block whose depth is
-/// within same_m + same_rel z^2 (metres) of z. It takes its own block when on its surface,
-/// else the one of the 3 x 3 neighbouring blocks nearest to z in depth (an edge pixel whose
-/// block was sampled on the other surface), else none when none of them has depth.
-///
-/// With use_colour_at_edges, colour places the outlines, in two steps:
-/// 1. A colour vote, once per edge block (one whose 3 x 3 neighbourhood holds another
-///    label), as in joint bilateral upsampling: the blocks on its surface on a 5 x 5 grid,
-///    two blocks apart, centred on it, vote for their labels with the weight
-///    exp(-|c_edge - c_block|^2 / (2 kColourSigma^2)). When the other labels together
-///    outweigh its own, the edge block takes its results from the block nearest to it in
-///    colour among theirs. This moves an outline that the decimated stages put a block or two
-///    off (where normals over twice the distance blur a foot or a crease) to the colour edge.
-/// 2. Per pixel, in an edge block: among its own block and the three beside the block's
-///    quarter it lies in (left or right, above or below, and the corner between) that are
-///    on its surface, the one nearest in colour (its own on a tie), through the block's
-///    vote: the outline follows the input's colour edge instead of the blocks' staircase.
-class DecimatedSource {
-public:
-    /// Throws InputError unless `decimated` is `input` decimated by `factor` in size.
-    DecimatedSource(const DepthImage& input, const DepthImage& decimated, int factor,
-                    float same_m, float same_rel);
-    /// The same for an input depth of `width` x `height` at `input` (packed rows), in units
-    /// of `scale_m_per_unit` metres.
-    DecimatedSource(const std::uint16_t* input, int width, int height, float scale_m_per_unit,
-                    const DepthImage& decimated, int factor, float same_m, float same_rel);
-    /// `edge_blocks`: one flag per decimated pixel (results differ from a neighbour's);
-    /// `block_labels`: the label each decimated pixel votes for (objects, or clusters). They
-    /// and the colour images stay owned by the caller, and so does `block_source`, which
-    /// receives each edge block's vote (a block index, its own when it keeps its label; sized
-    /// to the decimated image, reused from frame to frame; other blocks' entries untouched).
-    /// Ignored for frames without colour. Throws InputError for colour images of other sizes
-    /// than the depths'.
-    void use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
-                             const std::uint8_t* edge_blocks, const std::uint16_t* block_labels,
-                             std::vector<std::int32_t>& block_source);
-    /// The same with the input colour at `input_rgb` (packed RGB rows of the input depth's
-    /// size; nullptr: none).
-    void use_colour_at_edges(const std::uint8_t* input_rgb, const ColorImage& decimated,
-                             const std::uint8_t* edge_blocks, const std::uint16_t* block_labels,
-                             std::vector<std::int32_t>& block_source);
+struct FrameResult;  // frame_result.hpp
 
-    /// The vote's colour scale (distance between 8-bit RGB triples), chosen with the grid on
-    /// the OSD learn frames and slide_learn38 at N = 2 (docs/DESIGN.md, decimation).
-    static constexpr float kColourSigma = 20.0f;
-
-    int factor() const { return factor_; }
-    /// The decimated pixel (v' w + u') for input pixel (u, v), or -1.
-    std::int32_t operator()(int u, int v) const { return in_block(u, v, u / factor_, v / factor_); }
-    /// The same, for loops that step the block (bu, bv) = (u / factor, v / factor) themselves
-    /// (a division per pixel costs more than the rest of the test).
-    std::int32_t in_block(int u, int v, int bu, int bv) const {
-        const std::size_t p = static_cast<std::size_t>(v) * W_ + u;
-        const float z = full_[p];
-        if (z == 0) return -1;
-        const std::int32_t own = bv * w_ + bu;
-        const bool on_own = same_surface(own, z);
-        if (on_own && !(edges_ && edges_[own])) return own;
-        return search(u, v, bu, bv, z, on_own);
-    }
-    /// Of the 3 x 3 blocks around block (bu, bv) that have depth (and a flag in `among`, one
-    /// per block, when given), the one nearest to depth z (the image's units), or -1: a
-    /// first-found on ties, rows top to bottom.
-    std::int32_t nearest_in_depth(int bu, int bv, float z, const std::uint8_t* among) const;
-    /// Input row v at once: takes_own[u] = 1 where in_block(u, v, u / factor, v / factor) is
-    /// the pixel's own block, `usable` (one flag per block; nullptr: every block) holds for
-    /// that block and, with `range`, the pixel's depth in metres is in it; else 0. `scratch`
-    /// holds a float per input column and per block column (W + w). The test of in_block
-    /// without its branches (loops that vectorize), for callers that handle the other pixels
-    /// one by one.
-    void own_blocks_of_row(int v, const std::uint8_t* usable, const DepthRange* range,
-                           float* scratch, std::uint8_t* takes_own) const;
-
-private:
-    bool same_surface(std::int32_t q, float z) const {
-        return small_[q] != 0 && std::fabs(small_[q] - z) <= same_ + same_rel_ * z * z;
-    }
-    /// The search of an edge pixel, or of one off its own block's surface.
-    std::int32_t search(int u, int v, int bu, int bv, float z, bool on_own) const;
-    /// Step 1 of the colour placement: each block's source after the vote, into `source`.
-    void vote(const std::uint16_t* labels, std::int32_t* source) const;
-
-    const std::uint16_t* full_;
-    const std::uint16_t* small_;
-    int W_, H_, w_, h_, factor_;
-    float same_, same_rel_;  ///< in the depth images' units
-    float scale_;            ///< metres per depth unit
-    const std::uint8_t* rgb_ = nullptr;        ///< input colour, with use_colour_at_edges
-    const std::uint8_t* small_rgb_ = nullptr;  ///< decimated colour
-    const std::uint8_t* edges_ = nullptr;      ///< edge blocks
-    const std::int32_t* voted_ = nullptr;      ///< each block's source after the vote
+/// What the way back (expand_result) needs of the pipeline's parameters.
+struct ExpandParams {
+    int factor = 2;  ///< the frame was decimated by it (PipelineParams::decimation), [2, 8]
+    /// An input pixel is on a block's surface within same_m + same_rel z^2 metres of its
+    /// depth z (the pipeline: the segmentation's depth jump over a block's width, N times it).
+    float same_m = 0.0f, same_rel = 0.0f;
+    DepthRange range;  ///< the frame was decimated with it; a pixel out of it is no point
+    /// false: the result of the paper's steps only (labels, colours, active points); the
+    /// outlines placed by colour are the clusters' then, not the objects'.
+    bool objects = true;
+    std::size_t min_object_pixels = 0;  ///< objects under it (input pixels) are dropped
 };
-
-struct FrameResult;     // pipeline.hpp
-struct PipelineParams;  // pipeline.hpp
 
 /// expand_result's buffers, reused from frame to frame (opaque: decimation.cpp).
 class ExpandWorkspace {
@@ -142,20 +56,23 @@ public:
 private:
     struct Buffers;
     std::unique_ptr<Buffers> b_;
-    friend void expand_result(const PipelineParams&, const RgbdView&, const RgbdFrame&,
-                              const struct FrameResult&, ExpandWorkspace&, struct FrameResult&);
+    friend void expand_result(const ExpandParams&, const RgbdView&, const RgbdFrame&, const FrameResult&,
+                              ExpandWorkspace&, FrameResult&);
 };
 
 /// The last stage with decimation: `small`, the results of the stages on `decimated` (`frame`
-/// decimated by params.decimation with decimate_frame and params.range), carried back to
+/// decimated by params.factor with decimate_frame and params.range), carried back to
 /// `frame`'s pixels into `out`. Each per-pixel result (labels, colours, active points, plane
-/// classes, segments, objects) comes from the pixel's source block (DecimatedSource, with
-/// the colour placement at object outlines); a pixel out of the depth range, or without a
-/// source, is no point. Each object's pixels and 2D box are counted again at the input's
-/// size, and objects left under params.objects.min_points input pixels are dropped.
-/// Everything else of `small` (stats, plane, object_list) is copied; `out.times` is not set.
-void expand_result(const PipelineParams& params, const RgbdView& frame,
-                   const RgbdFrame& decimated, const FrameResult& small, ExpandWorkspace& ws,
-                   FrameResult& out);
+/// classes, segments, objects) comes from the pixel's source block: its own when its depth
+/// is on the block's surface, else the nearest in depth of the 3 x 3 blocks around; at the
+/// objects' outlines (the clusters' without params.objects) the input's colour places the
+/// outline (src/decimated_source.hpp gives the rules). A pixel out of the depth range, or
+/// without a source, is no point. Each object's pixels and 2D box are counted again at the
+/// input's size, and objects left under params.min_object_pixels are dropped. Everything
+/// else of `small` (stats, plane, object_list) is copied; `out.times` is not set. The same
+/// bytes on any number of threads; no allocation from the second frame of a size on.
+/// Throws InputError for a `decimated` frame or colour that does not match `frame`.
+void expand_result(const ExpandParams& params, const RgbdView& frame, const RgbdFrame& decimated,
+                   const FrameResult& small, ExpandWorkspace& ws, FrameResult& out);
 
 }  // namespace wul3d
