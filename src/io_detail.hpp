@@ -76,6 +76,14 @@ void check_index(std::size_t i, std::size_t n);
 /// The PNG files of `dir` by stem, sorted; InputError if it cannot be listed.
 std::vector<std::filesystem::path> list_pngs(const std::filesystem::path& dir);
 
+/// `p` made absolute and without a trailing separator, so that filename() and
+/// parent_path() mean the folder itself and its parent even for "." or "seq/".
+std::filesystem::path normalized(const std::filesystem::path& p);
+
+/// TUM RGB-D (io_tum.cpp): a folder holding rgb.txt and depth.txt.
+std::unique_ptr<FrameSource> open_tum(const std::string& path, const std::filesystem::path& root,
+                                      const SourceOptions& options);
+
 /// OSD-0.2-depth (io_osd.cpp): a folder holding image_color/.
 bool is_osd_tree(const std::filesystem::path& root);
 std::unique_ptr<FrameSource> open_osd(const std::string& path, const std::filesystem::path& root,
