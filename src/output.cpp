@@ -95,6 +95,54 @@ void write_folder_atomic(const std::string& dir,
     }
 }
 
+namespace {
+/// OutputFiles's names and members, in the order of output_files_names.
+const std::vector<std::pair<const char*, bool OutputFiles::*>>& output_file_members() {
+    static const std::vector<std::pair<const char*, bool OutputFiles::*>> members = {
+        {"labels", &OutputFiles::labels}, {"colors", &OutputFiles::colors},
+        {"objects", &OutputFiles::objects}, {"json", &OutputFiles::json},
+        {"ply", &OutputFiles::ply}, {"overlay", &OutputFiles::overlay}};
+    return members;
+}
+}  // namespace
+
+OutputFiles parse_output_files(const std::string& names) {
+    OutputFiles files;
+    for (const auto& member : output_file_members()) files.*member.second = false;
+    std::string known;
+    for (const auto& member : output_file_members()) {
+        if (!known.empty()) known += ", ";
+        known += member.first;
+    }
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t end = std::min(names.find(',', start), names.size());
+        const std::string name = names.substr(start, end - start);
+        bool found = false;
+        for (const auto& member : output_file_members()) {
+            if (name != member.first) continue;
+            if (files.*member.second)
+                throw ParamError("outputs '" + names + "': '" + name + "' given twice");
+            files.*member.second = found = true;
+        }
+        if (!found)
+            throw ParamError("outputs '" + names + "': '" + name + "' is not one of " + known);
+        if (end == names.size()) break;
+        start = end + 1;
+    }
+    return files;
+}
+
+std::string output_files_names(const OutputFiles& files) {
+    std::string names;
+    for (const auto& member : output_file_members()) {
+        if (!(files.*member.second)) continue;
+        if (!names.empty()) names += ',';
+        names += member.first;
+    }
+    return names;
+}
+
 const std::vector<std::string>& frame_output_files() {
     static const std::vector<std::string> names = {"labels.png",      "colors.png",
                                                    "selected.png",    "objects.png",
@@ -234,24 +282,26 @@ void write_frame(const std::string& out_dir, const std::string& name, const Orga
     check_frame_name(name);
     write_folder_atomic((fs::path(out_dir) / name).string(), [&](const std::string& dir) {
         const fs::path tmp_dir(dir);
-        write_label_png((tmp_dir / "labels.png").string(), r.labels);
-        write_color_png((tmp_dir / "colors.png").string(), r.colors);
+        const OutputFiles& files = extra.files;
+        if (files.labels) write_label_png((tmp_dir / "labels.png").string(), r.labels);
+        if (files.colors) write_color_png((tmp_dir / "colors.png").string(), r.colors);
         if (extra.selected)
             write_mask_png((tmp_dir / "selected.png").string(), r.labels.width,
                            r.labels.height, *extra.selected);
-        write_label_png((tmp_dir / "objects.png").string(), r.objects);
-        write_text_file((tmp_dir / "objects.json").string(), objects_json(r, extra.selected_id));
+        if (files.objects) write_label_png((tmp_dir / "objects.png").string(), r.objects);
+        if (files.json)
+            write_text_file((tmp_dir / "objects.json").string(), objects_json(r, extra.selected_id));
         if (extra.selected_object)
             write_mask_png((tmp_dir / "selected_object.png").string(), r.objects.width,
                            r.objects.height, *extra.selected_object);
-        if (extra.overlay) {
+        if (files.overlay) {
             ColorImage picture;
             overlay_picture(frame, r, picture);
             write_color_png((tmp_dir / "overlay.png").string(), picture);
         }
-        if (extra.ply && cloud && cloud->size() == r.labels.labels.size()) {
+        if (files.ply && cloud && cloud->size() == r.labels.labels.size()) {
             write_ply((tmp_dir / "cloud.ply").string(), *cloud, r.labels, r.colors);
-        } else if (extra.ply) {  // decimation: the results are at the input's size, the cloud not
+        } else if (files.ply) {  // decimation: the results are at the input's size, the cloud not
             OrganizedCloud full;
             back_project(frame, full);
             write_ply((tmp_dir / "cloud.ply").string(), full, r.labels, r.colors);

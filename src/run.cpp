@@ -190,13 +190,12 @@ struct Selection {
         }
         if (!object_selected) object_mask.assign(r.objects.labels.size(), 0);
     }
-    FrameOutputs outputs(bool ply, bool overlay) const {
+    FrameOutputs outputs(const OutputFiles& files) const {
         FrameOutputs o;
         o.selected = cluster ? &cluster_mask : nullptr;
         o.selected_object = object ? &object_mask : nullptr;
         o.selected_id = object_selected ? object->label() : 0;
-        o.ply = ply;
-        o.overlay = overlay;
+        o.files = files;
         return o;
     }
 };
@@ -245,6 +244,7 @@ nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const Ru
     summary["stopped_by"] = s.stopped_by;
     summary["error"] = s.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.error);
     summary["parameters"] = parameters_json(o.params, o.preset);
+    summary["outputs"] = output_files_names(o.files);  // what each OUT/<frame>/ holds
     summary["frames"] = s.frames;
     summary["frames_file"] = kFramesFile;
     summary["threads"] = threads.total;
@@ -296,9 +296,9 @@ void take_frame(PendingFrame& p, const std::string& name, SourceItem& item, cons
     c.plane = r.plane;
     c.segment_stats = r.segment_stats;
     c.times = r.times;
-    p.has_cloud = o.ply && pipeline.cloud().size() == r.labels.labels.size();
+    p.has_cloud = o.files.ply && pipeline.cloud().size() == r.labels.labels.size();
     if (p.has_cloud) p.cloud = pipeline.cloud();
-    p.outputs = selection.outputs(o.ply, o.overlay);
+    p.outputs = selection.outputs(o.files);
     if (p.outputs.selected) {
         p.cluster_mask = *p.outputs.selected;
         p.outputs.selected = &p.cluster_mask;

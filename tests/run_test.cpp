@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -111,7 +112,7 @@ TEST(RunSequence, SameBytesAsTheCommand) {
     TempDir dir;
     RunOptions o = sample_run(dir / "lib");
     o.select = std::make_pair(320, 240);
-    o.overlay = true;
+    o.files.overlay = true;
     run_sequence(o);
     const auto cli = test::run_cli({"run", o.feed.input, "-o", (dir / "cli").string(), "-q",
                                     "--select", "320,240", "--overlay"});
@@ -124,11 +125,64 @@ TEST(RunSequence, SameBytesAsTheCommand) {
     }
 }
 
+TEST(RunSequence, OutputsWritesOnlyTheFilesAskedForWithTheSameBytes) {
+    // --outputs objects,json: the two files, byte for byte those of the default run, and
+    // summary.json says which files the frames hold.
+    TempDir dir;
+    RunOptions all = sample_run(dir / "all");
+    all.max_frames = 2;
+    run_sequence(all);
+    RunOptions some = sample_run(dir / "some");
+    some.max_frames = 2;
+    some.files = parse_output_files("objects,json");
+    run_sequence(some);
+    std::vector<std::string> expected;
+    for (const std::string& f : test::list_files(dir / "all")) {
+        const std::string name = fs::path(f).filename().string();
+        if (name == "objects.png" || name == "objects.json") expected.push_back(f);
+        if (name != "labels.png" && name != "colors.png" && f.find('/') != std::string::npos &&
+            name != "objects.png" && name != "objects.json")
+            ADD_FAILURE() << "unexpected file of the default run: " << f;
+    }
+    expected.insert(expected.end(), {"frames.jsonl", "summary.json"});
+    std::sort(expected.begin(), expected.end());
+    auto written = test::list_files(dir / "some");
+    std::sort(written.begin(), written.end());
+    EXPECT_EQ(written, expected);
+    for (const std::string& f : expected) {
+        if (f == "summary.json" || f == "frames.jsonl") continue;
+        EXPECT_EQ(slurp(dir / "some" / f), slurp(dir / "all" / f)) << f;
+    }
+    EXPECT_NE(slurp(dir / "some" / "summary.json").find("\"outputs\": \"objects,json\""),
+              std::string::npos);
+    EXPECT_NE(slurp(dir / "all" / "summary.json").find("\"outputs\": \"labels,colors,objects,json\""),
+              std::string::npos);
+}
+
+TEST(RunSequence, OutputNamesAreParsedStrictly) {
+    const OutputFiles f = parse_output_files("overlay,labels,ply");
+    EXPECT_TRUE(f.labels && f.ply && f.overlay);
+    EXPECT_FALSE(f.colors || f.objects || f.json);
+    EXPECT_EQ(output_files_names(f), "labels,ply,overlay");
+    EXPECT_EQ(output_files_names(OutputFiles{}), "labels,colors,objects,json");
+    for (const char* bad : {"", "objects,", ",objects", "objects,objects", "object", "OBJECTS",
+                            "objects json"})
+        EXPECT_THROW(parse_output_files(bad), ParamError) << bad;
+    // The command: its flag named, exit 2, nothing written.
+    TempDir dir;
+    const auto r = test::run_cli({"run", (test::sample_dir() / "uois_tabletop").string(), "-o",
+                                  (dir / "out").string(), "--outputs", "objects,masks"});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--outputs 'objects,masks': 'masks' is not one of labels, colors"),
+              std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "image_0000"));
+}
+
 TEST(RunSequence, OverlayTintsOutlinesAndNumbersTheObjectsOverTheColour) {
     TempDir dir;
     RunOptions o = sample_run(dir / "out");
     o.max_frames = 1;
-    o.overlay = true;
+    o.files.overlay = true;
     run_sequence(o);
     const fs::path frame = test::sample_dir() / "uois_tabletop" / "image_0000";
     const ColorImage colour = read_color_image((frame / "color.png").string());

@@ -56,20 +56,43 @@ void prepare_out_dir(const std::string& out, bool overwrite);
 std::string objects_json(const FrameResult& result, int selected_id = 0);
 
 /// What write_frame writes beyond the four images and objects.json.
+/// Which files of OUT/<frame>/ are written. The first four by default: labels.png and
+/// colors.png are the paper's outputs (its clusters, eq. 9's colours), objects.png and
+/// objects.json the objects (what `wul3d eval` scores and what an object user reads).
+/// Each costs a PNG encode (or the JSON text) a frame, the largest part of a run's output
+/// time, so a user who needs only the objects leaves the others out (`wul3d run --outputs
+/// objects,json`). cloud.ply and overlay.png are written on request.
+struct OutputFiles {
+    bool labels = true;    ///< labels.png: the paper's clusters, 16-bit
+    bool colors = true;    ///< colors.png: eq. 9's display colours
+    bool objects = true;   ///< objects.png: 0 background, else track id, 16-bit
+    bool json = true;      ///< objects.json
+    bool ply = false;      ///< cloud.ply: the labelled points, binary PLY
+    /// overlay.png: the objects tinted, outlined and numbered over the frame's colour
+    /// (render_object_overlay; over a grey depth picture for a depth-only frame).
+    bool overlay = false;
+
+    bool any() const { return labels || colors || objects || json || ply || overlay; }
+};
+
+/// "labels,colors,objects,json,ply,overlay": a comma-separated subset, in any order, at
+/// least one. ParamError names an unknown or repeated name.
+OutputFiles parse_output_files(const std::string& names);
+/// The names of the files `files` asks for, comma-separated, in the order above.
+std::string output_files_names(const OutputFiles& files);
+
 struct FrameOutputs {
     /// selected.png: the followed cluster's mask (255 = in it), or nullptr for none.
     const Mask* selected = nullptr;
     /// selected_object.png: the followed object's mask, or nullptr for none.
     const Mask* selected_object = nullptr;
     int selected_id = 0;  ///< objects.json's "selected" (see objects_json)
-    bool ply = false;     ///< cloud.ply: the labelled points, binary PLY
-    /// overlay.png: the objects tinted, outlined and numbered over the frame's colour
-    /// (render_object_overlay; over a grey depth picture for a depth-only frame).
-    bool overlay = false;
+    OutputFiles files;    ///< which of the frame's files are written
 };
 
-/// Writes one frame's outputs to OUT/<name>/ atomically (write_folder_atomic): labels.png,
-/// colors.png, objects.png, objects.json and what `extra` asks for. `frame` is the frame
+/// Writes one frame's outputs to OUT/<name>/ atomically (write_folder_atomic): the files
+/// `extra.files` asks for (by default labels.png, colors.png, objects.png, objects.json)
+/// and the selection's masks. `frame` is the frame
 /// `result` came from (registered); `pipeline` the one that processed it (its cloud is
 /// reused for cloud.ply when it has the frame's size). Throws IoError.
 void write_frame(const std::string& out_dir, const std::string& name, const Pipeline& pipeline,

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "wul3d/feed.hpp"
+#include "wul3d/output.hpp"
 #include "wul3d/pipeline.hpp"
 
 namespace wul3d {
@@ -25,8 +26,7 @@ struct RunOptions {
     std::string preset;
     std::string out_dir;        ///< OUT; created if missing
     std::size_t max_frames = 0; ///< stop after N frames; 0 = all (a camera: until stop or end)
-    bool ply = false;           ///< also OUT/<frame>/cloud.ply
-    bool overlay = false;       ///< also OUT/<frame>/overlay.png (FrameOutputs::overlay)
+    OutputFiles files;          ///< which files each OUT/<frame>/ gets (output.hpp)
     /// Follow the object under pixel (u, v) of the first frame: selected.png (its cluster),
     /// selected_object.png (its object) and "selected" in objects.json.
     std::optional<std::pair<int, int>> select;

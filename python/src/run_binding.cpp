@@ -69,8 +69,19 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     const auto frames = take<long long>(o, "frames");
     if (frames && *frames < 1) throw ParamError("--frames " + std::to_string(*frames) + ": must be >= 1");
     r.max_frames = frames ? static_cast<std::size_t>(*frames) : 0;
-    r.ply = take<bool>(o, "ply").value_or(false);
-    r.overlay = take<bool>(o, "overlay").value_or(false);
+    if (const auto v = pop(o, "outputs")) {
+        // "objects,json" as the command's --outputs, or a sequence of the names.
+        std::string names;
+        if (py::isinstance<py::str>(*v)) {
+            names = to_string(*v, "outputs");
+        } else {
+            for (const py::handle item : py::iter(*v))
+                names += (names.empty() ? "" : ",") + to_string(item, "outputs[]");
+        }
+        r.files = parse_output_files(names);
+    }
+    if (take<bool>(o, "ply").value_or(false)) r.files.ply = true;
+    if (take<bool>(o, "overlay").value_or(false)) r.files.overlay = true;
     r.overwrite = take<bool>(o, "overwrite").value_or(false);
     r.out_dir = out;
     if (!o.empty()) {

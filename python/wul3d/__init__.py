@@ -154,8 +154,9 @@ def run(input, out, **options) -> dict:
         **options: the flags of `wul3d run`, with underscores: the Pipeline's parameters
             (preset, k, alpha, ..., decimate, no_plane=True), format, tum_camera,
             intrinsics ("fx,fy,cx,cy", wul3d.Intrinsics or dict), calibration,
-            registration, select ("u,v" or (u, v)), frames (stop after N), ply, overlay,
-            overwrite (as `wul3d run --overwrite`).
+            registration, select ("u,v" or (u, v)), frames (stop after N), outputs
+            ("objects,json" or a sequence of those names, as `wul3d run --outputs`), ply,
+            overlay, overwrite (as `wul3d run --overwrite`).
 
     Returns:
         dict: frames, stopped_by, ms_per_frame_median, fps, wall_s, fps_end_to_end,

@@ -72,7 +72,7 @@ def run_options():
                                   f"{p['help']}, {p['range']} (default {p['default']})")
     for name, kind in (("format", str), ("tum_camera", str), ("intrinsics", str),
                        ("calibration", str), ("registration", str), ("select", str),
-                       ("frames", int)):
+                       ("frames", int), ("outputs", str)):
         options[name] = (kind, f"as `wul3d run --{name.replace('_', '-')}`")
     return options
 
@@ -465,8 +465,8 @@ def _frame_scores(input_dir: pathlib.Path, out_dir: pathlib.Path, names):
     scores = []
     for name in names:
         gt_path = input_dir / name / "label.png"
-        if not gt_path.is_file():
-            continue
+        if not gt_path.is_file() or not (out_dir / name / "objects.png").is_file():
+            continue  # no ground truth, or objects.png left out (--outputs)
         s = wul3d.evaluate(wul3d.read_label_image(os.fsencode(out_dir / name / "objects.png")),
                            wul3d.read_label_image(os.fsencode(gt_path)))
         s.pop("matches")

@@ -43,3 +43,23 @@ def test_run_rejects_bad_options(tmp_path):
         wul3d.run(SAMPLES / "uois_tabletop", tmp_path, intrinsics="1,2")
     with pytest.raises(wul3d.InputError):
         wul3d.run(SAMPLES / "nothing_here", tmp_path)
+
+
+@pytest.mark.parametrize("outputs", ["objects,json", ("objects", "json"), ["json", "objects"]])
+def test_outputs_writes_only_the_files_named(cli, tmp_path, outputs):
+    ref, out = tmp_path / "ref", tmp_path / "out"
+    proc = run_cli(cli, "run", SAMPLES / "uois_tabletop", "--out", ref, "-q", "--frames", "2",
+                   "--outputs", "objects,json")
+    assert proc.returncode == 0, proc.stderr
+    summary = wul3d.run(SAMPLES / "uois_tabletop", out, frames=2, outputs=outputs)
+    assert summary["frames"] == 2
+    for name in ("image_0000", "image_0002"):
+        assert sorted(p.name for p in (out / name).iterdir()) == ["objects.json", "objects.png"]
+        _, mismatch, errors = filecmp.cmpfiles(ref / name, out / name,
+                                               ["objects.json", "objects.png"], shallow=False)
+        assert not mismatch and not errors
+    assert json.loads((out / "summary.json").read_text())["outputs"] == "objects,json"
+    with pytest.raises(ValueError, match="'masks' is not one of"):
+        wul3d.run(SAMPLES / "uois_tabletop", tmp_path / "bad", outputs="objects,masks")
+    with pytest.raises(TypeError, match="outputs"):
+        wul3d.run(SAMPLES / "uois_tabletop", tmp_path / "bad", outputs=[1])
