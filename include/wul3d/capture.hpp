@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "wul3d/io.hpp"
-#include "wul3d/registration.hpp"
+#include "wul3d/calibration.hpp"
 
 namespace wul3d {
 

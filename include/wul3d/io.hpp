@@ -13,7 +13,7 @@
 #include "wul3d/cloud.hpp"
 #include "wul3d/frame.hpp"
 #include "wul3d/image.hpp"
-#include "wul3d/registration.hpp"
+#include "wul3d/calibration.hpp"
 
 namespace wul3d {
 

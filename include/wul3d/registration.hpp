@@ -6,36 +6,12 @@
 /// P_d = z K_d^-1 (u_d, v_d, 1); the colour camera sees P_c = R P_d + t and projects it with
 /// the colour intrinsics: (u_c, v_c, 1) ~ K_c P_c. R and t take depth-camera coordinates to
 /// colour-camera coordinates (metres).
-#include <array>
-#include <string>
 #include <vector>
 
-#include "wul3d/camera.hpp"
+#include "wul3d/calibration.hpp"
 #include "wul3d/frame.hpp"
 
 namespace wul3d {
-
-/// Intrinsics of both cameras and the depth-to-colour extrinsic.
-struct StereoCalibration {
-    PinholeIntrinsics depth;
-    PinholeIntrinsics color;
-    std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< R, row-major, depth -> colour
-    std::array<double, 3> translation_m{0, 0, 0};                ///< t, metres, depth -> colour
-    float depth_scale_m_per_unit = 0.001f;
-
-    /// Throws ParamError if an intrinsics is invalid or R is not a rotation (|R^T R - I| > 1e-3).
-    void validate() const;
-};
-
-/// Typical Kinect v2 values (depth 512x424, colour 1920x1080, colour camera 5.2 cm along
-/// the depth camera's x axis). A per-device calibration is better: see docs/INPUTS.md.
-StereoCalibration kinect_v2_default_calibration();
-
-/// Which way registration goes.
-enum class RegistrationMode {
-    DepthToColor,  ///< one point per colour pixel (the paper's choice): depth splatted with a z-buffer
-    ColorToDepth,  ///< one point per depth pixel: colour sampled where the depth pixel projects
-};
 
 /// Reusable buffers so that registration allocates nothing after the first frame.
 struct RegistrationWorkspace {
@@ -54,8 +30,5 @@ void register_depth_to_color(const StereoCalibration& calib, const RawRgbdFrame&
 /// The result has the depth resolution and intrinsics.
 void register_color_to_depth(const StereoCalibration& calib, const RawRgbdFrame& raw,
                              RegistrationWorkspace& ws, RgbdFrame& out);
-
-/// "depth-to-color" / "color-to-depth"; throws ParamError otherwise.
-RegistrationMode parse_registration_mode(const std::string& name);
 
 }  // namespace wul3d
