@@ -212,6 +212,12 @@ struct SegmentWorkspace {
     std::vector<int> order;
     // The final renumbering (compact) reuses sizes, offsets and order for each label's pixel
     // count, first pixel and the labels kept, in order of their first pixel.
+    // Components on several threads (components.cpp): per pixel the union-find parent, the
+    // set's pixels at its root, each root's component; per strip of rows its roots in raster
+    // order and its one-way pairs (far, near: depth continuous seen from the far pixel only).
+    std::vector<int> cc_parent, cc_size, cc_id;
+    std::vector<std::vector<int>> cc_roots, cc_oneway;
+    std::vector<std::uint64_t> cc_edges;  ///< one-way pairs between sets: from << 32 | to
     std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
     std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
@@ -249,6 +255,13 @@ struct SegmentWorkspace {
     std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
                                                   ///< bottom; pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
+    /// What the scope counts of one segment in one strip of rows (scope_lo, hi, ...).
+    struct ScopeCounts {
+        float lo, hi;
+        int any_px, high, outline, outside, frame, size;
+    };
+    std::vector<ScopeCounts> scope_strips;               ///< per strip, per segment
+    std::vector<std::vector<std::uint64_t>> scope_edges;  ///< per strip: touching pairs
     // Stacks:
     std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
     std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)

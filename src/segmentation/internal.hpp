@@ -205,6 +205,16 @@ void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& 
 /// fragments under min_seed_points unlabelled again. Returns n.
 int seed_components(const Ctx& x, SegmentWorkspace& ws);
 
+/// Connected components of the pixels with seedable[p] = 1 (else 0) into ws.label, 1..n, and
+/// their sizes into ws.sizes[1..n]; returns n. A component is what a breadth-first search
+/// from its first pixel in raster order reaches, a neighbour joining where depth is
+/// continuous seen from the pixel already in it (Ctx::connected; the test is not symmetric),
+/// the seeds taken in raster order: components are numbered by their first pixel. With
+/// `strips` > 1 the rows are cut into that many strips, each labelled on a thread of its
+/// own with a union-find, joined along the seams, then numbered: the labels are those of
+/// strips = 1 (the search itself) at any count. Cost: O(pixels), strips in parallel.
+int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentWorkspace& ws, int strips);
+
 /// Cut pixels, feet, pixels without a normal and dropped fragments join the segment they
 /// touch (up to reattach_px, where depth is continuous), then containers' insides, however
 /// wide (components.cpp). Returns the pixels added.

@@ -9,6 +9,8 @@
 #include <limits>
 #include <utility>
 
+#include <omp.h>
+
 #include "internal.hpp"
 #include "wul3d/plane.hpp"
 
@@ -51,24 +53,24 @@ FrameEdge find_frame_edge(const Ctx& x) {
     return {top, bottom, left, right, edge_top, edge_bottom, edge_left, edge_right};
 }
 
-/// The support's middle in depth: the mean depth of the removed points on it. Walls and
-/// furniture leave the volume beyond it; on the near half an object cut by the frame (at
-/// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
-/// table's near edge, is still on the table. Cost: one pass over the pixels, per chunk a
-/// branch-free loop that tells the points on the support (vectorizes), then the sum over
-/// them in pixel order (a double sum in another order would round otherwise).
-float support_middle_depth(const Ctx& x, const Plane& pl) {
+/// Over pixels [p0, p1): the sum of the depths of the removed points on the support (in
+/// pixel order), their count, least and greatest depth. Per chunk a branch-free loop that
+/// tells the points on the support (vectorizes), then the sum over them.
+struct DepthSum {
+    double sum = 0, count = 0;
+    float lo = std::numeric_limits<float>::max(), hi = 0;
+};
+DepthSum sum_support_depths(const Ctx& x, const Plane& plane, std::size_t p0, std::size_t p1) {
     const float *const xs = x.c.x.data(), *const ys = x.c.y.data(), *const zs = x.c.z.data();
     const std::uint8_t *const valid = x.c.valid.data(), *const cls = x.cls.data();
     const float jump_m = x.prm.depth_jump_m, jump_rel = x.prm.depth_jump_rel;
-    const Plane plane = pl;
     constexpr std::size_t kChunk = 256;
     std::uint8_t on[kChunk];
-    double table_z = 0, table_n = 0;
-    for (std::size_t p0 = 0; p0 < x.c.size(); p0 += kChunk) {
-        const std::size_t n = std::min(kChunk, x.c.size() - p0);
+    DepthSum d;
+    for (std::size_t c0 = p0; c0 < p1; c0 += kChunk) {
+        const std::size_t n = std::min(kChunk, p1 - c0);
         for (std::size_t j = 0; j < n; ++j) {
-            const std::size_t p = p0 + j;
+            const std::size_t p = c0 + j;
             const float z = zs[p];
             // `!(a > b)` as before.
             on[j] = (valid[p] != 0) & (cls[p] == kPlaneRemoved) &
@@ -76,37 +78,49 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
         }
         for (std::size_t j = 0; j < n; ++j) {
             if (!on[j]) continue;
-            table_z += zs[p0 + j];
-            table_n += 1;
+            const float z = zs[c0 + j];
+            d.sum += z;
+            d.count += 1;
+            d.lo = std::min(d.lo, z);
+            d.hi = std::max(d.hi, z);
         }
     }
-    return table_n > 0 ? static_cast<float>(table_z / table_n) : 0.0f;
+    return d;
 }
 
-/// Per segment, over the frame inside its edge: the lowest and highest point over the
-/// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
-/// (ws.sizes), outline pairs (scope_outline) and those that lead out of the volume
-/// (scope_outside: into removed points above the support, or into the frame's top edge,
-/// beyond the support's middle `far_z`) or into its other edges there (scope_frame); the
-/// touching segment pairs, once each, into ws.edges. In:
-/// ws.label (1..n with gaps). Cost: one pass over the pixels, then a sort of the pairs.
-void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
-                   int n) {
+/// The support's middle in depth: the mean depth of the removed points on it. Walls and
+/// furniture leave the volume beyond it; on the near half an object cut by the frame (at
+/// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
+/// table's near edge, is still on the table. Summed in parts in parallel where the double
+/// sum is exact (every depth a multiple of the float step at the least depth, the total
+/// under 2^53 such steps: the sum in pixel order, whatever the parts), else again in pixel
+/// order. Cost: one pass over the pixels, parts in parallel.
+float support_middle_depth(const Ctx& x, const Plane& pl) {
+    constexpr int kParts = 16;
+    DepthSum part[kParts];
+    const std::size_t N = x.c.size();
+#pragma omp parallel for schedule(static) if (!omp_in_parallel())
+    for (int k = 0; k < kParts; ++k) part[k] = sum_support_depths(x, pl, N * k / kParts, N * (k + 1) / kParts);
+    DepthSum all;
+    for (const DepthSum& d : part) {
+        all.sum += d.sum, all.count += d.count;
+        all.lo = std::min(all.lo, d.lo), all.hi = std::max(all.hi, d.hi);
+    }
+    if (!(all.count > 0)) return 0.0f;
+    const bool exact = all.lo > 0 && std::isfinite(all.hi) &&
+                       all.count * all.hi < std::ldexp(1.0, std::ilogb(all.lo) - 23 + 53);
+    if (!exact) all = sum_support_depths(x, pl, 0, N);
+    return static_cast<float>(all.sum / all.count);
+}
+
+using ScopeCounts = SegmentWorkspace::ScopeCounts;
+
+/// measure_scope's counts (but the sums of the points) of the segments' pixels in rows [v0,
+/// v1) into cnt[0, n], the touching pairs into `edges` (not unique). Writes nothing else:
+/// strips of rows run in parallel.
+void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, const int* label, int v0,
+                   int v1, ScopeCounts* cnt, std::vector<std::uint64_t>& edges) {
     const int W = x.W;
-    const std::size_t L = static_cast<std::size_t>(n) + 1;
-    ws.scope_lo.assign(L, std::numeric_limits<float>::max());
-    ws.scope_any_px.assign(L, -1);
-    ws.scope_sx.assign(L, 0.0);
-    ws.scope_sy.assign(L, 0.0);
-    ws.scope_sz.assign(L, 0.0);
-    ws.scope_hi.assign(L, -std::numeric_limits<float>::max());
-    ws.scope_high.assign(L, 0);
-    ws.scope_outline.assign(L, 0);
-    ws.scope_outside.assign(L, 0);
-    ws.scope_frame.assign(L, 0);
-    ws.sizes.assign(L, 0);
-    ws.edges.clear();
-    const int* const label = ws.label.data();
     const SegmentParams& prm = x.prm;
     auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
     // A removed point clearly above the support (by more than the depth noise at its depth)
@@ -121,15 +135,15 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     auto pair = [&](std::size_t p, std::size_t q) {
         const int a = label[p], b = label[q];
         if (a == b) return;
-        if (a) ++ws.scope_outline[static_cast<std::size_t>(a)];
-        if (b) ++ws.scope_outline[static_cast<std::size_t>(b)];
+        if (a) ++cnt[a].outline;
+        if (b) ++cnt[b].outline;
         if (a && b) {
-            ws.edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
-                               static_cast<std::uint64_t>(std::max(a, b)) << 1);
+            edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
+                            static_cast<std::uint64_t>(std::max(a, b)) << 1);
         } else if (a) {
-            ws.scope_outside[static_cast<std::size_t>(a)] += x.c.z[p] > far_z && beyond(q, p);
+            cnt[a].outside += x.c.z[p] > far_z && beyond(q, p);
         } else {
-            ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
+            cnt[b].outside += x.c.z[q] > far_z && beyond(p, q);
         }
     };
     // A row without a label whose next row has none either adds nothing (every pair in it
@@ -137,8 +151,8 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     auto labelled_row = [&](int v) {
         return row_has_label(label + static_cast<std::size_t>(v) * W, fe.left, fe.right);
     };
-    bool next_has_label = fe.top < fe.bottom && labelled_row(fe.top);
-    for (int v = fe.top; v < fe.bottom; ++v) {
+    bool next_has_label = v0 < v1 && labelled_row(v0);
+    for (int v = v0; v < v1; ++v) {
         const bool has_label = next_has_label;
         next_has_label = v + 1 < fe.bottom && labelled_row(v + 1);
         if (!has_label && !next_has_label) continue;
@@ -146,23 +160,20 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if (const int l = label[p]) {
                 const float h = height(p);
-                const auto li = static_cast<std::size_t>(l);
-                ws.scope_lo[li] = std::min(ws.scope_lo[li], h);
-                ws.scope_any_px[li] = static_cast<int>(p);
-                ws.scope_sx[li] += x.c.x[p];
-                ws.scope_sy[li] += x.c.y[p];
-                ws.scope_sz[li] += x.c.z[p];
-                ws.scope_hi[li] = std::max(ws.scope_hi[li], h);
-                ws.scope_high[li] += h > prm.scope_max_height_m;
-                ++ws.sizes[li];
+                ScopeCounts& c = cnt[l];
+                c.lo = std::min(c.lo, h);
+                c.any_px = static_cast<int>(p);
+                c.hi = std::max(c.hi, h);
+                c.high += h > prm.scope_max_height_m;
+                ++c.size;
                 // On the frame's edge, beyond the support's middle.
                 const int on_edge = x.c.z[p] > far_z ? (v == fe.edge_top) + (u == fe.edge_left) +
                                                            (u == fe.edge_right) + (v == fe.edge_bottom)
                                                      : 0;
                 const int on_top = x.c.z[p] > far_z && v == fe.edge_top;
-                ws.scope_outline[li] += on_edge;
-                ws.scope_outside[li] += on_top;
-                ws.scope_frame[li] += on_edge - on_top;
+                c.outline += on_edge;
+                c.outside += on_top;
+                c.frame += on_edge - on_top;
             }
             // Most pairs join equal labels and add nothing: that test stays here, in line
             // (GCC does not inline `pair`, called twice).
@@ -170,8 +181,89 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             if (v + 1 < fe.bottom && label[p] != label[p + W]) pair(p, p + static_cast<std::size_t>(W));
         }
     }
+}
+
+/// The strips' counts into ws.scope_* and ws.sizes (minima, maxima, the last pixel, sums of
+/// counts: the same in any order of the strips), their touching pairs into ws.edges, once
+/// each.
+void gather_strips(SegmentWorkspace& ws, int strips, std::size_t L) {
+    ws.scope_lo.resize(L);
+    ws.scope_hi.resize(L);
+    ws.scope_any_px.resize(L);
+    ws.scope_high.resize(L);
+    ws.scope_outline.resize(L);
+    ws.scope_outside.resize(L);
+    ws.scope_frame.resize(L);
+    ws.sizes.resize(L);
+    for (std::size_t l = 0; l < L; ++l) {
+        ScopeCounts t = ws.scope_strips[l];
+        for (int s = 1; s < strips; ++s) {
+            const ScopeCounts& c = ws.scope_strips[static_cast<std::size_t>(s) * L + l];
+            t.lo = std::min(t.lo, c.lo), t.hi = std::max(t.hi, c.hi), t.any_px = std::max(t.any_px, c.any_px);
+            t.high += c.high, t.outline += c.outline, t.outside += c.outside, t.frame += c.frame, t.size += c.size;
+        }
+        ws.scope_lo[l] = t.lo, ws.scope_hi[l] = t.hi, ws.scope_any_px[l] = t.any_px, ws.scope_high[l] = t.high;
+        ws.scope_outline[l] = t.outline, ws.scope_outside[l] = t.outside, ws.scope_frame[l] = t.frame;
+        ws.sizes[l] = t.size;
+    }
+    ws.edges.clear();
+    for (int s = 0; s < strips; ++s) {
+        const auto& e = ws.scope_edges[static_cast<std::size_t>(s)];
+        ws.edges.insert(ws.edges.end(), e.begin(), e.end());
+    }
     std::sort(ws.edges.begin(), ws.edges.end());
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
+}
+
+/// ws.scope_sx, sy, sz: the sums of each segment's points inside the frame's edge, in raster
+/// order (a double sum in another order would round otherwise). Cost: a pass over the rows
+/// with labels.
+void sum_points(const Ctx& x, const FrameEdge& fe, SegmentWorkspace& ws, std::size_t L) {
+    ws.scope_sx.assign(L, 0.0);
+    ws.scope_sy.assign(L, 0.0);
+    ws.scope_sz.assign(L, 0.0);
+    const int* const label = ws.label.data();
+    for (int v = fe.top; v < fe.bottom; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * x.W;
+        if (!row_has_label(label + row, fe.left, fe.right)) continue;
+        for (int u = fe.left; u < fe.right; ++u) {
+            const std::size_t p = row + u;
+            if (const int l = label[p]) {
+                ws.scope_sx[static_cast<std::size_t>(l)] += x.c.x[p];
+                ws.scope_sy[static_cast<std::size_t>(l)] += x.c.y[p];
+                ws.scope_sz[static_cast<std::size_t>(l)] += x.c.z[p];
+            }
+        }
+    }
+}
+
+/// Per segment, over the frame inside its edge: the lowest and highest point over the
+/// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
+/// (ws.sizes), the sums of its points (scope_sx, sy, sz), outline pairs (scope_outline) and
+/// those that lead out of the volume (scope_outside: into removed points above the support,
+/// or into the frame's top edge, beyond the support's middle `far_z`) or into its other
+/// edges there (scope_frame); the touching segment pairs, once each, into ws.edges. In:
+/// ws.label (1..n with gaps). Cost: one pass over the pixels in strips of rows, a strip per
+/// thread, the counts gathered (O(strips n)), a sort of the pairs, and a pass over the
+/// labelled rows for the sums.
+void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
+                   int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    const int rows = std::max(fe.bottom - fe.top, 0);
+    const int strips = std::max(1, std::min(omp_in_parallel() ? 1 : omp_get_max_threads(), rows / 8));
+    constexpr float kMax = std::numeric_limits<float>::max();
+    ws.scope_strips.assign(static_cast<std::size_t>(strips) * L, ScopeCounts{kMax, -kMax, -1, 0, 0, 0, 0, 0});
+    ws.scope_edges.resize(static_cast<std::size_t>(strips));
+    const int* const label = ws.label.data();
+#pragma omp parallel for schedule(static)
+    for (int s = 0; s < strips; ++s) {
+        auto& edges = ws.scope_edges[static_cast<std::size_t>(s)];
+        edges.clear();
+        measure_strip(x, pl, fe, far_z, label, fe.top + rows * s / strips, fe.top + rows * (s + 1) / strips,
+                      ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges);
+    }
+    gather_strips(ws, strips, L);
+    sum_points(x, fe, ws, L);
 }
 
 /// ws.scope_upright: per segment that runs into the frame's sides or bottom (scope_frame),
@@ -272,15 +364,19 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 }
 
 /// Clears the labels of the segments not kept. Returns those of min_points or more (within
-/// the frame's edge). Cost: one pass over the pixels.
+/// the frame's edge). Cost: one parallel pass over the pixels.
 int clear_out_of_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const auto& keep = ws.scope_keep;
     int left_out = 0;
     for (std::size_t l = 1; l < L; ++l)
         left_out += keep[l] != 3 && ws.sizes[l] >= prm.min_points;
-    for (int& l : ws.label)
-        if (l && keep[static_cast<std::size_t>(l)] != 3) l = 0;
+    int* const label = ws.label.data();
+    const std::uint8_t* const kept = keep.data();
+    const auto n_px = static_cast<std::ptrdiff_t>(ws.label.size());
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n_px; ++p)
+        if (label[p] && kept[label[p]] != 3) label[p] = 0;
     return left_out;
 }
 
