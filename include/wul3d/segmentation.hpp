@@ -218,6 +218,11 @@ struct SegmentWorkspace {
     std::vector<int> cc_parent, cc_size, cc_id;
     std::vector<std::vector<int>> cc_roots, cc_oneway;
     std::vector<std::uint64_t> cc_edges;  ///< one-way pairs between sets: from << 32 | to
+    // Passes over the pixels in strips of rows, a strip per thread (merge, containers, scope):
+    // per strip its pairs, its boundary steps, and per segment its first and last row.
+    std::vector<std::vector<std::uint64_t>> strip_pairs;
+    std::vector<std::vector<BoundaryStep>> strip_steps;
+    std::vector<int> strip_rows;
     std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
     std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
@@ -261,7 +266,6 @@ struct SegmentWorkspace {
         int any_px, high, outline, outside, frame, size;
     };
     std::vector<ScopeCounts> scope_strips;               ///< per strip, per segment
-    std::vector<std::vector<std::uint64_t>> scope_edges;  ///< per strip: touching pairs
     // Stacks:
     std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
     std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)

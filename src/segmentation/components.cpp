@@ -282,16 +282,29 @@ void drop_small_components(SegmentWorkspace& ws, int min_seed) {
 
 }  // namespace
 
+int row_strips(int rows) {
+    return omp_in_parallel() ? 1 : std::max(1, std::min(omp_get_max_threads(), rows / 8));
+}
+
+void relabel_to_roots(SegmentWorkspace& ws) {
+    int* const parent = ws.parent.data();
+    const auto n = static_cast<int>(ws.parent.size());
+    for (int l = 1; l < n; ++l) parent[l] = find_root(ws.parent, l);
+    int* const label = ws.label.data();
+    const auto n_px = static_cast<std::ptrdiff_t>(ws.label.size());
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n_px; ++p)
+        if (label[p]) label[p] = parent[label[p]];
+}
+
 int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentWorkspace& ws, int strips) {
     strips = std::min(strips, x.H);
     return strips > 1 ? components_on_strips(x, seedable, ws, strips) : components_by_search(x, seedable, ws);
 }
 
 int seed_components(const Ctx& x, SegmentWorkspace& ws) {
-    // A strip per thread, of 8 rows at least (below, the seams and passes cost more than the
-    // search); one thread searches. Inside another parallel region the team is one thread.
-    const int strips = omp_in_parallel() ? 1 : std::min(omp_get_max_threads(), x.H / 8);
-    const int n = label_components(x, ws.cut.data(), ws, strips);
+    // A strip per thread; one thread searches.
+    const int n = label_components(x, ws.cut.data(), ws, row_strips(x.H));
     drop_small_components(ws, x.prm.min_seed_points);
     return n;
 }
@@ -304,23 +317,23 @@ std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws) {
 
 /// Drops labels with fewer than min_points pixels and writes the rest to `out` renumbered
 /// 1..n in order of first appearance (raster order); ws.label keeps the old numbers. Returns
-/// n. Each half of the image (in parallel) counts its labels' pixels and first pixel, the
-/// labels are numbered, then `out` is written in parallel. Two halves only: the labels run
-/// up to the number of components, tiny fragments included, and each half keeps a row of
-/// them. Cost: two parallel passes over the pixels, O(n log n) between them.
+/// n. Each band of the image (a band per thread, in parallel) counts its labels' pixels and
+/// first pixel, the labels are numbered, then `out` is written in parallel. Cost: two
+/// parallel passes over the pixels, O(bands n + n log n) between them.
 int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
-    constexpr int kBands = 2;
+    // Bands of 512 pixels at least (row_strips' 8 rows of 64).
+    const int bands = row_strips(static_cast<int>(std::min<std::size_t>(ws.label.size(), 1u << 30) / 64));
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const std::size_t B = (L + 15) / 16 * 16;  // a band's row, whole cache lines (no false sharing)
     const auto N = static_cast<std::ptrdiff_t>(ws.label.size());
-    ws.sizes.assign(kBands * B, 0);  // per band: pixels
-    ws.offsets.resize(kBands * B);   // per band: first pixel, valid where it has pixels
+    ws.sizes.assign(static_cast<std::size_t>(bands) * B, 0);  // per band: pixels
+    ws.offsets.resize(static_cast<std::size_t>(bands) * B);   // per band: first pixel, valid where it has pixels
     int* const label = ws.label.data();
 #pragma omp parallel for schedule(static)
-    for (int band = 0; band < kBands; ++band) {
+    for (int band = 0; band < bands; ++band) {
         int* const count = ws.sizes.data() + static_cast<std::size_t>(band) * B;
         int* const first = ws.offsets.data() + static_cast<std::size_t>(band) * B;
-        for (std::ptrdiff_t p = N * band / kBands; p < N * (band + 1) / kBands; ++p) {
+        for (std::ptrdiff_t p = N * band / bands; p < N * (band + 1) / bands; ++p) {
             const auto l = static_cast<std::size_t>(label[p]);
             if (count[l]++ == 0) first[l] = static_cast<int>(p);
         }
@@ -329,7 +342,7 @@ int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
     ws.order.clear();
     for (std::size_t l = 1; l < L; ++l) {
         int size = 0, first = std::numeric_limits<int>::max();
-        for (int band = 0; band < kBands; ++band) {
+        for (int band = 0; band < bands; ++band) {
             const int count = ws.sizes[static_cast<std::size_t>(band) * B + l];
             if (count == 0) continue;
             size += count;

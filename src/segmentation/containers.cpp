@@ -18,22 +18,21 @@ namespace {
 
 constexpr std::uint64_t kPairMask = ~std::uint64_t{15};  ///< BoundaryStep::key's segment pair
 
-/// One pass: the boundary pairs of two segments into ws.steps, keyed (lo, hi, depth step,
-/// lo is nearer) with the nearer pixel, sorted by key; each segment's first and last row into
-/// ws.rim_rows. In: ws.label (0..n). Cost: O(pixels), then a sort of the boundary pairs.
-void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
+/// The boundary pairs of two segments in rows [v0, v1) into `steps` in raster order, keyed
+/// (lo, hi, depth step, lo is nearer) with the nearer pixel; each segment's first and last
+/// row there into rows[2 l], rows[2 l + 1] (-1: none). Reads only the frame and the labels:
+/// strips run in parallel.
+void strip_boundary_steps(const Ctx& x, const int* label, int v0, int v1, std::vector<BoundaryStep>& steps,
+                          int* rim_rows) {
     const int W = x.W, H = x.H;
-    const auto& label = ws.label;
-    ws.steps.clear();
-    ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
-    for (int v = 0; v < H; ++v) {
+    for (int v = v0; v < v1; ++v) {
         // Only labelled pixels add anything.
-        if (!row_has_label(label.data() + static_cast<std::size_t>(v) * W, 0, W)) continue;
+        if (!row_has_label(label + static_cast<std::size_t>(v) * W, 0, W)) continue;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int a = label[p];
             if (a == 0) continue;
-            int* rows = ws.rim_rows.data() + 2 * static_cast<std::size_t>(a);
+            int* rows = rim_rows + 2 * static_cast<std::size_t>(a);
             if (rows[0] < 0) rows[0] = v;
             rows[1] = v;
             const std::size_t qs[2] = {u + 1 < W ? p + 1 : p, v + 1 < H ? p + static_cast<std::size_t>(W) : p};
@@ -46,8 +45,40 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
                 const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 34) |
                                           (static_cast<std::uint64_t>(std::max(a, b)) << 4) |
                                           (std::uint64_t{step} << 1) | std::uint64_t{lo_nearer};
-                ws.steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
+                steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
             }
+        }
+    }
+}
+
+/// One pass: the boundary pairs of two segments into ws.steps, keyed (lo, hi, depth step,
+/// lo is nearer) with the nearer pixel, sorted by key; each segment's first and last row into
+/// ws.rim_rows. In: ws.label (0..n). Cost: O(pixels) in strips of rows in parallel (their
+/// pairs joined in strip order: the raster order of one pass), then a sort of the boundary
+/// pairs.
+void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
+    const int strips = row_strips(x.H);
+    const std::size_t rows_size = 2 * (static_cast<std::size_t>(n) + 1);
+    ws.strip_steps.resize(static_cast<std::size_t>(strips));
+    ws.strip_rows.assign(static_cast<std::size_t>(strips) * rows_size, -1);
+    const int* const label = ws.label.data();
+#pragma omp parallel for schedule(static)
+    for (int t = 0; t < strips; ++t) {
+        auto& steps = ws.strip_steps[static_cast<std::size_t>(t)];
+        steps.clear();
+        strip_boundary_steps(x, label, x.H * t / strips, x.H * (t + 1) / strips, steps,
+                             ws.strip_rows.data() + static_cast<std::size_t>(t) * rows_size);
+    }
+    ws.steps.clear();
+    for (const auto& st : ws.strip_steps) ws.steps.insert(ws.steps.end(), st.begin(), st.end());
+    // First row: the first strip's that has one; last row: the last strip's.
+    ws.rim_rows.assign(rows_size, -1);
+    for (int t = 0; t < strips; ++t) {
+        const int* const rows = ws.strip_rows.data() + static_cast<std::size_t>(t) * rows_size;
+        for (std::size_t i = 0; i < rows_size; i += 2) {
+            if (rows[i] < 0) continue;
+            if (ws.rim_rows[i] < 0) ws.rim_rows[i] = rows[i];
+            ws.rim_rows[i + 1] = rows[i + 1];
         }
     }
     std::sort(ws.steps.begin(), ws.steps.end(),

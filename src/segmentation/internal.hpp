@@ -182,11 +182,14 @@ inline bool join_sets(std::vector<int>& parent, int a, int b) {
     return true;
 }
 
-/// Every labelled pixel takes its set's root.
-inline void relabel_to_roots(SegmentWorkspace& ws) {
-    for (int& l : ws.label)
-        if (l) l = find_root(ws.parent, l);
-}
+/// Every labelled pixel takes its set's root (components.cpp): the sets flattened, then one
+/// parallel pass over the pixels.
+void relabel_to_roots(SegmentWorkspace& ws);
+
+/// How many strips of rows a pass over `rows` rows is cut into to run in parallel: one per
+/// thread, of 8 rows at least (fewer cost more in joining than they save); 1 inside another
+/// parallel region, or on one thread. What the passes compute does not depend on it.
+int row_strips(int rows);
 
 // ---- the phases before the rules ---------------------------------------------------------
 

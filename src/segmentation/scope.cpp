@@ -208,7 +208,7 @@ void gather_strips(SegmentWorkspace& ws, int strips, std::size_t L) {
     }
     ws.edges.clear();
     for (int s = 0; s < strips; ++s) {
-        const auto& e = ws.scope_edges[static_cast<std::size_t>(s)];
+        const auto& e = ws.strip_pairs[static_cast<std::size_t>(s)];
         ws.edges.insert(ws.edges.end(), e.begin(), e.end());
     }
     std::sort(ws.edges.begin(), ws.edges.end());
@@ -250,14 +250,14 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                    int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const int rows = std::max(fe.bottom - fe.top, 0);
-    const int strips = std::max(1, std::min(omp_in_parallel() ? 1 : omp_get_max_threads(), rows / 8));
+    const int strips = row_strips(rows);
     constexpr float kMax = std::numeric_limits<float>::max();
     ws.scope_strips.assign(static_cast<std::size_t>(strips) * L, ScopeCounts{kMax, -kMax, -1, 0, 0, 0, 0, 0});
-    ws.scope_edges.resize(static_cast<std::size_t>(strips));
+    ws.strip_pairs.resize(static_cast<std::size_t>(strips));
     const int* const label = ws.label.data();
 #pragma omp parallel for schedule(static)
     for (int s = 0; s < strips; ++s) {
-        auto& edges = ws.scope_edges[static_cast<std::size_t>(s)];
+        auto& edges = ws.strip_pairs[static_cast<std::size_t>(s)];
         edges.clear();
         measure_strip(x, pl, fe, far_z, label, fe.top + rows * s / strips, fe.top + rows * (s + 1) / strips,
                       ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges);
