@@ -59,6 +59,14 @@ void strip_boundary_steps(const Ctx& x, const int* label, int v0, int v1, std::v
 void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
     const int strips = row_strips(x.H);
     const std::size_t rows_size = 2 * (static_cast<std::size_t>(n) + 1);
+    auto by_key = [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; };
+    ws.steps.clear();
+    ws.rim_rows.assign(rows_size, -1);
+    if (strips == 1) {  // one pass straight into ws.steps and ws.rim_rows
+        strip_boundary_steps(x, ws.label.data(), 0, x.H, ws.steps, ws.rim_rows.data());
+        std::sort(ws.steps.begin(), ws.steps.end(), by_key);
+        return;
+    }
     ws.strip_steps.resize(static_cast<std::size_t>(strips));
     ws.strip_rows.assign(static_cast<std::size_t>(strips) * rows_size, -1);
     const int* const label = ws.label.data();
@@ -69,10 +77,8 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
         strip_boundary_steps(x, label, x.H * t / strips, x.H * (t + 1) / strips, steps,
                              ws.strip_rows.data() + static_cast<std::size_t>(t) * rows_size);
     }
-    ws.steps.clear();
     for (const auto& st : ws.strip_steps) ws.steps.insert(ws.steps.end(), st.begin(), st.end());
     // First row: the first strip's that has one; last row: the last strip's.
-    ws.rim_rows.assign(rows_size, -1);
     for (int t = 0; t < strips; ++t) {
         const int* const rows = ws.strip_rows.data() + static_cast<std::size_t>(t) * rows_size;
         for (std::size_t i = 0; i < rows_size; i += 2) {
@@ -81,8 +87,7 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
             ws.rim_rows[i + 1] = rows[i + 1];
         }
     }
-    std::sort(ws.steps.begin(), ws.steps.end(),
-              [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
+    std::sort(ws.steps.begin(), ws.steps.end(), by_key);
 }
 
 /// The RMS distance from a fitted circle that still counts as on it, for points at mean

@@ -62,16 +62,20 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) 
     const SegmentParams& prm = x.prm;
     if (prm.merge_max_concave <= 0 || n < 2) return 0;
     const int strips = row_strips(x.H);
-    ws.strip_pairs.resize(static_cast<std::size_t>(strips));
     const int* const label = ws.label.data();
-#pragma omp parallel for schedule(static)
-    for (int t = 0; t < strips; ++t) {
-        auto& edges = ws.strip_pairs[static_cast<std::size_t>(t)];
-        edges.clear();
-        boundary_pairs(x, label, x.H * t / strips, x.H * (t + 1) / strips, edges);
-    }
     ws.edges.clear();
-    for (const auto& e : ws.strip_pairs) ws.edges.insert(ws.edges.end(), e.begin(), e.end());
+    if (strips == 1) {
+        boundary_pairs(x, label, 0, x.H, ws.edges);
+    } else {
+        ws.strip_pairs.resize(static_cast<std::size_t>(strips));
+#pragma omp parallel for schedule(static)
+        for (int t = 0; t < strips; ++t) {
+            auto& edges = ws.strip_pairs[static_cast<std::size_t>(t)];
+            edges.clear();
+            boundary_pairs(x, label, x.H * t / strips, x.H * (t + 1) / strips, edges);
+        }
+        for (const auto& e : ws.strip_pairs) ws.edges.insert(ws.edges.end(), e.begin(), e.end());
+    }
     std::sort(ws.edges.begin(), ws.edges.end());
     reset_sets(ws.parent, n);
     int merges = 0;

@@ -97,9 +97,13 @@ DepthSum sum_support_depths(const Ctx& x, const Plane& plane, std::size_t p0, st
 /// order. Cost: one pass over the pixels, parts in parallel.
 float support_middle_depth(const Ctx& x, const Plane& pl) {
     constexpr int kParts = 16;
-    DepthSum part[kParts];
     const std::size_t N = x.c.size();
-#pragma omp parallel for schedule(static) if (!omp_in_parallel())
+    if (omp_in_parallel() || omp_get_max_threads() == 1) {  // one thread: in pixel order
+        const DepthSum d = sum_support_depths(x, pl, 0, N);
+        return d.count > 0 ? static_cast<float>(d.sum / d.count) : 0.0f;
+    }
+    DepthSum part[kParts];
+#pragma omp parallel for schedule(static)
     for (int k = 0; k < kParts; ++k) part[k] = sum_support_depths(x, pl, N * k / kParts, N * (k + 1) / kParts);
     DepthSum all;
     for (const DepthSum& d : part) {
@@ -115,11 +119,12 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
 
 using ScopeCounts = SegmentWorkspace::ScopeCounts;
 
-/// measure_scope's counts (but the sums of the points) of the segments' pixels in rows [v0,
-/// v1) into cnt[0, n], the touching pairs into `edges` (not unique). Writes nothing else:
-/// strips of rows run in parallel.
+/// measure_scope's counts of the segments' pixels in rows [v0, v1) into cnt[0, n], the
+/// touching pairs into `edges` (not unique), and with `sums` (one strip: the whole frame)
+/// the sums of the points into sums[0][l], sums[1][l], sums[2][l]. Writes nothing else:
+/// strips of rows run in parallel (without sums).
 void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, const int* label, int v0,
-                   int v1, ScopeCounts* cnt, std::vector<std::uint64_t>& edges) {
+                   int v1, ScopeCounts* cnt, std::vector<std::uint64_t>& edges, double* const* sums) {
     const int W = x.W;
     const SegmentParams& prm = x.prm;
     auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
@@ -163,6 +168,7 @@ void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 ScopeCounts& c = cnt[l];
                 c.lo = std::min(c.lo, h);
                 c.any_px = static_cast<int>(p);
+                if (sums) sums[0][l] += x.c.x[p], sums[1][l] += x.c.y[p], sums[2][l] += x.c.z[p];
                 c.hi = std::max(c.hi, h);
                 c.high += h > prm.scope_max_height_m;
                 ++c.size;
@@ -215,13 +221,10 @@ void gather_strips(SegmentWorkspace& ws, int strips, std::size_t L) {
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
 }
 
-/// ws.scope_sx, sy, sz: the sums of each segment's points inside the frame's edge, in raster
-/// order (a double sum in another order would round otherwise). Cost: a pass over the rows
-/// with labels.
-void sum_points(const Ctx& x, const FrameEdge& fe, SegmentWorkspace& ws, std::size_t L) {
-    ws.scope_sx.assign(L, 0.0);
-    ws.scope_sy.assign(L, 0.0);
-    ws.scope_sz.assign(L, 0.0);
+/// ws.scope_sx, sy, sz (zeroed): the sums of each segment's points inside the frame's edge,
+/// in raster order (a double sum in another order would round otherwise). Cost: a pass over
+/// the rows with labels.
+void sum_points(const Ctx& x, const FrameEdge& fe, SegmentWorkspace& ws) {
     const int* const label = ws.label.data();
     for (int v = fe.top; v < fe.bottom; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * x.W;
@@ -244,8 +247,8 @@ void sum_points(const Ctx& x, const FrameEdge& fe, SegmentWorkspace& ws, std::si
 /// or into the frame's top edge, beyond the support's middle `far_z`) or into its other
 /// edges there (scope_frame); the touching segment pairs, once each, into ws.edges. In:
 /// ws.label (1..n with gaps). Cost: one pass over the pixels in strips of rows, a strip per
-/// thread, the counts gathered (O(strips n)), a sort of the pairs, and a pass over the
-/// labelled rows for the sums.
+/// thread, the counts gathered (O(strips n)), a sort of the pairs, and with more than one
+/// strip a pass over the labelled rows for the sums.
 void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
                    int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
@@ -254,16 +257,20 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     constexpr float kMax = std::numeric_limits<float>::max();
     ws.scope_strips.assign(static_cast<std::size_t>(strips) * L, ScopeCounts{kMax, -kMax, -1, 0, 0, 0, 0, 0});
     ws.strip_pairs.resize(static_cast<std::size_t>(strips));
+    ws.scope_sx.assign(L, 0.0);
+    ws.scope_sy.assign(L, 0.0);
+    ws.scope_sz.assign(L, 0.0);
+    double* const sums[3] = {ws.scope_sx.data(), ws.scope_sy.data(), ws.scope_sz.data()};
     const int* const label = ws.label.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (strips > 1)
     for (int s = 0; s < strips; ++s) {
         auto& edges = ws.strip_pairs[static_cast<std::size_t>(s)];
         edges.clear();
         measure_strip(x, pl, fe, far_z, label, fe.top + rows * s / strips, fe.top + rows * (s + 1) / strips,
-                      ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges);
+                      ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges, strips == 1 ? sums : nullptr);
     }
     gather_strips(ws, strips, L);
-    sum_points(x, fe, ws, L);
+    if (strips > 1) sum_points(x, fe, ws);
 }
 
 /// ws.scope_upright: per segment that runs into the frame's sides or bottom (scope_frame),
