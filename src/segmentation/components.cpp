@@ -18,7 +18,7 @@ namespace {
 /// label_components with one strip: a breadth-first search from each seedable pixel no
 /// component holds yet, in raster order. Cost: a memchr over the pixels for the seeds and
 /// the search over the seedable ones (ws.queue).
-int components_by_search(const Ctx& x, const std::uint8_t* seeds, SegmentWorkspace& ws) {
+int components_by_search(const Ctx& x, const std::uint8_t* seeds, SegmentBuffers& ws) {
     const std::size_t N = static_cast<std::size_t>(x.W) * x.H;
     std::fill(ws.label.begin(), ws.label.end(), 0);
     ws.sizes.assign(1, 0);
@@ -83,7 +83,7 @@ inline void link_pixels(const Ctx& x, int* parent, int* size, std::vector<int>& 
 
 /// The sets of rows [v0, v1) on their own (pairs within the strip), one-way pairs into
 /// `oneway`. Cost: two neighbour tests per seedable pixel.
-void link_strip(const Ctx& x, const std::uint8_t* seeds, SegmentWorkspace& ws, int v0, int v1,
+void link_strip(const Ctx& x, const std::uint8_t* seeds, SegmentBuffers& ws, int v0, int v1,
                 std::vector<int>& oneway) {
     const int W = x.W;
     int* const parent = ws.cc_parent.data();
@@ -104,7 +104,7 @@ void link_strip(const Ctx& x, const std::uint8_t* seeds, SegmentWorkspace& ws, i
 
 /// Each seedable pixel of rows [v0, v1) gets its set's root + 1 in ws.label (0 elsewhere),
 /// the strip's roots go to `roots` in raster order. Reads the union-find only.
-void find_roots(const std::uint8_t* seeds, SegmentWorkspace& ws, int W, int v0, int v1, std::vector<int>& roots) {
+void find_roots(const std::uint8_t* seeds, SegmentBuffers& ws, int W, int v0, int v1, std::vector<int>& roots) {
     const int* const parent = ws.cc_parent.data();
     int* const label = ws.label.data();
     roots.clear();
@@ -124,7 +124,7 @@ void find_roots(const std::uint8_t* seeds, SegmentWorkspace& ws, int W, int v0, 
 /// ws.cc_id at each root, their sizes into ws.sizes; returns n. Without one-way pairs each
 /// set is a component; with some, a depth-first search over them from each set no
 /// component holds yet (ws.queue, ws.cc_edges). In: ws.label holding root + 1.
-int number_components(SegmentWorkspace& ws, int strips) {
+int number_components(SegmentBuffers& ws, int strips) {
     int* const id = ws.cc_id.data();
     ws.sizes.assign(1, 0);
     ws.cc_edges.clear();
@@ -168,7 +168,7 @@ int number_components(SegmentWorkspace& ws, int strips) {
 /// label_components on `strips` strips of rows (2 or more, at most H): the sets of each
 /// strip in parallel, joined along the seams, their roots found in parallel, numbered, and
 /// the numbers written in parallel.
-int components_on_strips(const Ctx& x, const std::uint8_t* seeds, SegmentWorkspace& ws, int strips) {
+int components_on_strips(const Ctx& x, const std::uint8_t* seeds, SegmentBuffers& ws, int strips) {
     const int W = x.W, H = x.H;
     const std::size_t N = static_cast<std::size_t>(W) * H;
     ws.cc_parent.resize(N);
@@ -205,7 +205,7 @@ int components_on_strips(const Ctx& x, const std::uint8_t* seeds, SegmentWorkspa
 /// With `inside_only`, grows only into kPlaneInside pixels (a container's inside joins the
 /// container, however wide). Returns the pixels added. Cost: one parallel pass over the
 /// pixels for the search's start, then the search over the pixels it reaches.
-std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool inside_only = false) {
+std::size_t reattach(const Ctx& x, SegmentBuffers& ws, int max_steps, bool inside_only = false) {
     const int W = x.W, H = x.H;
     int head = 0, tail = 0;
     // Only labelled pixels with a neighbour they may grow into start the search, in raster
@@ -271,7 +271,7 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
 /// Fragments too small to seed an object (min_seed_points) go back to the unassigned pool:
 /// their labels in ws.label become 0. In: ws.sizes from components. Cost: one parallel pass
 /// over the pixels.
-void drop_small_components(SegmentWorkspace& ws, int min_seed) {
+void drop_small_components(SegmentBuffers& ws, int min_seed) {
     int* const label = ws.label.data();
     const int* const sizes = ws.sizes.data();
     const auto n_px = static_cast<std::ptrdiff_t>(ws.label.size());
@@ -286,7 +286,7 @@ int row_strips(int rows) {
     return omp_in_parallel() ? 1 : std::max(1, std::min(omp_get_max_threads(), rows / 8));
 }
 
-void relabel_to_roots(SegmentWorkspace& ws) {
+void relabel_to_roots(SegmentBuffers& ws) {
     int* const parent = ws.parent.data();
     const auto n = static_cast<int>(ws.parent.size());
     for (int l = 1; l < n; ++l) parent[l] = find_root(ws.parent, l);
@@ -297,19 +297,19 @@ void relabel_to_roots(SegmentWorkspace& ws) {
         if (label[p]) label[p] = parent[label[p]];
 }
 
-int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentWorkspace& ws, int strips) {
+int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentBuffers& ws, int strips) {
     strips = std::min(strips, x.H);
     return strips > 1 ? components_on_strips(x, seedable, ws, strips) : components_by_search(x, seedable, ws);
 }
 
-int seed_components(const Ctx& x, SegmentWorkspace& ws) {
+int seed_components(const Ctx& x, SegmentBuffers& ws) {
     // A strip per thread; one thread searches.
     const int n = label_components(x, ws.cut.data(), ws, row_strips(x.H));
     drop_small_components(ws, x.prm.min_seed_points);
     return n;
 }
 
-std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws) {
+std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
     // Cut pixels, feet and dropped fragments, then containers' insides, join what they touch.
     const std::size_t near = reattach(x, ws, x.prm.reattach_px);
     return near + reattach(x, ws, x.W + x.H, true);
@@ -320,7 +320,7 @@ std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws) {
 /// n. Each band of the image (a band per thread, in parallel) counts its labels' pixels and
 /// first pixel, the labels are numbered, then `out` is written in parallel. Cost: two
 /// parallel passes over the pixels, O(bands n + n log n) between them.
-int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
+int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out) {
     // Bands of 512 pixels at least (row_strips' 8 rows of 64).
     const int bands = row_strips(static_cast<int>(std::min<std::size_t>(ws.label.size(), 1u << 30) / 64));
     const std::size_t L = static_cast<std::size_t>(n) + 1;

@@ -56,7 +56,7 @@ void strip_boundary_steps(const Ctx& x, const int* label, int v0, int v1, std::v
 /// ws.rim_rows. In: ws.label (0..n). Cost: O(pixels) in strips of rows in parallel (their
 /// pairs joined in strip order: the raster order of one pass), then a sort of the boundary
 /// pairs.
-void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
+void collect_boundary_steps(const Ctx& x, SegmentBuffers& ws, int n) {
     const int strips = row_strips(x.H);
     const std::size_t rows_size = 2 * (static_cast<std::size_t>(n) + 1);
     auto by_key = [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; };
@@ -108,7 +108,7 @@ constexpr double kFarRimMinWidth = 1.0;
 
 /// The front segment's extent on the plane across the line of sight through `centre` (the
 /// camera lies at the plane's origin). Cost: one pass over the front's rows.
-double front_width(const Ctx& x, const PlaneAxes& plane_xy, const SegmentWorkspace& ws, int front,
+double front_width(const Ctx& x, const PlaneAxes& plane_xy, const SegmentBuffers& ws, int front,
                    const Eigen::Vector2d& centre) {
     const Eigen::Vector2d across = Eigen::Vector2d(centre.y(), -centre.x()).normalized();
     const int r0 = ws.rim_rows[2 * static_cast<std::size_t>(front)];
@@ -173,7 +173,7 @@ std::optional<RimCircle> rim_circle(const Ctx& x, const Plane& pl, const PlaneAx
 /// `rim_height` over the plane, and nearer across a depth step than a 4-neighbour that
 /// belongs to neither segment (or has no depth). A container's inside, seen over its front
 /// wall, ends there at the far half of the rim. Cost: one pass over the back's rows.
-void collect_far_rim(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int front, int back, double rim_height) {
+void collect_far_rim(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int front, int back, double rim_height) {
     const int W = x.W, H = x.H;
     const auto& label = ws.label;
     auto steps_to_farther = [&](std::size_t p, std::size_t q) {
@@ -208,7 +208,7 @@ void collect_far_rim(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int fr
 /// Cost: one pass over the back's rows and one over the front's; rim_circle's passes over
 /// the edge and the far rim, twice. ws.rim_far_px keeps its capacity across frames.
 template <class ForEdge>
-std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws,
                                         ForEdge& for_edge, int front, int back) {
     double m = 0, rim_height = 0;
     for_edge([&](std::size_t p) {
@@ -240,7 +240,7 @@ std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const Pla
 /// (far_rim_circle). Appends each that passes to ws.rim_fits as {front, back, centre (2),
 /// radius, rim height}; the inside test then judges each. Cost: rim_circle's passes over
 /// the pair's boundary pairs, and far_rim_circle's; no allocation but the appends.
-void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws,
              std::size_t i0, std::size_t i1, int front, int back) {
     auto for_edge = [&](auto&& visit) {
         for (std::size_t j = i0; j < i1; ++j)
@@ -259,7 +259,7 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
 /// segment nearer along them, and its edge must be a circular arc (fit_rim). In: ws.steps,
 /// sorted. Out: ws.rim_fits. Cost: one pass over the boundary pairs, then fit_rim's passes
 /// over each candidate's.
-void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws) {
+void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws) {
     const SegmentParams& prm = x.prm;
     ws.rim_fits.clear();
     for (std::size_t i = 0; i < ws.steps.size();) {
@@ -284,7 +284,7 @@ void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, Segment
 /// back's top, into ws.rim_back. A back segment may sit behind several fronts: ws.remap holds
 /// each segment's first candidate and ws.rim_next links the rest. Cost: one pass over the
 /// rows the back segments span, O(candidates) per back pixel (one in practice).
-void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws, int n) {
+void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws, int n) {
     const int W = x.W, H = x.H;
     const int C = static_cast<int>(ws.rim_fits.size());
     ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
@@ -319,7 +319,7 @@ void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, S
 /// Joins each candidate's back to its front when the back's feet lie inside the circle and
 /// its top reaches the rim, and relabels. Returns the joins. Cost: O(candidates), then one
 /// pass over the pixels when anything joined.
-int join_insides(const Ctx& x, SegmentWorkspace& ws, int n) {
+int join_insides(const Ctx& x, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
     reset_sets(ws.parent, n);
     int joins = 0;
@@ -335,7 +335,7 @@ int join_insides(const Ctx& x, SegmentWorkspace& ws, int n) {
 
 /// The rim test over segments 1..n (with gaps): candidates, their circles, their insides,
 /// the joins. Returns the joins. Cost: as join_containers', less the islands.
-int join_rims(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     if (n < 2) return 0;
     collect_boundary_steps(x, ws, n);
     const PlaneAxes plane_xy(pl);
@@ -357,7 +357,7 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 /// gaps). Out: ws.label with the insides joined. Cost: one pass over the pixels and a sort of
 /// the boundary pairs; then per candidate a few passes over its boundary, and one over the
 /// rows of the candidates' insides; with islands, add_islands and keep_lone_islands.
-void join_containers(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     if (!support || x.prm.rim_min_boundary <= 0 || n < 1) return;
     const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
     stats.containers = join_rims(x, *support, ws, n + islands);

@@ -58,7 +58,7 @@ void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, std::vector<
 /// of rows (in parallel), a sort of the boundary pairs (the order they come in does not
 /// matter), one more parallel pass to relabel when anything merged.
 template <class MayJoin>
-int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) {
+int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
     const SegmentParams& prm = x.prm;
     if (prm.merge_max_concave <= 0 || n < 2) return 0;
     const int strips = row_strips(x.H);
@@ -98,7 +98,7 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) 
 
 }  // namespace
 
-void merge_segments(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void merge_segments(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
 }
 
@@ -111,7 +111,7 @@ void merge_segments(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, Se
 /// crease, ran along their boundary too; once the cue has made the upper box a segment of
 /// its own, the pieces' boundary is their own convex edge. Cost: one pass over the rows with
 /// labels for the segments' mean colours, then merge_convex's.
-void rejoin_materials(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void rejoin_materials(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     const SegmentParams& prm = x.prm;
     if (stats.color_splits == 0 || !prm.color_rejoin) return;
     ws.material.assign(static_cast<std::size_t>(n) + 1, {0, 0, 0, 0});

@@ -117,7 +117,7 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
     return static_cast<float>(all.sum / all.count);
 }
 
-using ScopeCounts = SegmentWorkspace::ScopeCounts;
+using ScopeCounts = SegmentBuffers::ScopeCounts;
 
 /// measure_scope's counts of the segments' pixels in rows [v0, v1) into cnt[0, n], the
 /// touching pairs into `edges` (not unique), and with `sums` (one strip: the whole frame)
@@ -192,7 +192,7 @@ void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
 /// The strips' counts into ws.scope_* and ws.sizes (minima, maxima, the last pixel, sums of
 /// counts: the same in any order of the strips), their touching pairs into ws.edges, once
 /// each.
-void gather_strips(SegmentWorkspace& ws, int strips, std::size_t L) {
+void gather_strips(SegmentBuffers& ws, int strips, std::size_t L) {
     ws.scope_lo.resize(L);
     ws.scope_hi.resize(L);
     ws.scope_any_px.resize(L);
@@ -224,7 +224,7 @@ void gather_strips(SegmentWorkspace& ws, int strips, std::size_t L) {
 /// ws.scope_sx, sy, sz (zeroed): the sums of each segment's points inside the frame's edge,
 /// in raster order (a double sum in another order would round otherwise). Cost: a pass over
 /// the rows with labels.
-void sum_points(const Ctx& x, const FrameEdge& fe, SegmentWorkspace& ws) {
+void sum_points(const Ctx& x, const FrameEdge& fe, SegmentBuffers& ws) {
     const int* const label = ws.label.data();
     for (int v = fe.top; v < fe.bottom; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * x.W;
@@ -249,7 +249,7 @@ void sum_points(const Ctx& x, const FrameEdge& fe, SegmentWorkspace& ws) {
 /// ws.label (1..n with gaps). Cost: one pass over the pixels in strips of rows, a strip per
 /// thread, the counts gathered (O(strips n)), a sort of the pairs, and with more than one
 /// strip a pass over the labelled rows for the sums.
-void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
+void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentBuffers& ws,
                    int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const int rows = std::max(fe.bottom - fe.top, 0);
@@ -277,7 +277,7 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
 /// its pixels facing sideways (normals within kUprightDeg of the support plane); 0 for the
 /// others. Cost: none when no segment does (most tabletop frames), else one pass over the
 /// pixels.
-void count_upright(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+void count_upright(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     ws.scope_upright.assign(L, 0);
     if (std::all_of(ws.scope_frame.begin(), ws.scope_frame.end(), [](int f) { return f == 0; })) return;
@@ -297,7 +297,7 @@ void count_upright(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 /// A box seen from steeply above shows its top alone, its sides in shadow or edge-on, and
 /// its body hides its foot. A box hanging over the table, seen obliquely, shows the table
 /// under its middle. Cost: a few reads per segment.
-bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, std::size_t l) {
+bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::size_t l) {
     const int p = ws.scope_any_px[l];
     if (p < 0 || ws.sizes[l] == 0) return false;
     const int W = x.W, u = p % W, v = p / W;
@@ -338,7 +338,7 @@ bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, std:
 /// bottom can lie well above its supporter's visible top (a tin's lid overhangs what it
 /// stands on), and what hangs or is fixed to a wall has already left the volume. Cost: O(n),
 /// then passes over ws.edges until "rests on" stops spreading.
-void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     auto& keep = ws.scope_keep;
@@ -372,7 +372,7 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 
 /// Clears the labels of the segments not kept. Returns those of min_points or more (within
 /// the frame's edge). Cost: one parallel pass over the pixels.
-int clear_out_of_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+int clear_out_of_scope(const SegmentParams& prm, SegmentBuffers& ws, int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const auto& keep = ws.scope_keep;
     int left_out = 0;
@@ -392,7 +392,7 @@ int clear_out_of_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
 /// plane's classes. Out: the number of segments of min_points or more left out. Cost: one
 /// pass over the pixels (heights, outlines, touching pairs) and one over the depths, then a
 /// few passes over the touching pairs until "rests on" stops spreading.
-int keep_held(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+int keep_held(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const FrameEdge edge = find_frame_edge(x);
     const float far_z = support_middle_depth(x, pl);
     measure_scope(x, pl, edge, far_z, ws, n);
@@ -403,7 +403,7 @@ int keep_held(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 
 }  // namespace
 
-void restrict_to_support(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.support_scope = true;
     stats.out_of_scope = keep_held(x, *support, ws, n);
 }

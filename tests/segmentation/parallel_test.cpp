@@ -131,7 +131,7 @@ TEST(LabelComponents, StripsGiveTheSearchsLabels_RandomMasksOfOddSizes) {
             const std::vector<int> ref = reference_components(f, prm, ref_sizes);
             const Ctx x{prm, f.cloud, f.normals, f.classes, c.W, c.H};
             for (const int strips : {1, 2, 3, 5, 8, 13}) {
-                SegmentWorkspace ws;
+                SegmentWorkspace::Buffers ws;
                 ws.label.assign(f.seedable.size(), -7);  // stale labels: every pixel is written
                 ws.queue.resize(f.seedable.size());
                 const int n = label_components(x, f.seedable.data(), ws, strips);
@@ -151,7 +151,7 @@ TEST(LabelComponents, StripsGiveTheSearchsLabels_RandomMasksOfOddSizes) {
 // Workspaces reused across frames of other sizes and thread counts give what fresh ones do.
 TEST(LabelComponents, WorkspaceReusedAcrossSizesAndStrips) {
     const SegmentParams prm;
-    SegmentWorkspace ws;
+    SegmentWorkspace::Buffers ws;
     std::uint32_t seed = 100;
     for (const int strips : {5, 2, 8, 1, 3}) {
         for (const int W : {90, 33, 120}) {
