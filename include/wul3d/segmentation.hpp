@@ -10,10 +10,9 @@
 /// hybrid segmenter adds the colour cue of the paper's weighted clustering where geometry
 /// is silent (two flush boxes of different colours). The kmeans segmenter is the paper's
 /// clustering alone, split into connected parts.
-#include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "wul3d/cloud.hpp"
@@ -190,86 +189,20 @@ struct SegmentParams {
     void validate() const;  ///< throws ParamError naming the field
 };
 
-/// A 4-neighbour pixel pair where two segments meet (the container rule).
-struct BoundaryStep {
-    std::uint64_t key;   ///< lower segment << 34 | higher << 4 | depth step << 1 | lower nearer
-    std::uint32_t near;  ///< the nearer pixel
-};
+/// segment_objects' buffers, sized once per resolution and reused from frame to frame
+/// (opaque: src/segmentation/internal.hpp).
+class SegmentWorkspace {
+public:
+    SegmentWorkspace();
+    ~SegmentWorkspace();
+    SegmentWorkspace(SegmentWorkspace&&) noexcept;
+    SegmentWorkspace& operator=(SegmentWorkspace&&) noexcept;
 
-/// Scratch, sized once per resolution.
-struct SegmentWorkspace {
-    NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
-    std::vector<float> smooth_scratch;
-    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component; once the seeds are
-                                       ///< spent, the container rule's open pixels (islands)
-    std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
-    std::vector<int> label;    ///< 0 none, 1..n
-    std::vector<int> queue;
-    std::vector<int> dist;
-    std::vector<int> sizes;
-    std::vector<int> remap;
-    std::vector<int> offsets;  ///< counting sort of pixels by label
-    std::vector<int> order;
-    // The final renumbering (compact) reuses sizes, offsets and order for each label's pixel
-    // count, first pixel and the labels kept, in order of their first pixel.
-    std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
-    std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
-    std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
-    std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
-    std::vector<std::uint8_t> to_try;  ///< colour cue: 1 = try segment l this round
-    std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
-    std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
-    std::vector<int> parent;           ///< union-find over segments
-    std::vector<int> origin;           ///< colour cue: the segment (before it) each label
-                                       ///< comes from
-    std::vector<std::array<double, 4>> material;  ///< rejoin: per segment, sums of r, g, b
-                                                  ///< and the pixels
-    std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
-                                                                  ///< offset per line (steps)
-    std::vector<std::uint8_t> occluded_outline;  ///< occlusion: 1 = outline pixel, one row
-    // Containers:
-    std::vector<BoundaryStep> steps;   ///< boundary pairs of two segments
-    std::vector<int> rim_rows;         ///< first and last row of each segment
-    std::vector<std::array<double, 6>> rim_fits;  ///< front, back, circle centre (2), radius,
-                                                  ///< rim height per candidate
-    std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
-    std::vector<int> rim_next;         ///< candidates of one back segment, linked
-    std::vector<int> rim_far_px;       ///< the back's far rim, of the pair being fitted
-    std::vector<int> island_pixels, island_outline;  ///< lone islands: per island
-    std::vector<std::uint8_t> island_lone;           ///< 1 = kept
-    // Floor gaps:
-    std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
-    std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
-    // Scope: per segment its lowest and highest point over the support, points above the
-    // height limit, outline pairs, and those that continue into removed points above it.
-    std::vector<float> scope_lo, scope_hi;
-    std::vector<int> scope_any_px;                     ///< one pixel of each segment
-    std::vector<double> scope_sx, scope_sy, scope_sz;  ///< sums of each segment's points
-    std::vector<int> scope_high, scope_outline, scope_outside;
-    std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
-                                                  ///< bottom; pixels facing sideways
-    std::vector<std::uint8_t> scope_keep;
-    // Stacks:
-    std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
-    std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)
-    /// A pixel of an upper object's wall: its segment and where it stands on the support plane.
-    struct WallPoint {
-        int segment;
-        float u, v;
-    };
-    /// Where one segment's upper object's walls stand: cells of wall_cells[at, at + cols *
-    /// rows), row by row from (u0, v0) on the plane; cols 0: no map.
-    struct WallMap {
-        float u0 = 0, v0 = 0;
-        int cols = 0, rows = 0;
-        std::size_t at = 0;
-    };
-    std::vector<WallPoint> stack_walls;      ///< the cut segments' upper walls
-    std::vector<WallMap> wall_maps;          ///< per segment
-    std::vector<std::array<float, 4>> wall_box;  ///< scratch: per segment its walls' u0, v0, u1, v1
-    std::vector<std::uint8_t> wall_cells;    ///< 1 = an upper object's wall stands in that cell
-    std::vector<std::array<double, 4>> wall_colour;  ///< per segment and piece: chromaticity
-                                                     ///< sums (3) and count
+    struct Buffers;      ///< src/segmentation/internal.hpp
+    Buffers& buffers();  ///< for segmentation's own code and its tests (made again after a move)
+
+private:
+    std::unique_ptr<Buffers> b_;
 };
 
 /// What segmentation did, as data.

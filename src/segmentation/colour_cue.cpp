@@ -25,7 +25,7 @@ namespace {
 /// rows in parallel: counts per band, then each band writes from its own start (segment by
 /// segment, bands in order). In: ws.label (0..n). Cost: two parallel passes over the pixels,
 /// O(8 n) between them.
-void sort_pixels_by_segment(const Ctx& x, SegmentWorkspace& ws, int n) {
+void sort_pixels_by_segment(const Ctx& x, SegmentBuffers& ws, int n) {
     const int W = x.W;
     constexpr int kSortBands = 8;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
@@ -62,7 +62,7 @@ void sort_pixels_by_segment(const Ctx& x, SegmentWorkspace& ws, int n) {
     }
 }
 
-int segment_size(const SegmentWorkspace& ws, int l) {
+int segment_size(const SegmentBuffers& ws, int l) {
     return ws.offsets[static_cast<std::size_t>(l) + 1] - ws.offsets[static_cast<std::size_t>(l)];
 }
 
@@ -83,7 +83,7 @@ struct ColourFeatures {
 /// that a squared distance is a sum. Only the segments' pixels (order positions first..last)
 /// are gathered: plane q holds position i at f[q][i - first], sized by the object pixels, not
 /// the image. In: ws.order, ws.offsets. Cost: one parallel pass over the object pixels.
-ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWorkspace& ws, int n) {
+ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentBuffers& ws, int n) {
     const int first = ws.offsets[1], last = ws.offsets[static_cast<std::size_t>(n) + 1];
     const std::size_t M = static_cast<std::size_t>(last - first);
     ws.feature.resize(6 * M);
@@ -110,7 +110,7 @@ ColourFeatures gather_features(const Ctx& x, const ClusterParams& cp, SegmentWor
 /// The segments of this round (ws.to_try) large enough to split (2 x min_points), largest
 /// first, into ws.by_size: tried in parallel, no thread is left with a big one at the end.
 /// Cost: O(n log n).
-void order_by_size(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+void order_by_size(const SegmentParams& prm, SegmentBuffers& ws, int n) {
     ws.by_size.clear();
     for (int l = 1; l <= n; ++l)
         if (ws.to_try[static_cast<std::size_t>(l)] && segment_size(ws, l) >= 2 * prm.min_points)
@@ -263,7 +263,7 @@ struct SplitBoundary {
 /// (dv = 1) that lies in segment l in another part (ws.part): each boundary pair inside the
 /// segment once. Cost: two lookups.
 template <class Visit>
-void for_part_boundary_pairs(const Ctx& x, const SegmentWorkspace& ws, int l, int p, Visit&& visit) {
+void for_part_boundary_pairs(const Ctx& x, const SegmentBuffers& ws, int l, int p, Visit&& visit) {
     const int W = x.W, u = p % W, v = p / W;
     const std::uint8_t* const part = ws.part.data();
     if (u + 1 < W && ws.label[static_cast<std::size_t>(p) + 1] == l && part[p + 1] != part[p]) visit(p + 1, 1, 0);
@@ -273,7 +273,7 @@ void for_part_boundary_pairs(const Ctx& x, const SegmentWorkspace& ws, int l, in
 /// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part), its
 /// brightness steps on one plane, and the smaller part's outline. Cost: one pass over the
 /// segment's pixels and their neighbours.
-SplitBoundary split_boundary(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
+SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m,
                              std::uint8_t small_part, float cos_crease) {
     const int W = x.W, s = x.prm.crease_step_px;
     const std::uint8_t* const part = ws.part.data();
@@ -374,7 +374,7 @@ enum class Verdict {
 /// pass over the segment's pixels for the boundary; the round test's three more, on a
 /// support, when every other test passed.
 Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ClusterParams& cp,
-                    float cos_crease, const SegmentWorkspace& ws, int l, const int* px, int m, const int (&count)[2],
+                    float cos_crease, const SegmentBuffers& ws, int l, const int* px, int m, const int (&count)[2],
                     const float (&cen)[2][6]) {
     const SegmentParams& prm = x.prm;
     const int small = std::min(count[0], count[1]);
@@ -533,7 +533,7 @@ void texture_colours(const float* const* f, int m, const float (&two)[2][6], std
 /// of a compact piece) they lie apart. Between the two the pair is neither: no split. True,
 /// with `material` (0 or 1 per colour), when the colours make exactly two materials. Cost:
 /// one pass over the segment's pixels.
-bool texture_materials(const Ctx& x, const SegmentWorkspace& ws, int l, const int* px, int m,
+bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m,
                        const int (&count)[kTextureColours], std::uint8_t (&material)[kTextureColours]) {
     constexpr int K = kTextureColours;
     const SegmentParams& prm = x.prm;
@@ -585,7 +585,7 @@ bool texture_materials(const Ctx& x, const SegmentWorkspace& ws, int l, const in
 /// texture_materials, then ws.part, side, `count` and `cen` say the materials (cen: their
 /// means). False, and ws.part not a split, when the colours are not two materials. Cost:
 /// texture_colours' passes and two more over the segment's pixels.
-bool split_by_materials(const Ctx& x, SegmentWorkspace& ws, int l, const int* px, const float* const* f, int m,
+bool split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, const float* const* f, int m,
                         std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
     float colour[kTextureColours][6];
     int colour_count[kTextureColours];
@@ -625,7 +625,7 @@ enum Split : std::uint8_t { kNotSplit = 0, kSplitByColour = 1, kSplitByMaterial 
 /// materials' passes when 2-means followed a texture; no allocation (called in parallel, one
 /// segment per call).
 Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
-                       const ClusterParams& cp, float cos_crease, SegmentWorkspace& ws, int l) {
+                       const ClusterParams& cp, float cos_crease, SegmentBuffers& ws, int l) {
     const SegmentParams& prm = x.prm;
     const int o = ws.offsets[static_cast<std::size_t>(l)];
     const int* px = ws.order.data() + o;
@@ -653,7 +653,7 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
 /// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
 /// thread order), with the split segment's ws.origin. Returns the splits, and adds those by
 /// material to `by_material`. Cost: one pass over the split segments' pixels.
-int number_splits(SegmentWorkspace& ws, int n, int& by_material) {
+int number_splits(SegmentBuffers& ws, int n, int& by_material) {
     int splits = 0, next = n;
     for (int l = 1; l <= n; ++l) {
         if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
@@ -676,7 +676,7 @@ int number_splits(SegmentWorkspace& ws, int n, int& by_material) {
 /// Returns the splits, and adds those by material to `by_material`. Cost: a counting sort
 /// and a gather of the object pixels (parallel passes), then O(segment pixels) per 2-means
 /// iteration per segment tried, segments in parallel.
-int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
+int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, int& by_material) {
     const SegmentParams& prm = x.prm;
     sort_pixels_by_segment(x, ws, n);
     // part is written for a segment's pixels before anything reads them: no clearing.
@@ -714,7 +714,7 @@ int split_round(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n,
 /// n + 1, n + 2, ... (round 1's in segment order, then round 2's), and ws.origin, each
 /// label's segment before the cue; `by_material` counts the splits between materials. Cost:
 /// split_round once, twice when it split anything.
-int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n, int& by_material) {
+int color_splits(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, int& by_material) {
     by_material = 0;
     // Each label's segment before the cue; a round adds at most one label per segment.
     ws.origin.resize(4 * static_cast<std::size_t>(n) + 1);
@@ -732,7 +732,7 @@ int color_splits(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int n
 
 }  // namespace
 
-void split_by_colour(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void split_by_colour(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.color_splits = color_splits(x, support, ws, n, stats.texture_splits);
     n += stats.color_splits;
 }

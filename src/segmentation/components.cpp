@@ -7,23 +7,22 @@
 #include <cstring>
 #include <limits>
 
+#include <omp.h>
+
 #include "internal.hpp"
 #include "wul3d/plane.hpp"
 
 namespace wul3d::detail {
 namespace {
 
-/// Connected components of the pixels with `seedable[p]` = 1 (else 0, as ws.cut holds),
-/// 4-connected where depth is continuous; `ws.label` gets 1..n, returns n. Sizes in
-/// ws.sizes[1..n]. Cost: a memchr over the pixels for the seeds and a breadth-first search
-/// over the seedable ones (ws.queue).
-int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentWorkspace& ws) {
-    const int W = x.W, H = x.H;
-    const std::size_t N = static_cast<std::size_t>(W) * H;
+/// label_components with one strip: a breadth-first search from each seedable pixel no
+/// component holds yet, in raster order. Cost: a memchr over the pixels for the seeds and
+/// the search over the seedable ones (ws.queue).
+int components_by_search(const Ctx& x, const std::uint8_t* seeds, SegmentBuffers& ws) {
+    const std::size_t N = static_cast<std::size_t>(x.W) * x.H;
     std::fill(ws.label.begin(), ws.label.end(), 0);
     ws.sizes.assign(1, 0);
     int n = 0;
-    const std::uint8_t* const seeds = seedable.data();
     for (std::size_t seed = 0; seed < N; ++seed) {
         if (!seeds[seed]) {
             // The next seedable pixel: memchr skips the run of others (most of the frame).
@@ -35,9 +34,169 @@ int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentW
         const int id = ++n;
         ws.label[seed] = id;
         ws.sizes.push_back(flood_region(
-            x, ws.queue, static_cast<int>(seed), [&](std::size_t q) { return seedable[q] && !ws.label[q]; },
+            x, ws.queue, static_cast<int>(seed), [&](std::size_t q) { return seeds[q] && !ws.label[q]; },
             [&](std::size_t q) { ws.label[q] = id; }));
     }
+    return n;
+}
+
+// ---- label_components on strips -------------------------------------------------------
+// The search's components, put together from sets: two 4-neighbours whose depth is
+// continuous seen from either are one set (the search crosses between them both ways, so a
+// component holds a set whole), and a pair continuous seen from the far pixel only is a
+// one-way pair from that pixel's set to the near one's. A component is then its first set
+// (in raster order of the sets' first pixels, among those no component holds yet) and the
+// sets it reaches over one-way pairs. Sets are a union-find over pixels whose root is the
+// set's first pixel; one-way pairs are rare (a depth step between the noise at the near and
+// at the far depth), and without any a component is one set.
+
+/// The root of pixel p's set; halves the path (writes parent: the caller's strip only).
+inline int find_pixel(int* parent, int p) {
+    while (parent[p] != p) {
+        parent[p] = parent[parent[p]];
+        p = parent[p];
+    }
+    return p;
+}
+
+/// Joins the sets of p and q (the first pixel stays root) and their sizes at the root.
+inline void unite_pixels(int* parent, int* size, int p, int q) {
+    int a = find_pixel(parent, p), b = find_pixel(parent, q);
+    if (a == b) return;
+    if (a > b) std::swap(a, b);
+    parent[b] = a;
+    size[a] += size[b];
+}
+
+/// Seedable 4-neighbours p and q: one set where depth is continuous seen from both, else a
+/// one-way pair (from, to) into `oneway` where from one only.
+inline void link_pixels(const Ctx& x, int* parent, int* size, std::vector<int>& oneway, int p, int q) {
+    const bool pq = x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q));
+    const bool qp = x.connected(static_cast<std::size_t>(q), static_cast<std::size_t>(p));
+    if (pq && qp) {
+        unite_pixels(parent, size, p, q);
+    } else if (pq || qp) {
+        oneway.push_back(pq ? p : q);
+        oneway.push_back(pq ? q : p);
+    }
+}
+
+/// The sets of rows [v0, v1) on their own (pairs within the strip), one-way pairs into
+/// `oneway`. Cost: two neighbour tests per seedable pixel.
+void link_strip(const Ctx& x, const std::uint8_t* seeds, SegmentBuffers& ws, int v0, int v1,
+                std::vector<int>& oneway) {
+    const int W = x.W;
+    int* const parent = ws.cc_parent.data();
+    int* const size = ws.cc_size.data();
+    oneway.clear();
+    for (int v = v0; v < v1; ++v) {
+        const int row = v * W;
+        for (int u = 0; u < W; ++u) {
+            const int p = row + u;
+            if (!seeds[p]) continue;
+            parent[p] = p;
+            size[p] = 1;
+            if (u > 0 && seeds[p - 1]) link_pixels(x, parent, size, oneway, p, p - 1);
+            if (v > v0 && seeds[p - W]) link_pixels(x, parent, size, oneway, p, p - W);
+        }
+    }
+}
+
+/// Each seedable pixel of rows [v0, v1) gets its set's root + 1 in ws.label (0 elsewhere),
+/// the strip's roots go to `roots` in raster order. Reads the union-find only.
+void find_roots(const std::uint8_t* seeds, SegmentBuffers& ws, int W, int v0, int v1, std::vector<int>& roots) {
+    const int* const parent = ws.cc_parent.data();
+    int* const label = ws.label.data();
+    roots.clear();
+    for (int p = v0 * W; p < v1 * W; ++p) {
+        if (!seeds[p]) {
+            label[p] = 0;
+            continue;
+        }
+        int r = p;
+        while (parent[r] != r) r = parent[r];
+        label[p] = r + 1;
+        if (r == p) roots.push_back(p);
+    }
+}
+
+/// Numbers the components from the sets (roots in raster order, strip by strip) into
+/// ws.cc_id at each root, their sizes into ws.sizes; returns n. Without one-way pairs each
+/// set is a component; with some, a depth-first search over them from each set no
+/// component holds yet (ws.queue, ws.cc_edges). In: ws.label holding root + 1.
+int number_components(SegmentBuffers& ws, int strips) {
+    int* const id = ws.cc_id.data();
+    ws.sizes.assign(1, 0);
+    ws.cc_edges.clear();
+    for (int s = 0; s < strips; ++s) {
+        const std::vector<int>& pairs = ws.cc_oneway[static_cast<std::size_t>(s)];
+        for (std::size_t i = 0; i < pairs.size(); i += 2) {
+            const auto a = static_cast<std::uint64_t>(ws.label[static_cast<std::size_t>(pairs[i])] - 1);
+            const auto b = static_cast<std::uint64_t>(ws.label[static_cast<std::size_t>(pairs[i + 1])] - 1);
+            if (a != b) ws.cc_edges.push_back(a << 32 | b);
+        }
+    }
+    std::sort(ws.cc_edges.begin(), ws.cc_edges.end());
+    for (int s = 0; s < strips; ++s)
+        for (const int r : ws.cc_roots[static_cast<std::size_t>(s)]) id[r] = 0;
+    int n = 0;
+    for (int s = 0; s < strips; ++s) {
+        for (const int r : ws.cc_roots[static_cast<std::size_t>(s)]) {
+            if (id[r]) continue;
+            const int c = ++n;
+            int size = 0, top = 0;
+            id[r] = c;
+            ws.queue[static_cast<std::size_t>(top++)] = r;
+            while (top > 0) {
+                const int a = ws.queue[static_cast<std::size_t>(--top)];
+                size += ws.cc_size[static_cast<std::size_t>(a)];
+                const std::uint64_t from = static_cast<std::uint64_t>(a) << 32;
+                auto e = std::lower_bound(ws.cc_edges.begin(), ws.cc_edges.end(), from);
+                for (; e != ws.cc_edges.end() && (*e >> 32) == static_cast<std::uint64_t>(a); ++e) {
+                    const auto b = static_cast<int>(*e & 0xffffffffu);
+                    if (id[b]) continue;
+                    id[b] = c;
+                    ws.queue[static_cast<std::size_t>(top++)] = b;
+                }
+            }
+            ws.sizes.push_back(size);
+        }
+    }
+    return n;
+}
+
+/// label_components on `strips` strips of rows (2 or more, at most H): the sets of each
+/// strip in parallel, joined along the seams, their roots found in parallel, numbered, and
+/// the numbers written in parallel.
+int components_on_strips(const Ctx& x, const std::uint8_t* seeds, SegmentBuffers& ws, int strips) {
+    const int W = x.W, H = x.H;
+    const std::size_t N = static_cast<std::size_t>(W) * H;
+    ws.cc_parent.resize(N);
+    ws.cc_size.resize(N);
+    ws.cc_id.resize(N);
+    ws.cc_roots.resize(static_cast<std::size_t>(strips));
+    ws.cc_oneway.resize(static_cast<std::size_t>(strips));
+    auto strip_row = [&](int s) { return static_cast<int>(static_cast<long long>(H) * s / strips); };
+#pragma omp parallel for schedule(static)
+    for (int s = 0; s < strips; ++s)
+        link_strip(x, seeds, ws, strip_row(s), strip_row(s + 1), ws.cc_oneway[static_cast<std::size_t>(s)]);
+    // The seams, in order (their one-way pairs with the first strip's).
+    for (int s = 1; s < strips; ++s) {
+        const int row = strip_row(s) * W;
+        for (int p = row; p < row + W; ++p)
+            if (seeds[p] && seeds[p - W])
+                link_pixels(x, ws.cc_parent.data(), ws.cc_size.data(), ws.cc_oneway[0], p, p - W);
+    }
+#pragma omp parallel for schedule(static)
+    for (int s = 0; s < strips; ++s)
+        find_roots(seeds, ws, W, strip_row(s), strip_row(s + 1), ws.cc_roots[static_cast<std::size_t>(s)]);
+    const int n = number_components(ws, strips);
+    int* const label = ws.label.data();
+    const int* const id = ws.cc_id.data();
+    const auto n_px = static_cast<std::ptrdiff_t>(N);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n_px; ++p)
+        if (label[p]) label[p] = id[label[p] - 1];
     return n;
 }
 
@@ -46,7 +205,7 @@ int components(const Ctx& x, const std::vector<std::uint8_t>& seedable, SegmentW
 /// With `inside_only`, grows only into kPlaneInside pixels (a container's inside joins the
 /// container, however wide). Returns the pixels added. Cost: one parallel pass over the
 /// pixels for the search's start, then the search over the pixels it reaches.
-std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool inside_only = false) {
+std::size_t reattach(const Ctx& x, SegmentBuffers& ws, int max_steps, bool inside_only = false) {
     const int W = x.W, H = x.H;
     int head = 0, tail = 0;
     // Only labelled pixels with a neighbour they may grow into start the search, in raster
@@ -112,7 +271,7 @@ std::size_t reattach(const Ctx& x, SegmentWorkspace& ws, int max_steps, bool ins
 /// Fragments too small to seed an object (min_seed_points) go back to the unassigned pool:
 /// their labels in ws.label become 0. In: ws.sizes from components. Cost: one parallel pass
 /// over the pixels.
-void drop_small_components(SegmentWorkspace& ws, int min_seed) {
+void drop_small_components(SegmentBuffers& ws, int min_seed) {
     int* const label = ws.label.data();
     const int* const sizes = ws.sizes.data();
     const auto n_px = static_cast<std::ptrdiff_t>(ws.label.size());
@@ -123,13 +282,34 @@ void drop_small_components(SegmentWorkspace& ws, int min_seed) {
 
 }  // namespace
 
-int seed_components(const Ctx& x, SegmentWorkspace& ws) {
-    const int n = components(x, ws.cut, ws);
+int row_strips(int rows) {
+    return omp_in_parallel() ? 1 : std::max(1, std::min(omp_get_max_threads(), rows / 8));
+}
+
+void relabel_to_roots(SegmentBuffers& ws) {
+    int* const parent = ws.parent.data();
+    const auto n = static_cast<int>(ws.parent.size());
+    for (int l = 1; l < n; ++l) parent[l] = find_root(ws.parent, l);
+    int* const label = ws.label.data();
+    const auto n_px = static_cast<std::ptrdiff_t>(ws.label.size());
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n_px; ++p)
+        if (label[p]) label[p] = parent[label[p]];
+}
+
+int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentBuffers& ws, int strips) {
+    strips = std::min(strips, x.H);
+    return strips > 1 ? components_on_strips(x, seedable, ws, strips) : components_by_search(x, seedable, ws);
+}
+
+int seed_components(const Ctx& x, SegmentBuffers& ws) {
+    // A strip per thread; one thread searches.
+    const int n = label_components(x, ws.cut.data(), ws, row_strips(x.H));
     drop_small_components(ws, x.prm.min_seed_points);
     return n;
 }
 
-std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws) {
+std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
     // Cut pixels, feet and dropped fragments, then containers' insides, join what they touch.
     const std::size_t near = reattach(x, ws, x.prm.reattach_px);
     return near + reattach(x, ws, x.W + x.H, true);
@@ -137,23 +317,23 @@ std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws) {
 
 /// Drops labels with fewer than min_points pixels and writes the rest to `out` renumbered
 /// 1..n in order of first appearance (raster order); ws.label keeps the old numbers. Returns
-/// n. Each half of the image (in parallel) counts its labels' pixels and first pixel, the
-/// labels are numbered, then `out` is written in parallel. Two halves only: the labels run
-/// up to the number of components, tiny fragments included, and each half keeps a row of
-/// them. Cost: two parallel passes over the pixels, O(n log n) between them.
-int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
-    constexpr int kBands = 2;
+/// n. Each band of the image (a band per thread, in parallel) counts its labels' pixels and
+/// first pixel, the labels are numbered, then `out` is written in parallel. Cost: two
+/// parallel passes over the pixels, O(bands n + n log n) between them.
+int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out) {
+    // Bands of 512 pixels at least (row_strips' 8 rows of 64).
+    const int bands = row_strips(static_cast<int>(std::min<std::size_t>(ws.label.size(), 1u << 30) / 64));
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const std::size_t B = (L + 15) / 16 * 16;  // a band's row, whole cache lines (no false sharing)
     const auto N = static_cast<std::ptrdiff_t>(ws.label.size());
-    ws.sizes.assign(kBands * B, 0);  // per band: pixels
-    ws.offsets.resize(kBands * B);   // per band: first pixel, valid where it has pixels
+    ws.sizes.assign(static_cast<std::size_t>(bands) * B, 0);  // per band: pixels
+    ws.offsets.resize(static_cast<std::size_t>(bands) * B);   // per band: first pixel, valid where it has pixels
     int* const label = ws.label.data();
 #pragma omp parallel for schedule(static)
-    for (int band = 0; band < kBands; ++band) {
+    for (int band = 0; band < bands; ++band) {
         int* const count = ws.sizes.data() + static_cast<std::size_t>(band) * B;
         int* const first = ws.offsets.data() + static_cast<std::size_t>(band) * B;
-        for (std::ptrdiff_t p = N * band / kBands; p < N * (band + 1) / kBands; ++p) {
+        for (std::ptrdiff_t p = N * band / bands; p < N * (band + 1) / bands; ++p) {
             const auto l = static_cast<std::size_t>(label[p]);
             if (count[l]++ == 0) first[l] = static_cast<int>(p);
         }
@@ -162,7 +342,7 @@ int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out) {
     ws.order.clear();
     for (std::size_t l = 1; l < L; ++l) {
         int size = 0, first = std::numeric_limits<int>::max();
-        for (int band = 0; band < kBands; ++band) {
+        for (int band = 0; band < bands; ++band) {
             const int count = ws.sizes[static_cast<std::size_t>(band) * B + l];
             if (count == 0) continue;
             size += count;

@@ -18,22 +18,21 @@ namespace {
 
 constexpr std::uint64_t kPairMask = ~std::uint64_t{15};  ///< BoundaryStep::key's segment pair
 
-/// One pass: the boundary pairs of two segments into ws.steps, keyed (lo, hi, depth step,
-/// lo is nearer) with the nearer pixel, sorted by key; each segment's first and last row into
-/// ws.rim_rows. In: ws.label (0..n). Cost: O(pixels), then a sort of the boundary pairs.
-void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
+/// The boundary pairs of two segments in rows [v0, v1) into `steps` in raster order, keyed
+/// (lo, hi, depth step, lo is nearer) with the nearer pixel; each segment's first and last
+/// row there into rows[2 l], rows[2 l + 1] (-1: none). Reads only the frame and the labels:
+/// strips run in parallel.
+void strip_boundary_steps(const Ctx& x, const int* label, int v0, int v1, std::vector<BoundaryStep>& steps,
+                          int* rim_rows) {
     const int W = x.W, H = x.H;
-    const auto& label = ws.label;
-    ws.steps.clear();
-    ws.rim_rows.assign(2 * (static_cast<std::size_t>(n) + 1), -1);
-    for (int v = 0; v < H; ++v) {
+    for (int v = v0; v < v1; ++v) {
         // Only labelled pixels add anything.
-        if (!row_has_label(label.data() + static_cast<std::size_t>(v) * W, 0, W)) continue;
+        if (!row_has_label(label + static_cast<std::size_t>(v) * W, 0, W)) continue;
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             const int a = label[p];
             if (a == 0) continue;
-            int* rows = ws.rim_rows.data() + 2 * static_cast<std::size_t>(a);
+            int* rows = rim_rows + 2 * static_cast<std::size_t>(a);
             if (rows[0] < 0) rows[0] = v;
             rows[1] = v;
             const std::size_t qs[2] = {u + 1 < W ? p + 1 : p, v + 1 < H ? p + static_cast<std::size_t>(W) : p};
@@ -46,12 +45,49 @@ void collect_boundary_steps(const Ctx& x, SegmentWorkspace& ws, int n) {
                 const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 34) |
                                           (static_cast<std::uint64_t>(std::max(a, b)) << 4) |
                                           (std::uint64_t{step} << 1) | std::uint64_t{lo_nearer};
-                ws.steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
+                steps.push_back({key, static_cast<std::uint32_t>(p_nearer ? p : q)});
             }
         }
     }
-    std::sort(ws.steps.begin(), ws.steps.end(),
-              [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; });
+}
+
+/// One pass: the boundary pairs of two segments into ws.steps, keyed (lo, hi, depth step,
+/// lo is nearer) with the nearer pixel, sorted by key; each segment's first and last row into
+/// ws.rim_rows. In: ws.label (0..n). Cost: O(pixels) in strips of rows in parallel (their
+/// pairs joined in strip order: the raster order of one pass), then a sort of the boundary
+/// pairs.
+void collect_boundary_steps(const Ctx& x, SegmentBuffers& ws, int n) {
+    const int strips = row_strips(x.H);
+    const std::size_t rows_size = 2 * (static_cast<std::size_t>(n) + 1);
+    auto by_key = [](const BoundaryStep& l, const BoundaryStep& r) { return l.key < r.key; };
+    ws.steps.clear();
+    ws.rim_rows.assign(rows_size, -1);
+    if (strips == 1) {  // one pass straight into ws.steps and ws.rim_rows
+        strip_boundary_steps(x, ws.label.data(), 0, x.H, ws.steps, ws.rim_rows.data());
+        std::sort(ws.steps.begin(), ws.steps.end(), by_key);
+        return;
+    }
+    ws.strip_steps.resize(static_cast<std::size_t>(strips));
+    ws.strip_rows.assign(static_cast<std::size_t>(strips) * rows_size, -1);
+    const int* const label = ws.label.data();
+#pragma omp parallel for schedule(static)
+    for (int t = 0; t < strips; ++t) {
+        auto& steps = ws.strip_steps[static_cast<std::size_t>(t)];
+        steps.clear();
+        strip_boundary_steps(x, label, x.H * t / strips, x.H * (t + 1) / strips, steps,
+                             ws.strip_rows.data() + static_cast<std::size_t>(t) * rows_size);
+    }
+    for (const auto& st : ws.strip_steps) ws.steps.insert(ws.steps.end(), st.begin(), st.end());
+    // First row: the first strip's that has one; last row: the last strip's.
+    for (int t = 0; t < strips; ++t) {
+        const int* const rows = ws.strip_rows.data() + static_cast<std::size_t>(t) * rows_size;
+        for (std::size_t i = 0; i < rows_size; i += 2) {
+            if (rows[i] < 0) continue;
+            if (ws.rim_rows[i] < 0) ws.rim_rows[i] = rows[i];
+            ws.rim_rows[i + 1] = rows[i + 1];
+        }
+    }
+    std::sort(ws.steps.begin(), ws.steps.end(), by_key);
 }
 
 /// The RMS distance from a fitted circle that still counts as on it, for points at mean
@@ -72,7 +108,7 @@ constexpr double kFarRimMinWidth = 1.0;
 
 /// The front segment's extent on the plane across the line of sight through `centre` (the
 /// camera lies at the plane's origin). Cost: one pass over the front's rows.
-double front_width(const Ctx& x, const PlaneAxes& plane_xy, const SegmentWorkspace& ws, int front,
+double front_width(const Ctx& x, const PlaneAxes& plane_xy, const SegmentBuffers& ws, int front,
                    const Eigen::Vector2d& centre) {
     const Eigen::Vector2d across = Eigen::Vector2d(centre.y(), -centre.x()).normalized();
     const int r0 = ws.rim_rows[2 * static_cast<std::size_t>(front)];
@@ -137,7 +173,7 @@ std::optional<RimCircle> rim_circle(const Ctx& x, const Plane& pl, const PlaneAx
 /// `rim_height` over the plane, and nearer across a depth step than a 4-neighbour that
 /// belongs to neither segment (or has no depth). A container's inside, seen over its front
 /// wall, ends there at the far half of the rim. Cost: one pass over the back's rows.
-void collect_far_rim(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int front, int back, double rim_height) {
+void collect_far_rim(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int front, int back, double rim_height) {
     const int W = x.W, H = x.H;
     const auto& label = ws.label;
     auto steps_to_farther = [&](std::size_t p, std::size_t q) {
@@ -172,7 +208,7 @@ void collect_far_rim(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int fr
 /// Cost: one pass over the back's rows and one over the front's; rim_circle's passes over
 /// the edge and the far rim, twice. ws.rim_far_px keeps its capacity across frames.
 template <class ForEdge>
-std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws,
                                         ForEdge& for_edge, int front, int back) {
     double m = 0, rim_height = 0;
     for_edge([&](std::size_t p) {
@@ -204,7 +240,7 @@ std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const Pla
 /// (far_rim_circle). Appends each that passes to ws.rim_fits as {front, back, centre (2),
 /// radius, rim height}; the inside test then judges each. Cost: rim_circle's passes over
 /// the pair's boundary pairs, and far_rim_circle's; no allocation but the appends.
-void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws,
+void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws,
              std::size_t i0, std::size_t i1, int front, int back) {
     auto for_edge = [&](auto&& visit) {
         for (std::size_t j = i0; j < i1; ++j)
@@ -223,7 +259,7 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWo
 /// segment nearer along them, and its edge must be a circular arc (fit_rim). In: ws.steps,
 /// sorted. Out: ws.rim_fits. Cost: one pass over the boundary pairs, then fit_rim's passes
 /// over each candidate's.
-void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws) {
+void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws) {
     const SegmentParams& prm = x.prm;
     ws.rim_fits.clear();
     for (std::size_t i = 0; i < ws.steps.size();) {
@@ -248,7 +284,7 @@ void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, Segment
 /// back's top, into ws.rim_back. A back segment may sit behind several fronts: ws.remap holds
 /// each segment's first candidate and ws.rim_next links the rest. Cost: one pass over the
 /// rows the back segments span, O(candidates) per back pixel (one in practice).
-void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentWorkspace& ws, int n) {
+void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBuffers& ws, int n) {
     const int W = x.W, H = x.H;
     const int C = static_cast<int>(ws.rim_fits.size());
     ws.remap.assign(static_cast<std::size_t>(n) + 1, -1);
@@ -283,7 +319,7 @@ void measure_insides(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, S
 /// Joins each candidate's back to its front when the back's feet lie inside the circle and
 /// its top reaches the rim, and relabels. Returns the joins. Cost: O(candidates), then one
 /// pass over the pixels when anything joined.
-int join_insides(const Ctx& x, SegmentWorkspace& ws, int n) {
+int join_insides(const Ctx& x, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
     reset_sets(ws.parent, n);
     int joins = 0;
@@ -299,7 +335,7 @@ int join_insides(const Ctx& x, SegmentWorkspace& ws, int n) {
 
 /// The rim test over segments 1..n (with gaps): candidates, their circles, their insides,
 /// the joins. Returns the joins. Cost: as join_containers', less the islands.
-int join_rims(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     if (n < 2) return 0;
     collect_boundary_steps(x, ws, n);
     const PlaneAxes plane_xy(pl);
@@ -321,7 +357,7 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 /// gaps). Out: ws.label with the insides joined. Cost: one pass over the pixels and a sort of
 /// the boundary pairs; then per candidate a few passes over its boundary, and one over the
 /// rows of the candidates' insides; with islands, add_islands and keep_lone_islands.
-void join_containers(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     if (!support || x.prm.rim_min_boundary <= 0 || n < 1) return;
     const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
     stats.containers = join_rims(x, *support, ws, n + islands);

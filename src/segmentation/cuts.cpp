@@ -20,7 +20,7 @@ namespace wul3d::detail {
 /// smoothed. Cost: a scan of the classes for the rows with objects, then running sums over
 /// those rows (smooth_normals); no allocation once ws.smooth has the frame's size.
 const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& normals,
-                                const std::vector<std::uint8_t>& classes, int W, int H, SegmentWorkspace& ws) {
+                                const std::vector<std::uint8_t>& classes, int W, int H, SegmentBuffers& ws) {
     if (params.normal_smooth_px <= 0) return normals;
     int first = H, last = -1;
     for (int v = 0; v < H; ++v) {
@@ -42,7 +42,7 @@ namespace {
 /// lower neighbour lies in another of the paper's clusters, so that a component never
 /// crosses a cluster boundary (cheaper than labelling cluster by cluster). InputError when
 /// `clusters` is not the frame's. Cost: two passes over the pixels.
-void seeds_in_clusters(const Ctx& x, const LabelImage& clusters, SegmentWorkspace& ws) {
+void seeds_in_clusters(const Ctx& x, const LabelImage& clusters, SegmentBuffers& ws) {
     const int W = x.W, H = x.H;
     const std::size_t N = static_cast<std::size_t>(W) * H;
     if (clusters.labels.size() != N)
@@ -63,7 +63,7 @@ void seeds_in_clusters(const Ctx& x, const LabelImage& clusters, SegmentWorkspac
 /// object pixels with a normal, depth-continuous over the s pixels, Ctx::concavity above
 /// SegmentParams::concavity), bit 1 for (p, p + s W) along v. `has_normal`: the raw normals'
 /// validity. Cost: one parallel pass over the pixels, two tests each.
-void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentWorkspace& ws) {
+void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentBuffers& ws) {
     const int W = x.W, H = x.H, s = x.prm.crease_step_px;
     // Raw pointers and plain values: the byte stores would otherwise make the compiler
     // reload every container's data pointer and every parameter on each pixel.
@@ -117,7 +117,7 @@ void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentWor
 /// crease, i.e. no concave pair of ws.crease spans them (a second pass, so that no two
 /// threads write one byte). Cost: one parallel pass over the pixels, up to 2 (s + 1) reads
 /// each; no allocation.
-void seeds_off_creases(const Ctx& x, const std::uint8_t* has_normal, SegmentWorkspace& ws) {
+void seeds_off_creases(const Ctx& x, const std::uint8_t* has_normal, SegmentBuffers& ws) {
     const int W = x.W, H = x.H, s = x.prm.crease_step_px;
     const std::uint8_t* const cls = x.cls.data();
     const std::uint8_t* const crease = ws.crease.data();
@@ -142,7 +142,7 @@ void seeds_off_creases(const Ctx& x, const std::uint8_t* has_normal, SegmentWork
 
 }  // namespace
 
-void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& clusters, SegmentWorkspace& ws) {
+void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& clusters, SegmentBuffers& ws) {
     const std::size_t N = static_cast<std::size_t>(x.W) * x.H;
     ws.cut.resize(N);
     ws.label.resize(N);

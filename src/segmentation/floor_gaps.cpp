@@ -16,7 +16,7 @@ namespace {
 /// segment (no image border, no other segment) and small, its points join that segment.
 /// Only the inside pixels are visited to find the patches, and the marks are cleared behind
 /// each search: the cost follows the insides, not the image. Returns the points filled.
-std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws) {
+std::size_t fill_container_gaps(const Ctx& x, SegmentBuffers& ws) {
     const int max_px = x.prm.gap_max_px;
     if (max_px <= 0) return 0;
     const int W = x.W, H = x.H;
@@ -84,7 +84,7 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentWorkspace& ws) {
 
 }  // namespace
 
-void fill_floor_gaps(const Ctx& x, const Plane*, SegmentWorkspace& ws, int&, SegmentStats& stats) {
+void fill_floor_gaps(const Ctx& x, const Plane*, SegmentBuffers& ws, int&, SegmentStats& stats) {
     stats.gaps_filled = fill_container_gaps(x, ws);
 }
 

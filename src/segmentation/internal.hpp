@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,7 +18,114 @@
 #include "wul3d/plane.hpp"
 #include "wul3d/segmentation.hpp"
 
+namespace wul3d {
+
+namespace detail {
+/// A 4-neighbour pixel pair where two segments meet (the container rule).
+struct BoundaryStep {
+    std::uint64_t key;   ///< lower segment << 34 | higher << 4 | depth step << 1 | lower nearer
+    std::uint32_t near;  ///< the nearer pixel
+};
+}  // namespace detail
+
+/// segment_objects' buffers (SegmentWorkspace, opaque to its callers).
+struct SegmentWorkspace::Buffers {
+    NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
+    std::vector<float> smooth_scratch;
+    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component; once the seeds are
+                                       ///< spent, the container rule's open pixels (islands)
+    std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
+    std::vector<int> label;    ///< 0 none, 1..n
+    std::vector<int> queue;
+    std::vector<int> dist;
+    std::vector<int> sizes;
+    std::vector<int> remap;
+    std::vector<int> offsets;  ///< counting sort of pixels by label
+    std::vector<int> order;
+    // The final renumbering (compact) reuses sizes, offsets and order for each label's pixel
+    // count, first pixel and the labels kept, in order of their first pixel.
+    // Components on several threads (components.cpp): per pixel the union-find parent, the
+    // set's pixels at its root, each root's component; per strip of rows its roots in raster
+    // order and its one-way pairs (far, near: depth continuous seen from the far pixel only).
+    std::vector<int> cc_parent, cc_size, cc_id;
+    std::vector<std::vector<int>> cc_roots, cc_oneway;
+    std::vector<std::uint64_t> cc_edges;  ///< one-way pairs between sets: from << 32 | to
+    // Passes over the pixels in strips of rows, a strip per thread (merge, containers, scope):
+    // per strip its pairs, its boundary steps, and per segment its first and last row.
+    std::vector<std::vector<std::uint64_t>> strip_pairs;
+    std::vector<std::vector<detail::BoundaryStep>> strip_steps;
+    std::vector<int> strip_rows;
+    std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
+    std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
+    std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
+    std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
+    std::vector<std::uint8_t> to_try;  ///< colour cue: 1 = try segment l this round
+    std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
+    std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
+    std::vector<int> parent;           ///< union-find over segments
+    std::vector<int> origin;           ///< colour cue: the segment (before it) each label
+                                       ///< comes from
+    std::vector<std::array<double, 4>> material;  ///< rejoin: per segment, sums of r, g, b
+                                                  ///< and the pixels
+    std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
+                                                                  ///< offset per line (steps)
+    std::vector<std::uint8_t> occluded_outline;  ///< occlusion: 1 = outline pixel, one row
+    // Containers:
+    std::vector<detail::BoundaryStep> steps;   ///< boundary pairs of two segments
+    std::vector<int> rim_rows;         ///< first and last row of each segment
+    std::vector<std::array<double, 6>> rim_fits;  ///< front, back, circle centre (2), radius,
+                                                  ///< rim height per candidate
+    std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
+    std::vector<int> rim_next;         ///< candidates of one back segment, linked
+    std::vector<int> rim_far_px;       ///< the back's far rim, of the pair being fitted
+    std::vector<int> island_pixels, island_outline;  ///< lone islands: per island
+    std::vector<std::uint8_t> island_lone;           ///< 1 = kept
+    // Floor gaps:
+    std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
+    std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
+    // Scope: per segment its lowest and highest point over the support, points above the
+    // height limit, outline pairs, and those that continue into removed points above it.
+    std::vector<float> scope_lo, scope_hi;
+    std::vector<int> scope_any_px;                     ///< one pixel of each segment
+    std::vector<double> scope_sx, scope_sy, scope_sz;  ///< sums of each segment's points
+    std::vector<int> scope_high, scope_outline, scope_outside;
+    std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
+                                                  ///< bottom; pixels facing sideways
+    std::vector<std::uint8_t> scope_keep;
+    /// What the scope counts of one segment in one strip of rows (scope_lo, hi, ...).
+    struct ScopeCounts {
+        float lo, hi;
+        int any_px, high, outline, outside, frame, size;
+    };
+    std::vector<ScopeCounts> scope_strips;               ///< per strip, per segment
+    // Stacks:
+    std::vector<int> layer_hist;             ///< per segment, upward pixels per height bin
+    std::vector<float> stack_cut;            ///< per segment, the height it is cut at (< 0: not)
+    /// A pixel of an upper object's wall: its segment and where it stands on the support plane.
+    struct WallPoint {
+        int segment;
+        float u, v;
+    };
+    /// Where one segment's upper object's walls stand: cells of wall_cells[at, at + cols *
+    /// rows), row by row from (u0, v0) on the plane; cols 0: no map.
+    struct WallMap {
+        float u0 = 0, v0 = 0;
+        int cols = 0, rows = 0;
+        std::size_t at = 0;
+    };
+    std::vector<WallPoint> stack_walls;      ///< the cut segments' upper walls
+    std::vector<WallMap> wall_maps;          ///< per segment
+    std::vector<std::array<float, 4>> wall_box;  ///< scratch: per segment its walls' u0, v0, u1, v1
+    std::vector<std::uint8_t> wall_cells;    ///< 1 = an upper object's wall stands in that cell
+    std::vector<std::array<double, 4>> wall_colour;  ///< per segment and piece: chromaticity
+                                                     ///< sums (3) and count
+};
+
+}  // namespace wul3d
+
 namespace wul3d::detail {
+
+using SegmentBuffers = SegmentWorkspace::Buffers;
 
 constexpr float kDegToRad = 3.14159265358979f / 180.0f;
 
@@ -182,36 +290,49 @@ inline bool join_sets(std::vector<int>& parent, int a, int b) {
     return true;
 }
 
-/// Every labelled pixel takes its set's root.
-inline void relabel_to_roots(SegmentWorkspace& ws) {
-    for (int& l : ws.label)
-        if (l) l = find_root(ws.parent, l);
-}
+/// Every labelled pixel takes its set's root (components.cpp): the sets flattened, then one
+/// parallel pass over the pixels.
+void relabel_to_roots(SegmentBuffers& ws);
+
+/// How many strips of rows a pass over `rows` rows is cut into to run in parallel: one per
+/// thread, of 8 rows at least (fewer cost more in joining than they save); 1 inside another
+/// parallel region, or on one thread. What the passes compute does not depend on it.
+int row_strips(int rows);
 
 // ---- the phases before the rules ---------------------------------------------------------
 
 /// The normals of the crease tests (cuts.cpp): `normals` smoothed over normal_smooth_px into
 /// ws.smooth, or `normals` themselves when normal_smooth_px is 0.
 const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& normals,
-                                const std::vector<std::uint8_t>& classes, int W, int H, SegmentWorkspace& ws);
+                                const std::vector<std::uint8_t>& classes, int W, int H, SegmentBuffers& ws);
 
 /// The seeds into ws.cut (cuts.cpp): object pixels off concave creases, or with the kmeans
 /// segmenter off the boundaries of the paper's clusters (`clusters`, InputError when not the
 /// frame's). `has_normal`: the raw normals' validity. Sizes ws.cut, label, queue and dist to
 /// the frame. Cost: a few parallel passes over the pixels.
-void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& clusters, SegmentWorkspace& ws);
+void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& clusters, SegmentBuffers& ws);
 
 /// The segments (components.cpp): connected components of the seeds into ws.label, 1..n,
 /// fragments under min_seed_points unlabelled again. Returns n.
-int seed_components(const Ctx& x, SegmentWorkspace& ws);
+int seed_components(const Ctx& x, SegmentBuffers& ws);
+
+/// Connected components of the pixels with seedable[p] = 1 (else 0) into ws.label, 1..n, and
+/// their sizes into ws.sizes[1..n]; returns n. A component is what a breadth-first search
+/// from its first pixel in raster order reaches, a neighbour joining where depth is
+/// continuous seen from the pixel already in it (Ctx::connected; the test is not symmetric),
+/// the seeds taken in raster order: components are numbered by their first pixel. With
+/// `strips` > 1 the rows are cut into that many strips, each labelled on a thread of its
+/// own with a union-find, joined along the seams, then numbered: the labels are those of
+/// strips = 1 (the search itself) at any count. Cost: O(pixels), strips in parallel.
+int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentBuffers& ws, int strips);
 
 /// Cut pixels, feet, pixels without a normal and dropped fragments join the segment they
 /// touch (up to reattach_px, where depth is continuous), then containers' insides, however
 /// wide (components.cpp). Returns the pixels added.
-std::size_t reattach_foreground(const Ctx& x, SegmentWorkspace& ws);
+std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws);
 
 /// The segments of min_points or more into `out`, renumbered 1..n (components.cpp). Returns n.
-int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out);
+int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out);
 
 // ---- the rules, in the driver's order ----------------------------------------------------
 
@@ -219,49 +340,49 @@ int compact(SegmentWorkspace& ws, int n, int min_points, std::uint16_t* out);
 /// segments it adds n + 1, ... and adds them to n, and counts what it did into `stats`.
 /// `support`: the support plane, nullptr when none was found (the rules that need one are
 /// run only with one, or do nothing without).
-using Rule = void (*)(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+using Rule = void (*)(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// The convexity merge (merge.cpp): joins segments that meet along a boundary that is mostly
 /// not concave. stats.merges.
-void merge_segments(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void merge_segments(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Containers (containers.cpp; SegmentParams, "Containers"): joins a container's inside,
 /// seen over its rim, to the container; with rim_islands, keeps the lone islands
 /// (lone_islands.cpp). Nothing without a support. stats.containers, islands_kept.
-void join_containers(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// The colour cue (colour_cue.cpp; hybrid): splits segments in two by colour; ws.origin
 /// holds each label's segment before the cue. stats.color_splits, texture_splits (those
 /// between a texture and another material, SegmentParams::color_textures).
-void split_by_colour(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void split_by_colour(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// The convexity merge again after the colour cue split anything (merge.cpp;
 /// SegmentParams::color_rejoin), between the parts of different segments that are one
 /// material. Adds to stats.merges.
-void rejoin_materials(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void rejoin_materials(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Stacks (stacks.cpp; SegmentParams, "Stacks"; `support` not null): cuts a segment whose
 /// upward faces lie at two heights in two. stats.stack_splits.
-void split_stacks(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void split_stacks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Floor gaps (floor_gaps.cpp; SegmentParams::gap_max_px): small unlabelled patches beside a
 /// container's inside, enclosed by one segment, join it. stats.gaps_filled.
-void fill_floor_gaps(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void fill_floor_gaps(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Occlusion (occlusion.cpp; SegmentParams, "Occlusion"): joins the two parts of a surface
 /// that a nearer object divides in view. stats.occluded.
-void join_occluded(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void join_occluded(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Scope::Support (scope.cpp; docs/DESIGN.md, "Scope"; `support` not null): clears the
 /// labels of the segments the support does not hold. stats.support_scope, out_of_scope.
-void restrict_to_support(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats);
+void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 // ---- islands (lone_islands.cpp), for the container rule ------------------------------------
 
 /// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
 /// segment reached, of min_seed_points or more, become segments n + 1, ... for the rim
 /// test. Returns the islands added.
-int add_islands(const Ctx& x, SegmentWorkspace& ws, int n);
+int add_islands(const Ctx& x, SegmentBuffers& ws, int n);
 
 /// Lone islands (SegmentParams::island_min_width_px): of the islands n + 1 .. n + islands in
 /// ws.label, those the rim test joined to nothing, keeps each that meets no segment across
@@ -269,6 +390,6 @@ int add_islands(const Ctx& x, SegmentWorkspace& ws, int n);
 /// pixels / outline pairs) or more and holds min_points; unlabels the others. Returns the
 /// islands kept. Cost: a vectorized test per row, four neighbours of each island pixel, and
 /// a pass over the rows that hold islands.
-int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands);
+int keep_lone_islands(const Ctx& x, SegmentBuffers& ws, int n, int islands);
 
 }  // namespace wul3d::detail

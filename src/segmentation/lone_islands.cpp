@@ -21,7 +21,7 @@ namespace wul3d::detail {
 /// by now) holds the pixels still open. Returns the islands added. Cost: one pass over the
 /// pixels that vectorizes, a memchr for each island's first pixel, and a search over the
 /// unreached object pixels.
-int add_islands(const Ctx& x, SegmentWorkspace& ws, int n) {
+int add_islands(const Ctx& x, SegmentBuffers& ws, int n) {
     const int W = x.W, H = x.H;
     const std::size_t N = static_cast<std::size_t>(W) * H;
     std::uint8_t* const open = ws.cut.data();
@@ -53,7 +53,7 @@ int add_islands(const Ctx& x, SegmentWorkspace& ws, int n) {
 /// island_min_width_px is such a band of mixed pixels (a RealSense frame, image_0003: 1.7
 /// points wide along the drill's top edge). What is left is seen past every segment it
 /// meets: a bowl's inside whose rim fitted no circle, an object's top between nearer ones.
-int keep_lone_islands(const Ctx& x, SegmentWorkspace& ws, int n, int islands) {
+int keep_lone_islands(const Ctx& x, SegmentBuffers& ws, int n, int islands) {
     int* const label = ws.label.data();
     const int W = x.W, H = x.H;
     const int min_width = x.prm.island_min_width_px;

@@ -12,19 +12,13 @@
 namespace wul3d::detail {
 namespace {
 
-/// Joins segments that touch along a boundary that is mostly not concave. Each 4-neighbour
-/// pair (p, q) of two segments with continuous depth is tested for a crease between the
-/// pixels a crease step away on either side, inside their own segments; the pair of
-/// segments (a, b) merges when enough pairs were tested, few were concave and may_join(a,
-/// b). Returns the merges. Cost: one pass over the pixels, a sort of the boundary pairs, one
-/// more pass to relabel when anything merged.
-template <class MayJoin>
-int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) {
+/// The boundary pairs of rows [v0, v1) into `edges`: each 4-neighbour pair (p, q) of two
+/// segments a, b with continuous depth, q right of or below p, keyed (lo, hi, tested,
+/// concave): whether the pixels a crease step away on either side, inside their own
+/// segments, were tested for a crease and found concave. Reads only: strips run in parallel.
+void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, std::vector<std::uint64_t>& edges) {
     const SegmentParams& prm = x.prm;
-    if (prm.merge_max_concave <= 0 || n < 2) return 0;
     const int W = x.W, H = x.H, s = prm.crease_step_px;
-    ws.edges.clear();
-    const int* const label = ws.label.data();
     // The pair (p, q = p + d) of segments a and b, q right of or below p.
     auto boundary_pair = [&](int u, int v, int a, int b, const int (&d)[2]) {
         const int p = v * W + u, q = p + d[0] + d[1] * W;
@@ -42,10 +36,10 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) 
         }
         const auto lo = static_cast<std::uint64_t>(std::min(a, b));
         const auto hi = static_cast<std::uint64_t>(std::max(a, b));
-        ws.edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
+        edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | concave);
     };
     static constexpr int kRight[2] = {1, 0}, kDown[2] = {0, 1};
-    for (int v = 0; v < H; ++v) {
+    for (int v = v0; v < v1; ++v) {
         const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
         if (!row_has_label(row, 0, W)) continue;  // a row without labels has no pair
         for (int u = 0; u < W; ++u) {
@@ -55,6 +49,32 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) 
             if (u + 1 < W && row[u + 1] != 0 && row[u + 1] != a) boundary_pair(u, v, a, row[u + 1], kRight);
             if (v + 1 < H && row[u + W] != 0 && row[u + W] != a) boundary_pair(u, v, a, row[u + W], kDown);
         }
+    }
+}
+
+/// Joins segments that touch along a boundary that is mostly not concave: the segments (a,
+/// b) of the boundary pairs (boundary_pairs) merge when enough pairs were tested, few were
+/// concave and may_join(a, b). Returns the merges. Cost: one pass over the pixels in strips
+/// of rows (in parallel), a sort of the boundary pairs (the order they come in does not
+/// matter), one more parallel pass to relabel when anything merged.
+template <class MayJoin>
+int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
+    const SegmentParams& prm = x.prm;
+    if (prm.merge_max_concave <= 0 || n < 2) return 0;
+    const int strips = row_strips(x.H);
+    const int* const label = ws.label.data();
+    ws.edges.clear();
+    if (strips == 1) {
+        boundary_pairs(x, label, 0, x.H, ws.edges);
+    } else {
+        ws.strip_pairs.resize(static_cast<std::size_t>(strips));
+#pragma omp parallel for schedule(static)
+        for (int t = 0; t < strips; ++t) {
+            auto& edges = ws.strip_pairs[static_cast<std::size_t>(t)];
+            edges.clear();
+            boundary_pairs(x, label, x.H * t / strips, x.H * (t + 1) / strips, edges);
+        }
+        for (const auto& e : ws.strip_pairs) ws.edges.insert(ws.edges.end(), e.begin(), e.end());
     }
     std::sort(ws.edges.begin(), ws.edges.end());
     reset_sets(ws.parent, n);
@@ -78,7 +98,7 @@ int merge_convex(const Ctx& x, SegmentWorkspace& ws, int n, MayJoin&& may_join) 
 
 }  // namespace
 
-void merge_segments(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void merge_segments(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
 }
 
@@ -91,7 +111,7 @@ void merge_segments(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, Se
 /// crease, ran along their boundary too; once the cue has made the upper box a segment of
 /// its own, the pieces' boundary is their own convex edge. Cost: one pass over the rows with
 /// labels for the segments' mean colours, then merge_convex's.
-void rejoin_materials(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void rejoin_materials(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     const SegmentParams& prm = x.prm;
     if (stats.color_splits == 0 || !prm.color_rejoin) return;
     ws.material.assign(static_cast<std::size_t>(n) + 1, {0, 0, 0, 0});

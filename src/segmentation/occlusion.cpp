@@ -84,7 +84,7 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
 /// right or lower neighbour is nearer (a segment, or points between segments), into
 /// ws.occluded_lines as (segment pair, offset). Cost: a branch-free pass per row with labels
 /// to find the outline pixels, then the lines from those.
-void collect_lines(const Ctx& x, SegmentWorkspace& ws, float cos_max) {
+void collect_lines(const Ctx& x, SegmentBuffers& ws, float cos_max) {
     const int W = x.W, H = x.H;
     const int* const label = ws.label.data();
     const OrganizedCloud& c = x.c;
@@ -132,7 +132,7 @@ void collect_lines(const Ctx& x, SegmentWorkspace& ws, float cos_max) {
 /// steps: one line's tolerance takes the sensor's noise, the mean takes two faces a little
 /// apart. In: ws.label (1..n with gaps). Out: ws.label with the pairs joined. Cost:
 /// collect_lines; a sort of the lines; a relabel pass when anything joined.
-int join_across_occluders(const Ctx& x, SegmentWorkspace& ws, int n) {
+int join_across_occluders(const Ctx& x, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
     if (prm.occluded_min_lines <= 0 || n < 2) return 0;
     collect_lines(x, ws, std::cos(prm.occluded_max_deg * kDegToRad));
@@ -157,7 +157,7 @@ int join_across_occluders(const Ctx& x, SegmentWorkspace& ws, int n) {
 
 }  // namespace
 
-void join_occluded(const Ctx& x, const Plane*, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void join_occluded(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.occluded = join_across_occluders(x, ws, n);
 }
 

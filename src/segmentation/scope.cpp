@@ -9,6 +9,8 @@
 #include <limits>
 #include <utility>
 
+#include <omp.h>
+
 #include "internal.hpp"
 #include "wul3d/plane.hpp"
 
@@ -51,24 +53,24 @@ FrameEdge find_frame_edge(const Ctx& x) {
     return {top, bottom, left, right, edge_top, edge_bottom, edge_left, edge_right};
 }
 
-/// The support's middle in depth: the mean depth of the removed points on it. Walls and
-/// furniture leave the volume beyond it; on the near half an object cut by the frame (at
-/// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
-/// table's near edge, is still on the table. Cost: one pass over the pixels, per chunk a
-/// branch-free loop that tells the points on the support (vectorizes), then the sum over
-/// them in pixel order (a double sum in another order would round otherwise).
-float support_middle_depth(const Ctx& x, const Plane& pl) {
+/// Over pixels [p0, p1): the sum of the depths of the removed points on the support (in
+/// pixel order), their count, least and greatest depth. Per chunk a branch-free loop that
+/// tells the points on the support (vectorizes), then the sum over them.
+struct DepthSum {
+    double sum = 0, count = 0;
+    float lo = std::numeric_limits<float>::max(), hi = 0;
+};
+DepthSum sum_support_depths(const Ctx& x, const Plane& plane, std::size_t p0, std::size_t p1) {
     const float *const xs = x.c.x.data(), *const ys = x.c.y.data(), *const zs = x.c.z.data();
     const std::uint8_t *const valid = x.c.valid.data(), *const cls = x.cls.data();
     const float jump_m = x.prm.depth_jump_m, jump_rel = x.prm.depth_jump_rel;
-    const Plane plane = pl;
     constexpr std::size_t kChunk = 256;
     std::uint8_t on[kChunk];
-    double table_z = 0, table_n = 0;
-    for (std::size_t p0 = 0; p0 < x.c.size(); p0 += kChunk) {
-        const std::size_t n = std::min(kChunk, x.c.size() - p0);
+    DepthSum d;
+    for (std::size_t c0 = p0; c0 < p1; c0 += kChunk) {
+        const std::size_t n = std::min(kChunk, p1 - c0);
         for (std::size_t j = 0; j < n; ++j) {
-            const std::size_t p = p0 + j;
+            const std::size_t p = c0 + j;
             const float z = zs[p];
             // `!(a > b)` as before.
             on[j] = (valid[p] != 0) & (cls[p] == kPlaneRemoved) &
@@ -76,37 +78,54 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
         }
         for (std::size_t j = 0; j < n; ++j) {
             if (!on[j]) continue;
-            table_z += zs[p0 + j];
-            table_n += 1;
+            const float z = zs[c0 + j];
+            d.sum += z;
+            d.count += 1;
+            d.lo = std::min(d.lo, z);
+            d.hi = std::max(d.hi, z);
         }
     }
-    return table_n > 0 ? static_cast<float>(table_z / table_n) : 0.0f;
+    return d;
 }
 
-/// Per segment, over the frame inside its edge: the lowest and highest point over the
-/// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
-/// (ws.sizes), outline pairs (scope_outline) and those that lead out of the volume
-/// (scope_outside: into removed points above the support, or into the frame's top edge,
-/// beyond the support's middle `far_z`) or into its other edges there (scope_frame); the
-/// touching segment pairs, once each, into ws.edges. In:
-/// ws.label (1..n with gaps). Cost: one pass over the pixels, then a sort of the pairs.
-void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentWorkspace& ws,
-                   int n) {
+/// The support's middle in depth: the mean depth of the removed points on it. Walls and
+/// furniture leave the volume beyond it; on the near half an object cut by the frame (at
+/// the bottom or the sides of a tabletop view), or by the hull where the frame hides the
+/// table's near edge, is still on the table. Summed in parts in parallel where the double
+/// sum is exact (every depth a multiple of the float step at the least depth, the total
+/// under 2^53 such steps: the sum in pixel order, whatever the parts), else again in pixel
+/// order. Cost: one pass over the pixels, parts in parallel.
+float support_middle_depth(const Ctx& x, const Plane& pl) {
+    constexpr int kParts = 16;
+    const std::size_t N = x.c.size();
+    if (omp_in_parallel() || omp_get_max_threads() == 1) {  // one thread: in pixel order
+        const DepthSum d = sum_support_depths(x, pl, 0, N);
+        return d.count > 0 ? static_cast<float>(d.sum / d.count) : 0.0f;
+    }
+    DepthSum part[kParts];
+#pragma omp parallel for schedule(static)
+    for (int k = 0; k < kParts; ++k) part[k] = sum_support_depths(x, pl, N * k / kParts, N * (k + 1) / kParts);
+    DepthSum all;
+    for (const DepthSum& d : part) {
+        all.sum += d.sum, all.count += d.count;
+        all.lo = std::min(all.lo, d.lo), all.hi = std::max(all.hi, d.hi);
+    }
+    if (!(all.count > 0)) return 0.0f;
+    const bool exact = all.lo > 0 && std::isfinite(all.hi) &&
+                       all.count * all.hi < std::ldexp(1.0, std::ilogb(all.lo) - 23 + 53);
+    if (!exact) all = sum_support_depths(x, pl, 0, N);
+    return static_cast<float>(all.sum / all.count);
+}
+
+using ScopeCounts = SegmentBuffers::ScopeCounts;
+
+/// measure_scope's counts of the segments' pixels in rows [v0, v1) into cnt[0, n], the
+/// touching pairs into `edges` (not unique), and with `sums` (one strip: the whole frame)
+/// the sums of the points into sums[0][l], sums[1][l], sums[2][l]. Writes nothing else:
+/// strips of rows run in parallel (without sums).
+void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, const int* label, int v0,
+                   int v1, ScopeCounts* cnt, std::vector<std::uint64_t>& edges, double* const* sums) {
     const int W = x.W;
-    const std::size_t L = static_cast<std::size_t>(n) + 1;
-    ws.scope_lo.assign(L, std::numeric_limits<float>::max());
-    ws.scope_any_px.assign(L, -1);
-    ws.scope_sx.assign(L, 0.0);
-    ws.scope_sy.assign(L, 0.0);
-    ws.scope_sz.assign(L, 0.0);
-    ws.scope_hi.assign(L, -std::numeric_limits<float>::max());
-    ws.scope_high.assign(L, 0);
-    ws.scope_outline.assign(L, 0);
-    ws.scope_outside.assign(L, 0);
-    ws.scope_frame.assign(L, 0);
-    ws.sizes.assign(L, 0);
-    ws.edges.clear();
-    const int* const label = ws.label.data();
     const SegmentParams& prm = x.prm;
     auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
     // A removed point clearly above the support (by more than the depth noise at its depth)
@@ -121,15 +140,15 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     auto pair = [&](std::size_t p, std::size_t q) {
         const int a = label[p], b = label[q];
         if (a == b) return;
-        if (a) ++ws.scope_outline[static_cast<std::size_t>(a)];
-        if (b) ++ws.scope_outline[static_cast<std::size_t>(b)];
+        if (a) ++cnt[a].outline;
+        if (b) ++cnt[b].outline;
         if (a && b) {
-            ws.edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
-                               static_cast<std::uint64_t>(std::max(a, b)) << 1);
+            edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 33 |
+                            static_cast<std::uint64_t>(std::max(a, b)) << 1);
         } else if (a) {
-            ws.scope_outside[static_cast<std::size_t>(a)] += x.c.z[p] > far_z && beyond(q, p);
+            cnt[a].outside += x.c.z[p] > far_z && beyond(q, p);
         } else {
-            ws.scope_outside[static_cast<std::size_t>(b)] += x.c.z[q] > far_z && beyond(p, q);
+            cnt[b].outside += x.c.z[q] > far_z && beyond(p, q);
         }
     };
     // A row without a label whose next row has none either adds nothing (every pair in it
@@ -137,8 +156,8 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     auto labelled_row = [&](int v) {
         return row_has_label(label + static_cast<std::size_t>(v) * W, fe.left, fe.right);
     };
-    bool next_has_label = fe.top < fe.bottom && labelled_row(fe.top);
-    for (int v = fe.top; v < fe.bottom; ++v) {
+    bool next_has_label = v0 < v1 && labelled_row(v0);
+    for (int v = v0; v < v1; ++v) {
         const bool has_label = next_has_label;
         next_has_label = v + 1 < fe.bottom && labelled_row(v + 1);
         if (!has_label && !next_has_label) continue;
@@ -146,23 +165,21 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if (const int l = label[p]) {
                 const float h = height(p);
-                const auto li = static_cast<std::size_t>(l);
-                ws.scope_lo[li] = std::min(ws.scope_lo[li], h);
-                ws.scope_any_px[li] = static_cast<int>(p);
-                ws.scope_sx[li] += x.c.x[p];
-                ws.scope_sy[li] += x.c.y[p];
-                ws.scope_sz[li] += x.c.z[p];
-                ws.scope_hi[li] = std::max(ws.scope_hi[li], h);
-                ws.scope_high[li] += h > prm.scope_max_height_m;
-                ++ws.sizes[li];
+                ScopeCounts& c = cnt[l];
+                c.lo = std::min(c.lo, h);
+                c.any_px = static_cast<int>(p);
+                if (sums) sums[0][l] += x.c.x[p], sums[1][l] += x.c.y[p], sums[2][l] += x.c.z[p];
+                c.hi = std::max(c.hi, h);
+                c.high += h > prm.scope_max_height_m;
+                ++c.size;
                 // On the frame's edge, beyond the support's middle.
                 const int on_edge = x.c.z[p] > far_z ? (v == fe.edge_top) + (u == fe.edge_left) +
                                                            (u == fe.edge_right) + (v == fe.edge_bottom)
                                                      : 0;
                 const int on_top = x.c.z[p] > far_z && v == fe.edge_top;
-                ws.scope_outline[li] += on_edge;
-                ws.scope_outside[li] += on_top;
-                ws.scope_frame[li] += on_edge - on_top;
+                c.outline += on_edge;
+                c.outside += on_top;
+                c.frame += on_edge - on_top;
             }
             // Most pairs join equal labels and add nothing: that test stays here, in line
             // (GCC does not inline `pair`, called twice).
@@ -170,15 +187,97 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
             if (v + 1 < fe.bottom && label[p] != label[p + W]) pair(p, p + static_cast<std::size_t>(W));
         }
     }
+}
+
+/// The strips' counts into ws.scope_* and ws.sizes (minima, maxima, the last pixel, sums of
+/// counts: the same in any order of the strips), their touching pairs into ws.edges, once
+/// each.
+void gather_strips(SegmentBuffers& ws, int strips, std::size_t L) {
+    ws.scope_lo.resize(L);
+    ws.scope_hi.resize(L);
+    ws.scope_any_px.resize(L);
+    ws.scope_high.resize(L);
+    ws.scope_outline.resize(L);
+    ws.scope_outside.resize(L);
+    ws.scope_frame.resize(L);
+    ws.sizes.resize(L);
+    for (std::size_t l = 0; l < L; ++l) {
+        ScopeCounts t = ws.scope_strips[l];
+        for (int s = 1; s < strips; ++s) {
+            const ScopeCounts& c = ws.scope_strips[static_cast<std::size_t>(s) * L + l];
+            t.lo = std::min(t.lo, c.lo), t.hi = std::max(t.hi, c.hi), t.any_px = std::max(t.any_px, c.any_px);
+            t.high += c.high, t.outline += c.outline, t.outside += c.outside, t.frame += c.frame, t.size += c.size;
+        }
+        ws.scope_lo[l] = t.lo, ws.scope_hi[l] = t.hi, ws.scope_any_px[l] = t.any_px, ws.scope_high[l] = t.high;
+        ws.scope_outline[l] = t.outline, ws.scope_outside[l] = t.outside, ws.scope_frame[l] = t.frame;
+        ws.sizes[l] = t.size;
+    }
+    ws.edges.clear();
+    for (int s = 0; s < strips; ++s) {
+        const auto& e = ws.strip_pairs[static_cast<std::size_t>(s)];
+        ws.edges.insert(ws.edges.end(), e.begin(), e.end());
+    }
     std::sort(ws.edges.begin(), ws.edges.end());
     ws.edges.erase(std::unique(ws.edges.begin(), ws.edges.end()), ws.edges.end());
+}
+
+/// ws.scope_sx, sy, sz (zeroed): the sums of each segment's points inside the frame's edge,
+/// in raster order (a double sum in another order would round otherwise). Cost: a pass over
+/// the rows with labels.
+void sum_points(const Ctx& x, const FrameEdge& fe, SegmentBuffers& ws) {
+    const int* const label = ws.label.data();
+    for (int v = fe.top; v < fe.bottom; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * x.W;
+        if (!row_has_label(label + row, fe.left, fe.right)) continue;
+        for (int u = fe.left; u < fe.right; ++u) {
+            const std::size_t p = row + u;
+            if (const int l = label[p]) {
+                ws.scope_sx[static_cast<std::size_t>(l)] += x.c.x[p];
+                ws.scope_sy[static_cast<std::size_t>(l)] += x.c.y[p];
+                ws.scope_sz[static_cast<std::size_t>(l)] += x.c.z[p];
+            }
+        }
+    }
+}
+
+/// Per segment, over the frame inside its edge: the lowest and highest point over the
+/// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
+/// (ws.sizes), the sums of its points (scope_sx, sy, sz), outline pairs (scope_outline) and
+/// those that lead out of the volume (scope_outside: into removed points above the support,
+/// or into the frame's top edge, beyond the support's middle `far_z`) or into its other
+/// edges there (scope_frame); the touching segment pairs, once each, into ws.edges. In:
+/// ws.label (1..n with gaps). Cost: one pass over the pixels in strips of rows, a strip per
+/// thread, the counts gathered (O(strips n)), a sort of the pairs, and with more than one
+/// strip a pass over the labelled rows for the sums.
+void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentBuffers& ws,
+                   int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    const int rows = std::max(fe.bottom - fe.top, 0);
+    const int strips = row_strips(rows);
+    constexpr float kMax = std::numeric_limits<float>::max();
+    ws.scope_strips.assign(static_cast<std::size_t>(strips) * L, ScopeCounts{kMax, -kMax, -1, 0, 0, 0, 0, 0});
+    ws.strip_pairs.resize(static_cast<std::size_t>(strips));
+    ws.scope_sx.assign(L, 0.0);
+    ws.scope_sy.assign(L, 0.0);
+    ws.scope_sz.assign(L, 0.0);
+    double* const sums[3] = {ws.scope_sx.data(), ws.scope_sy.data(), ws.scope_sz.data()};
+    const int* const label = ws.label.data();
+#pragma omp parallel for schedule(static) if (strips > 1)
+    for (int s = 0; s < strips; ++s) {
+        auto& edges = ws.strip_pairs[static_cast<std::size_t>(s)];
+        edges.clear();
+        measure_strip(x, pl, fe, far_z, label, fe.top + rows * s / strips, fe.top + rows * (s + 1) / strips,
+                      ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges, strips == 1 ? sums : nullptr);
+    }
+    gather_strips(ws, strips, L);
+    if (strips > 1) sum_points(x, fe, ws);
 }
 
 /// ws.scope_upright: per segment that runs into the frame's sides or bottom (scope_frame),
 /// its pixels facing sideways (normals within kUprightDeg of the support plane); 0 for the
 /// others. Cost: none when no segment does (most tabletop frames), else one pass over the
 /// pixels.
-void count_upright(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+void count_upright(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     ws.scope_upright.assign(L, 0);
     if (std::all_of(ws.scope_frame.begin(), ws.scope_frame.end(), [](int f) { return f == 0; })) return;
@@ -198,7 +297,7 @@ void count_upright(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 /// A box seen from steeply above shows its top alone, its sides in shadow or edge-on, and
 /// its body hides its foot. A box hanging over the table, seen obliquely, shows the table
 /// under its middle. Cost: a few reads per segment.
-bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, std::size_t l) {
+bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::size_t l) {
     const int p = ws.scope_any_px[l];
     if (p < 0 || ws.sizes[l] == 0) return false;
     const int W = x.W, u = p % W, v = p / W;
@@ -239,7 +338,7 @@ bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, std:
 /// bottom can lie well above its supporter's visible top (a tin's lid overhangs what it
 /// stands on), and what hangs or is fixed to a wall has already left the volume. Cost: O(n),
 /// then passes over ws.edges until "rests on" stops spreading.
-void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     auto& keep = ws.scope_keep;
@@ -272,15 +371,19 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 }
 
 /// Clears the labels of the segments not kept. Returns those of min_points or more (within
-/// the frame's edge). Cost: one pass over the pixels.
-int clear_out_of_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
+/// the frame's edge). Cost: one parallel pass over the pixels.
+int clear_out_of_scope(const SegmentParams& prm, SegmentBuffers& ws, int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const auto& keep = ws.scope_keep;
     int left_out = 0;
     for (std::size_t l = 1; l < L; ++l)
         left_out += keep[l] != 3 && ws.sizes[l] >= prm.min_points;
-    for (int& l : ws.label)
-        if (l && keep[static_cast<std::size_t>(l)] != 3) l = 0;
+    int* const label = ws.label.data();
+    const std::uint8_t* const kept = keep.data();
+    const auto n_px = static_cast<std::ptrdiff_t>(ws.label.size());
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n_px; ++p)
+        if (label[p] && kept[label[p]] != 3) label[p] = 0;
     return left_out;
 }
 
@@ -289,7 +392,7 @@ int clear_out_of_scope(const SegmentParams& prm, SegmentWorkspace& ws, int n) {
 /// plane's classes. Out: the number of segments of min_points or more left out. Cost: one
 /// pass over the pixels (heights, outlines, touching pairs) and one over the depths, then a
 /// few passes over the touching pairs until "rests on" stops spreading.
-int keep_held(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+int keep_held(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const FrameEdge edge = find_frame_edge(x);
     const float far_z = support_middle_depth(x, pl);
     measure_scope(x, pl, edge, far_z, ws, n);
@@ -300,7 +403,7 @@ int keep_held(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
 
 }  // namespace
 
-void restrict_to_support(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.support_scope = true;
     stats.out_of_scope = keep_held(x, *support, ws, n);
 }

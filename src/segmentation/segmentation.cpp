@@ -3,6 +3,7 @@
 #include "wul3d/segmentation.hpp"
 
 #include <chrono>
+#include <memory>
 
 #include "internal.hpp"  // Ctx, the phases and the rules
 
@@ -25,6 +26,15 @@ public:
 
 }  // namespace
 
+SegmentWorkspace::SegmentWorkspace() : b_(std::make_unique<Buffers>()) {}
+SegmentWorkspace::~SegmentWorkspace() = default;
+SegmentWorkspace::SegmentWorkspace(SegmentWorkspace&&) noexcept = default;
+SegmentWorkspace& SegmentWorkspace::operator=(SegmentWorkspace&&) noexcept = default;
+SegmentWorkspace::Buffers& SegmentWorkspace::buffers() {
+    if (!b_) b_ = std::make_unique<Buffers>();
+    return *b_;
+}
+
 /// Labels stay in 1..n with gaps (dropped fragments, merged or joined segments) until
 /// `compact`: every phase between works per pixel, per pair or per segment, whatever the
 /// numbers. Rules that add segments number them n + 1, ... and add them to n. A new rule is
@@ -32,8 +42,9 @@ public:
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
                              const Plane* support, const LabelImage& clusters,
-                             SegmentWorkspace& ws, LabelImage& out) {
+                             SegmentWorkspace& workspace, LabelImage& out) {
     using namespace detail;
+    SegmentBuffers& ws = workspace.buffers();
     const int W = cloud.width, H = cloud.height;
     SegmentStats stats;
     SegmentStats::Phases& ms = stats.ms;

@@ -35,7 +35,7 @@ constexpr float kCutOverLowerM = 0.01f;
 /// Calls visit(p, l) for each pixel p of a segment l (labels 1..), skipping the rows without
 /// any (most rows above and below the objects). Cost: one pass over the rows with objects.
 template <class Visit>
-void for_segment_pixels(const Ctx& x, const SegmentWorkspace& ws, Visit&& visit) {
+void for_segment_pixels(const Ctx& x, const SegmentBuffers& ws, Visit&& visit) {
     for (int v = 0; v < x.H; ++v) {
         const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
         if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
@@ -49,7 +49,7 @@ void for_segment_pixels(const Ctx& x, const SegmentWorkspace& ws, Visit&& visit)
 /// limit, above which nothing stands on the support) into ws.layer_hist, segment after
 /// segment, and its size into ws.sizes. In: ws.label (0..n). Cost: one pass over the rows
 /// with objects.
-void count_layers(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n, int bins) {
+void count_layers(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n, int bins) {
     ws.layer_hist.assign(static_cast<std::size_t>(n + 1) * static_cast<std::size_t>(bins), 0);
     ws.sizes.assign(static_cast<std::size_t>(n) + 1, 0);
     const float cos_up = std::cos(kUprightDeg * kDegToRad);
@@ -99,7 +99,7 @@ float cut_height(const int* hist, int bins, int size, const SegmentParams& prm) 
 
 /// The cut of every segment of 2 x min_points or more into ws.stack_cut (< 0: none).
 /// Returns how many have one. Cost: O(n bins^2).
-int find_cuts(const Ctx& x, SegmentWorkspace& ws, int n, int bins) {
+int find_cuts(const Ctx& x, SegmentBuffers& ws, int n, int bins) {
     ws.stack_cut.assign(static_cast<std::size_t>(n) + 1, -1.0f);
     int found = 0;
     for (int l = 1; l <= n; ++l) {
@@ -115,7 +115,7 @@ int find_cuts(const Ctx& x, SegmentWorkspace& ws, int n, int bins) {
 /// Calls visit(p, l, h) for each pixel p of a cut segment l, h its height over the support.
 /// Cost: one pass over the rows with objects.
 template <class Visit>
-void for_cut_pixels(const Ctx& x, const Plane& pl, const SegmentWorkspace& ws, Visit&& visit) {
+void for_cut_pixels(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, Visit&& visit) {
     for_segment_pixels(x, ws, [&](std::size_t p, int l) {
         if (ws.stack_cut[static_cast<std::size_t>(l)] >= 0) visit(p, l, pl.height(x.c.x[p], x.c.y[p], x.c.z[p]));
     });
@@ -132,7 +132,7 @@ constexpr int kMaxWallCells = 256;
 /// The upper objects' walls: the pixels of each cut segment above its cut that face
 /// sideways, with where they stand on the support plane, into ws.stack_walls. Cost: one pass
 /// over the rows with objects.
-void collect_upper_walls(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws) {
+void collect_upper_walls(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentBuffers& ws) {
     ws.stack_walls.clear();
     for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
         if (h <= ws.stack_cut[static_cast<std::size_t>(l)] || !faces_sideways(x, pl, p, sin_wall)) return;
@@ -143,12 +143,12 @@ void collect_upper_walls(const Ctx& x, const Plane& pl, const PlaneAxes& axes, f
 
 /// Per segment, a map of where its upper object's walls stand (ws.stack_walls) in
 /// ws.wall_maps, its cells in ws.wall_cells. Cost: two passes over the walls.
-void draw_wall_maps(SegmentWorkspace& ws, int n) {
+void draw_wall_maps(SegmentBuffers& ws, int n) {
     // The walls' box on the plane per segment, then its cells.
     const float big = std::numeric_limits<float>::max();
     std::vector<std::array<float, 4>>& box = ws.wall_box;  // u0, v0, u1, v1
     box.assign(static_cast<std::size_t>(n) + 1, {big, big, -big, -big});
-    for (const SegmentWorkspace::WallPoint& w : ws.stack_walls) {
+    for (const SegmentBuffers::WallPoint& w : ws.stack_walls) {
         std::array<float, 4>& b = box[static_cast<std::size_t>(w.segment)];
         b = {std::min(b[0], w.u), std::min(b[1], w.v), std::max(b[2], w.u), std::max(b[3], w.v)};
     }
@@ -164,8 +164,8 @@ void draw_wall_maps(SegmentWorkspace& ws, int n) {
         cells += static_cast<std::size_t>(cols) * static_cast<std::size_t>(rows);
     }
     ws.wall_cells.assign(cells, 0);
-    for (const SegmentWorkspace::WallPoint& w : ws.stack_walls) {
-        const SegmentWorkspace::WallMap& m = ws.wall_maps[static_cast<std::size_t>(w.segment)];
+    for (const SegmentBuffers::WallPoint& w : ws.stack_walls) {
+        const SegmentBuffers::WallMap& m = ws.wall_maps[static_cast<std::size_t>(w.segment)];
         if (m.cols == 0) continue;
         const auto cu = static_cast<std::size_t>((w.u - m.u0) / kWallCellM);
         const auto cv = static_cast<std::size_t>((w.v - m.v0) / kWallCellM);
@@ -175,8 +175,8 @@ void draw_wall_maps(SegmentWorkspace& ws, int n) {
 
 /// Whether point q of segment l (on the plane) stands where its upper object's walls stand:
 /// in a cell of its map or a neighbour. Cost: nine lookups.
-bool under_upper_walls(const SegmentWorkspace& ws, int l, const Eigen::Vector2d& q) {
-    const SegmentWorkspace::WallMap& m = ws.wall_maps[static_cast<std::size_t>(l)];
+bool under_upper_walls(const SegmentBuffers& ws, int l, const Eigen::Vector2d& q) {
+    const SegmentBuffers::WallMap& m = ws.wall_maps[static_cast<std::size_t>(l)];
     if (m.cols == 0) return false;
     const int cu = static_cast<int>(std::floor((static_cast<float>(q.x()) - m.u0) / kWallCellM));
     const int cv = static_cast<int>(std::floor((static_cast<float>(q.y()) - m.v0) / kWallCellM));
@@ -194,7 +194,7 @@ bool under_upper_walls(const SegmentWorkspace& ws, int l, const Eigen::Vector2d&
 enum Piece : int { kUpperWall = 0, kUnderUpperWalls = 1, kLower = 2, kUpper = 3 };
 
 /// The piece of pixel p (height h) of cut segment l. Cost: O(1).
-Piece piece_of(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, const SegmentWorkspace& ws,
+Piece piece_of(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, const SegmentBuffers& ws,
                std::size_t p, int l, float h) {
     const bool wall = faces_sideways(x, pl, p, sin_wall);
     if (h > ws.stack_cut[static_cast<std::size_t>(l)]) return wall ? kUpperWall : kUpper;
@@ -219,7 +219,7 @@ double colour_distance(const std::array<double, 4>& a, const std::array<double, 
 /// (another material) and nearer the upper object's walls. Same-coloured pairs stay cut by
 /// height. Clears the map of every segment whose walls stay. Cost: one pass over the rows
 /// with objects.
-void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws,
+void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentBuffers& ws,
                           int n) {
     ws.wall_colour.assign(static_cast<std::size_t>(n + 1) * 3, {0.0, 0.0, 0.0, 0.0});
     for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
@@ -251,7 +251,7 @@ void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, 
 /// Cuts each layered segment: its upper object (above the cut, and the walls under its walls
 /// where a map is kept) takes a new label n + 1, n + 2, ... in segment order. Returns the
 /// cuts. Cost: one pass over the rows with objects.
-int cut_layers(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentWorkspace& ws, int n) {
+int cut_layers(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentBuffers& ws, int n) {
     ws.remap.assign(static_cast<std::size_t>(n) + 1, 0);
     int next = n;
     for (int l = 1; l <= n; ++l)
@@ -265,7 +265,7 @@ int cut_layers(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_w
 /// The stack rule over segments 1..n (with gaps): the layers of each segment's upward faces,
 /// where to cut, which walls go up with the upper object (hybrid), then the cuts. Returns
 /// the cuts.
-int split_by_height(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) {
+int split_by_height(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     if (x.prm.stack_min_step_m <= 0) return 0;
     const int bins = static_cast<int>(std::ceil(x.prm.scope_max_height_m / kLayerBinM));
     count_layers(x, pl, ws, n, bins);
@@ -286,7 +286,7 @@ int split_by_height(const Ctx& x, const Plane& pl, SegmentWorkspace& ws, int n) 
 
 }  // namespace
 
-void split_stacks(const Ctx& x, const Plane* support, SegmentWorkspace& ws, int& n, SegmentStats& stats) {
+void split_stacks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.stack_splits = split_by_height(x, *support, ws, n);
     n += stats.stack_splits;
 }

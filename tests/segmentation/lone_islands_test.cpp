@@ -85,7 +85,7 @@ TEST(SegmentObjects, LoneIslands_KeptWhenBehindEverySegmentAndWide) {
     for (const Case& t : cases) {
         OrganizedCloud cloud;
         cloud.resize(W, H);
-        SegmentWorkspace ws;
+        SegmentWorkspace::Buffers ws;
         ws.label.assign(static_cast<std::size_t>(W) * H, 0);
         for (int v = 0; v < H; ++v)
             for (int u = 0; u < W; ++u) {
