@@ -43,6 +43,12 @@ def load(out):
     for f in frames or []: f.pop("ms", None)
     return s, frames
 a, b = load(sys.argv[1]), load(sys.argv[2])
+# A key one build writes and the other does not (summary.json's "outputs", added later) is
+# named, not counted: every key both write must agree.
+added = sorted(set(a[0]) ^ set(b[0]))
+if added:
+    print(f"summary.json keys in one build only (not compared): {', '.join(added)}")
+    for k in added: a[0].pop(k, None); b[0].pop(k, None)
 sys.exit(0 if a == b else f"summary.json / frames.jsonl differ beyond timings: {sys.argv[1]}")
 PY
   if [[ $ok == 0 ]]; then status=1; echo "$name: DIFFERS"; continue; fi
