@@ -9,10 +9,27 @@
 
 #include "branch_free.hpp"
 #include "param_check.hpp"
+#include "plane_internal.hpp"
 #include "point_moments.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
+
+PlaneWorkspace::PlaneWorkspace() : b_(std::make_unique<Buffers>()) {}
+PlaneWorkspace::~PlaneWorkspace() = default;
+PlaneWorkspace::PlaneWorkspace(PlaneWorkspace&&) noexcept = default;
+PlaneWorkspace& PlaneWorkspace::operator=(PlaneWorkspace&&) noexcept = default;
+PlaneWorkspace::Buffers& PlaneWorkspace::buffers() {
+    if (!b_) b_ = std::make_unique<Buffers>();
+    return *b_;
+}
+
+using PlaneBuffers = PlaneWorkspace::Buffers;
+using detail::Band;
+using detail::Grid;
+using detail::HullMask;
+using detail::make_grid;
+using detail::make_hull_mask;
 
 namespace {
 template <class T>
@@ -66,29 +83,6 @@ Plane fit(const double* s) {
     return p;
 }
 
-/// The coarse grid planes are grown on: w x h points, every s-th pixel of a W-wide image.
-struct Grid {
-    int w = 0, h = 0, s = 1, W = 0;
-    int size() const { return w * h; }
-};
-
-Grid make_grid(int W, int H, int stride) {
-    Grid grid;
-    grid.s = stride;
-    grid.w = (W + grid.s - 1) / grid.s;
-    grid.h = (H + grid.s - 1) / grid.s;
-    grid.W = W;
-    return grid;
-}
-
-/// The plane's band at depth z: heights within it are on the plane (sensor noise grows
-/// with z^2). Plain values, copied into the loops that use it: the grid loops vectorize,
-/// and a byte store there cannot change them as far as the compiler knows.
-struct Band {
-    float m, rel;
-    float operator()(float z) const { return m + rel * z * z; }
-};
-
 /// A grid point is an inlier of a plane when it lies on the plane's band and its normal
 /// agrees with the plane's. No branch: a point without a usable normal holds the zero
 /// normal and fails the normal test, so loops over the grid vectorize. Reads the gathered
@@ -120,59 +114,6 @@ struct InlierTest {
     }
 };
 
-/// The support's extent as a grid-resolution mask, and the test the pixels take against it:
-/// a point belongs over the support when its foot (the point moved down the normal onto the
-/// plane, `h` above it) projects into the mask. Plain values and a raw pointer: the
-/// per-pixel loops that call it store bytes, which would otherwise make the compiler reload
-/// every member on each pixel.
-struct HullMask {
-    const std::uint8_t* mask;
-    std::size_t w;
-    float fw, fh;            // w, h as floats
-    float gfx, gfy, gcx, gcy;  // intrinsics in grid cells, centres + 0.5 (cell by truncation)
-    float nx, ny, nz;        // the plane's normal
-
-    /// A foot below the frame's bottom edge is tested on that edge's row. A camera looking
-    /// down on a table cuts off the table's near part with the frame's bottom, and a foot
-    /// lies lower in the image than its point, so the nearest objects' feet fall out of
-    /// the frame with the table running on under them: where the hull reaches the bottom
-    /// edge there, they are over the support; where the table's near edge is in view, the
-    /// hull stops above it and they are not. Beyond the top and sides a foot stays off the
-    /// image (docs/ABLATION.md, "Support plane").
-    float below_to_edge(float gv) const { return std::min(gv, fh - 0.5f); }
-
-    /// The grid cell the foot projects into, -1 off the image.
-    std::ptrdiff_t foot_cell(float x, float y, float z, float h) const {
-        const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
-        if (fz <= 1e-3f) return -1;
-        const float inv_z = 1.0f / fz;
-        const float gu = gfx * fx * inv_z + gcx, gv = below_to_edge(gfy * fy * inv_z + gcy);
-        if (!(gu >= 0.0f && gv >= 0.0f && gu < fw && gv < fh)) return -1;
-        return static_cast<std::ptrdiff_t>(static_cast<std::size_t>(gv) * w + static_cast<std::size_t>(gu));
-    }
-    /// foot_cell as int, without a branch (vectorizes): -1 off the image.
-    int foot_cell_or_none(float x, float y, float z, float h) const {
-        const float fx = x - h * nx, fy = y - h * ny, fz = z - h * nz;
-        const float inv_z = 1.0f / fz;
-        const float gu = gfx * fx * inv_z + gcx, gv = below_to_edge(gfy * fy * inv_z + gcy);
-        const bool in = (fz > 1e-3f) & (gu >= 0.0f) & (gv >= 0.0f) & (gu < fw) & (gv < fh);
-        // Off the image gu, gv may be anything (inf, NaN): 0 instead, so the conversion is defined.
-        const int cu = static_cast<int>(detail::pick(in, gu, 0.0f)), cv = static_cast<int>(detail::pick(in, gv, 0.0f));
-        return cv * static_cast<int>(w) + cu - !in;  // cu = cv = 0 off the image
-    }
-};
-
-/// The test against `hull` (ws.hull, built by build_hull for `pl`). Per pixel in the hot
-/// loops: float arithmetic, grid cell by rounding (no libm call).
-HullMask make_hull_mask(const Grid& grid, const PinholeIntrinsics& K, const Plane& pl,
-                        const std::vector<std::uint8_t>& hull) {
-    const float inv_s = 1.0f / static_cast<float>(grid.s);
-    return HullMask{hull.data(), static_cast<std::size_t>(grid.w), static_cast<float>(grid.w),
-                    static_cast<float>(grid.h), static_cast<float>(K.fx) * inv_s,
-                    static_cast<float>(K.fy) * inv_s, static_cast<float>(K.cx) * inv_s + 0.5f,
-                    static_cast<float>(K.cy) * inv_s + 0.5f, pl.nx, pl.ny, pl.nz};
-}
-
 // ---------------------------------------------------------------------------------------
 // The phases of remove_support_plane, in their order. Costs: N pixels, G = N / s^2 grid
 // points (s = grid_stride_px), B regions worth fitting, C candidates. Scratch lives in the
@@ -185,7 +126,7 @@ HullMask make_hull_mask(const Grid& grid, const PinholeIntrinsics& K, const Plan
 /// a usable normal (inactive, or no normal) gets the zero normal. O(G), one parallel pass,
 /// no allocation.
 void gather_grid(const Grid& grid, const OrganizedCloud& cloud, const NormalMap& normals,
-                 const std::vector<std::uint8_t>& active, PlaneWorkspace::GridPoints& gp) {
+                 const std::vector<std::uint8_t>& active, PlaneBuffers::GridPoints& gp) {
     const int W = grid.W;
     const auto G = static_cast<std::size_t>(grid.size());
     for (auto* a : {&gp.x, &gp.y, &gp.z, &gp.nx, &gp.ny, &gp.nz}) a->resize(G);
@@ -221,7 +162,7 @@ struct GrownRegions {
 /// `ws.region` (G: region id per point, -1 none), `ws.sums` (kSums per region: moments,
 /// then summed normal). O(G), sequential flood fill on `ws.stack`; `ws.sums` grows by
 /// kSums per region (no allocation once its capacity suffices).
-GrownRegions grow_regions(const PlaneParams& params, const Grid& grid, PlaneWorkspace& ws) {
+GrownRegions grow_regions(const PlaneParams& params, const Grid& grid, PlaneBuffers& ws) {
     const int G = grid.size();
     ws.region.assign(static_cast<std::size_t>(G), -1);
     ws.stack.resize(static_cast<std::size_t>(G));
@@ -283,7 +224,7 @@ GrownRegions grow_regions(const PlaneParams& params, const Grid& grid, PlaneWork
 /// Out: the merged regions' ids (their roots); each root's sums in `ws.sums` now hold its
 /// whole merged set. O(B^2) plane pairs per pass for B regions worth fitting, two passes,
 /// plus B eigen-solves (3x3) per pass; a few small vectors per frame.
-std::vector<int> merge_coplanar(const PlaneParams& params, int regions, PlaneWorkspace& ws) {
+std::vector<int> merge_coplanar(const PlaneParams& params, int regions, PlaneBuffers& ws) {
     std::vector<int> big;
     std::vector<Plane> fits(static_cast<std::size_t>(regions));
     for (int r = 0; r < regions; ++r) {
@@ -334,7 +275,7 @@ std::vector<int> merge_coplanar(const PlaneParams& params, int regions, PlaneWor
 /// (every root's plane), `candidates` appended. O(G) per root, parallel over roots; no
 /// allocation but the candidates.
 void fit_candidates(const PlaneParams& params, const std::vector<int>& roots, std::size_t with_normal,
-                    const InlierTest& inliers, PlaneWorkspace& ws, std::vector<Plane>& candidates) {
+                    const InlierTest& inliers, PlaneBuffers& ws, std::vector<Plane>& candidates) {
     auto& fitted = ws.fitted;
     fitted.resize(roots.size());
     const auto n_roots = static_cast<std::ptrdiff_t>(roots.size());
@@ -406,7 +347,7 @@ void add_near_corners(const GridEdges& e, std::vector<int>& hull_points) {
 /// then the hull of at most 2 grid.h points and a dilation over G; OpenCV allocates the
 /// hull's corners and the kernel.
 void build_hull(const PlaneParams& params, const Grid& grid, const GridEdges& edges,
-                const InlierTest& is_inlier, const Plane& pl, PlaneWorkspace& ws) {
+                const InlierTest& is_inlier, const Plane& pl, PlaneBuffers& ws) {
     ws.hull.assign(static_cast<std::size_t>(grid.size()), 0);
     ws.hull_points.clear();
     // The hull of a set is the hull of each row's leftmost and rightmost members.
@@ -444,7 +385,7 @@ void build_hull(const PlaneParams& params, const Grid& grid, const GridEdges& ed
 /// few). Inlier sets are one bit per candidate per grid point (`ws.candidate_bits`, G).
 /// O(C x G) for the bits, O(G x C^2) at worst for the shared counts (points on two or more
 /// candidates only); no allocation.
-void mark_slivers(const std::vector<Plane>& candidates, const InlierTest& inliers, PlaneWorkspace& ws) {
+void mark_slivers(const std::vector<Plane>& candidates, const InlierTest& inliers, PlaneBuffers& ws) {
     const int G = inliers.G;
     const std::size_t C = std::min<std::size_t>(ws.by_extent.size(), 32);
     ws.sliver.assign(C, 0);
@@ -487,7 +428,7 @@ struct SupportChoice {
 /// O(C log C) to rank, mark_slivers, then O(G) (a hull, a pass and a parallel pass) per
 /// candidate counted, usually one or two.
 SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics& K, const Grid& grid,
-                             const GridEdges& edges, const InlierTest& inliers, PlaneWorkspace& ws,
+                             const GridEdges& edges, const InlierTest& inliers, PlaneBuffers& ws,
                              std::vector<Plane>& candidates) {
     const int G = grid.size();
     const auto& gp = ws.grid;
@@ -627,7 +568,7 @@ float lowest_dense_layer(const float* t, int G) {
 /// In: `chosen`, the gathered grid. Out: the support, its inliers counted (`above` is the
 /// chosen one's); `ws.layer_t` (G). O(G): four passes (heights, histogram, two fits) and an
 /// inlier count; no allocation.
-Plane refine_support(const PlaneParams& params, const InlierTest& is_inlier, PlaneWorkspace& ws,
+Plane refine_support(const PlaneParams& params, const InlierTest& is_inlier, PlaneBuffers& ws,
                      const Plane& chosen) {
     const int G = is_inlier.G;
     const float *const gx = is_inlier.x, *const gy = is_inlier.y, *const gz = is_inlier.z;
@@ -673,269 +614,13 @@ std::size_t keep_all_active(const std::vector<std::uint8_t>& active, std::vector
     return static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
 }
 
-/// What classify_pixels tests per pixel: the cloud, normals and active mask (raw
-/// pointers), the support and its band, and its extent.
-struct PixelTest {
-    const float *xs, *ys, *zs, *nxs, *nys, *nzs;
-    const std::uint8_t *act, *has_normal;
-    Plane pl;
-    Band on_band;
-    float cos_inlier;
-    HullMask hull;
-};
-
-/// classify_pixels' per-pixel test up to the hull lookup, for pixels [p0, p0 + n): what the
-/// hull decides (`hull_makes`: object above the band, foot on it where the normal faces
-/// otherwise, else removed; removed where inactive), the hull cell under the pixel (`cell`,
-/// -1 off the image) and whether it lies on the band (`near`). Branch-free so that it
-/// vectorizes; built for AVX2 and baseline x86-64 (no FMA either way: the same bits).
-/// Cost: one pass.
-WUL3D_AVX2_CLONES
-void hull_candidates(const PixelTest& t, std::size_t p0, int n, std::uint8_t* __restrict hull_makes,
-                     std::uint8_t* __restrict near, int* __restrict cell) {
-    // Locals: a byte store may alias `t` as far as the compiler knows.
-    const float *const xs = t.xs, *const ys = t.ys, *const zs = t.zs;
-    const float *const nxs = t.nxs, *const nys = t.nys, *const nzs = t.nzs;
-    const std::uint8_t *const act = t.act, *const has_normal = t.has_normal;
-    const float pnx = t.pl.nx, pny = t.pl.ny, pnz = t.pl.nz, pd = t.pl.d, cos_inlier = t.cos_inlier;
-    const Band on_band = t.on_band;
-    const HullMask hull = t.hull;
-    for (int j = 0; j < n; ++j) {
-        const std::size_t p = p0 + j;
-        const float x = xs[p], y = ys[p], z = zs[p];
-        const float h = pnx * x + pny * y + pnz * z + pd, band = on_band(z);
-        const bool faces_otherwise = (h > -band) & (has_normal[p] != 0) &
-                                     (nxs[p] * pnx + nys[p] * pny + nzs[p] * pnz < cos_inlier);
-        // Arithmetic, not `?:`, which GCC keeps as branches here.
-        const bool above = h > band;
-        const int makes = above * kPlaneObject + (!above & faces_otherwise) * kPlaneFoot;
-        hull_makes[j] = static_cast<std::uint8_t>(makes * (act[p] != 0));
-        near[j] = (act[p] != 0) & (std::fabs(h) <= band);
-        cell[j] = hull.foot_cell_or_none(x, y, z, h);
-    }
-}
-
-/// 6. Classify every pixel: below or on the plane (and facing like it) is removed; on the
-/// band but facing otherwise is a candidate foot; above and over the support is object.
-/// In: the support `pl` and its extent `ws.hull`. Out: `classes` (N, PlaneClass), `ws.on_band`
-/// (N, 1 = removed and on the band) and `ws.row_first_run[v + 1]` (row v's number of runs of
-/// on-band pixels, for restore_islands); returns the pixels kept. O(N), one parallel pass,
-/// no allocation.
-std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const OrganizedCloud& cloud,
-                            const NormalMap& normals, const std::vector<std::uint8_t>& active,
-                            const Plane& pl, const Band on_band, const float cos_inlier,
-                            PlaneWorkspace& ws, std::vector<std::uint8_t>& classes) {
-    const int W = cloud.width, H = cloud.height;
-    ws.on_band.resize(cloud.size());
-    ws.row_first_run.assign(static_cast<std::size_t>(H) + 1, 0);
-    std::size_t kept = 0;
-    // Raw pointers: the byte stores below may alias anything, so through the containers the
-    // compiler would reload their data pointers on every pixel.
-    const float *const xs = cloud.x.data(), *const ys = cloud.y.data(), *const zs = cloud.z.data();
-    const float *const nxs = normals.nx.data(), *const nys = normals.ny.data(), *const nzs = normals.nz.data();
-    const std::uint8_t *const act = active.data(), *const has_normal = normals.valid.data();
-    std::uint8_t* const cls = classes.data();
-    std::uint8_t* const band_out = ws.on_band.data();
-    // ... and the mask a local copy for the same reason. Per chunk of a row, the arithmetic
-    // in hull_candidates (vectorized), then the hull lookups and counts here.
-    const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
-    const PixelTest test{xs, ys, zs, nxs, nys, nzs, act, has_normal, pl, on_band, cos_inlier, hull};
-    constexpr int kChunk = 64;  // pixels per call of hull_candidates
-#pragma omp parallel for schedule(static) reduction(+ : kept)
-    for (int v = 0; v < H; ++v) {
-        int runs = 0;
-        std::uint8_t previous = 0;
-        for (int u0 = 0; u0 < W; u0 += kChunk) {
-            const std::size_t p0 = static_cast<std::size_t>(v) * W + u0;
-            const int n = std::min(kChunk, W - u0);
-            std::uint8_t hull_makes[kChunk], near[kChunk];
-            int cell[kChunk];
-            hull_candidates(test, p0, n, hull_makes, near, cell);
-            // Then the hull lookups where the hull decides, and the counts.
-            for (int j = 0; j < n; ++j) {
-                const std::uint8_t c = hull_makes[j] != kPlaneRemoved && cell[j] >= 0 && hull.mask[cell[j]] != 0
-                                           ? hull_makes[j]
-                                           : std::uint8_t{kPlaneRemoved};
-                const std::uint8_t on_band_removed = c == kPlaneRemoved && near[j];
-                cls[p0 + j] = c;
-                band_out[p0 + j] = on_band_removed;
-                kept += c != kPlaneRemoved;
-                runs += on_band_removed > previous;
-                previous = on_band_removed;
-            }
-        }
-        ws.row_first_run[static_cast<std::size_t>(v) + 1] = runs;
-    }
-    return kept;
-}
-
-// 7. Islands (restore_islands and its steps). On-plane patches that the objects enclose (a
-// bowl's inner bottom seen through its opening) are object material, not the support: a
-// 4-connected patch of removed on-band pixels that touches neither the image border nor
-// other removed points, borders object points, is small and sits on average above the
-// plane is given back (kPlaneInside). The patches are found as runs of on-band pixels per
-// row joined by union-find where runs of consecutive rows overlap: a few thousand runs
-// instead of a flood fill over the table.
-
-using Run = PlaneWorkspace::Run;
-
-/// The root of run `a`'s set, halving the path on the way.
-int find_run(std::vector<Run>& runs, int a) {
-    while (runs[static_cast<std::size_t>(a)].parent != a) {
-        auto& r = runs[static_cast<std::size_t>(a)];
-        r.parent = runs[static_cast<std::size_t>(r.parent)].parent;
-        a = r.parent;
-    }
-    return a;
-}
-
-/// The runs of `ws.on_band`, row by row in parallel, each row's at its offset. In:
-/// `ws.row_first_run[v + 1]` = row v's count (classify_pixels). Out: `ws.row_first_run`
-/// as offsets (H + 1), `ws.runs` (each its own set). O(N), one parallel pass; no
-/// allocation once `ws.runs` has the capacity.
-void find_band_runs(int W, int H, PlaneWorkspace& ws) {
-    const std::uint8_t* band = ws.on_band.data();
-    auto& runs = ws.runs;
-    for (int v = 0; v < H; ++v)
-        ws.row_first_run[static_cast<std::size_t>(v) + 1] += ws.row_first_run[static_cast<std::size_t>(v)];
-    const std::size_t R = static_cast<std::size_t>(ws.row_first_run[static_cast<std::size_t>(H)]);
-    runs.resize(R);
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
-        int id = ws.row_first_run[static_cast<std::size_t>(v)];
-        const std::uint8_t* row = band + static_cast<std::size_t>(v) * W;
-        for (int u = 0; u < W;) {
-            if (!row[u]) {
-                ++u;
-                continue;
-            }
-            const int begin = u;
-            while (u < W && row[u]) ++u;
-            runs[static_cast<std::size_t>(id)] = {v, begin, u, id};
-            ++id;
-        }
-    }
-}
-
-/// Per run (in parallel): what borders it and, unless that opens it (its island is then
-/// open whatever else it holds: most of the table's runs), its heights over `pl`. Out:
-/// `ws.island_flags`, `ws.island_height` per run; `ws.island_size` zeroed. O(runs' pixels
-/// and their neighbours above and below), one parallel pass; no allocation once sized.
-void inspect_runs(const OrganizedCloud& cloud, const std::vector<std::uint8_t>& active, const Plane& pl,
-                  const std::vector<std::uint8_t>& classes, PlaneWorkspace& ws) {
-    const int W = cloud.width, H = cloud.height;
-    const std::uint8_t* band = ws.on_band.data();
-    const auto& runs = ws.runs;
-    const std::size_t R = runs.size();
-    ws.island_height.assign(R, 0.0);
-    ws.island_size.assign(R, 0);
-    ws.island_flags.assign(R, 0);
-    // A neighbour outside the patch: object material, or a removed active point off the
-    // band (support or room beside it) that opens the patch.
-    auto look = [&](std::size_t q, std::uint8_t& flags) {
-        if (band[q]) return;
-        if (classes[q] != kPlaneRemoved) flags |= 2;
-        else if (active[q]) flags |= 1;
-    };
-    const auto Rn = static_cast<std::ptrdiff_t>(R);
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t i = 0; i < Rn; ++i) {
-        const auto& r = runs[static_cast<std::size_t>(i)];
-        std::uint8_t flags = 0;
-        const std::size_t row = static_cast<std::size_t>(r.row) * W;
-        if (r.row == 0 || r.row == H - 1 || r.begin == 0 || r.end == W) {
-            flags |= 1;  // touches the image border
-        } else {
-            look(row + static_cast<std::size_t>(r.begin) - 1, flags);
-            look(row + static_cast<std::size_t>(r.end), flags);
-            for (int u = r.begin; u < r.end && !(flags & 1); ++u) {
-                look(row - W + static_cast<std::size_t>(u), flags);
-                look(row + W + static_cast<std::size_t>(u), flags);
-            }
-        }
-        double height = 0;
-        if (!(flags & 1))
-            for (int u = r.begin; u < r.end; ++u) {
-                const std::size_t p = row + static_cast<std::size_t>(u);
-                height += pl.height(cloud.x[p], cloud.y[p], cloud.z[p]);
-            }
-        ws.island_height[static_cast<std::size_t>(i)] = height;
-        ws.island_flags[static_cast<std::size_t>(i)] = flags;
-    }
-}
-
-/// Runs of consecutive rows that share a column (4-connectivity) join, except two open
-/// runs: their islands are open whatever else they join (most of the table's runs). Then
-/// each run's size, heights and flags are summed into its root. Out: `ws.runs`' parents,
-/// `ws.island_*` complete at the roots. O(runs) near-constant union-find steps,
-/// sequential; no allocation.
-void join_runs_into_islands(int H, PlaneWorkspace& ws) {
-    auto& runs = ws.runs;
-    for (int v = 1; v < H; ++v) {
-        int a = ws.row_first_run[static_cast<std::size_t>(v) - 1];
-        const int a_end = ws.row_first_run[static_cast<std::size_t>(v)];
-        const int b_end = ws.row_first_run[static_cast<std::size_t>(v) + 1];
-        for (int b = a_end; b < b_end; ++b) {
-            const auto& rb = runs[static_cast<std::size_t>(b)];
-            while (a < a_end && runs[static_cast<std::size_t>(a)].end <= rb.begin) ++a;
-            const bool b_open = ws.island_flags[static_cast<std::size_t>(b)] & 1;
-            for (int c = a; c < a_end && runs[static_cast<std::size_t>(c)].begin < rb.end; ++c) {
-                if (b_open && (ws.island_flags[static_cast<std::size_t>(c)] & 1)) continue;
-                const int ra = find_run(runs, c), rb_root = find_run(runs, b);
-                if (ra != rb_root) runs[static_cast<std::size_t>(std::max(ra, rb_root))].parent = std::min(ra, rb_root);
-            }
-        }
-    }
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-        const auto& r = runs[i];
-        const std::size_t root = static_cast<std::size_t>(find_run(runs, static_cast<int>(i)));
-        ws.island_size[root] += r.end - r.begin;
-        if (root == i) continue;
-        ws.island_height[root] += ws.island_height[i];
-        ws.island_flags[root] |= ws.island_flags[i];
-    }
-}
-
-/// The closed islands that border object points only, are small and sit above the plane
-/// become kPlaneInside in `classes`; returns their pixels. O(runs + the pixels given
-/// back), sequential; no allocation.
-std::size_t give_back_islands(const PlaneParams& params, int W, std::size_t N, PlaneWorkspace& ws,
-                              std::vector<std::uint8_t>& classes) {
-    auto& runs = ws.runs;
-    const double max_size = params.island_max_share * static_cast<double>(N);
-    std::size_t restored = 0;
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-        const auto& r = runs[i];
-        const std::size_t root = static_cast<std::size_t>(find_run(runs, static_cast<int>(i)));
-        const int size = ws.island_size[root];
-        if (ws.island_flags[root] != 2 || size > max_size ||
-            ws.island_height[root] / size <= params.island_min_height_m)
-            continue;
-        std::fill(classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.begin,
-                  classes.begin() + static_cast<std::ptrdiff_t>(r.row) * W + r.end, kPlaneInside);
-        restored += static_cast<std::size_t>(r.end - r.begin);
-    }
-    return restored;
-}
-
-/// 7. The islands given back. In: classify_pixels' `classes`, `ws.on_band` and run counts.
-/// Out: `classes` with kPlaneInside; returns the pixels given back. O(N) for the runs, then
-/// O(runs).
-std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
-                            const std::vector<std::uint8_t>& active, const Plane& pl,
-                            PlaneWorkspace& ws, std::vector<std::uint8_t>& classes) {
-    find_band_runs(cloud.width, cloud.height, ws);
-    inspect_runs(cloud, active, pl, classes, ws);
-    join_runs_into_islands(cloud.height, ws);
-    return give_back_islands(params, cloud.width, cloud.size(), ws, classes);
-}
-
 }  // namespace
 
 PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
                                  const OrganizedCloud& cloud, const NormalMap& normals,
-                                 const std::vector<std::uint8_t>& active, PlaneWorkspace& ws,
+                                 const std::vector<std::uint8_t>& active, PlaneWorkspace& workspace,
                                  std::vector<std::uint8_t>& classes) {
+    PlaneBuffers& ws = workspace.buffers();
     classes.resize(cloud.size());
     PlaneResult result;
     const Grid grid = make_grid(cloud.width, cloud.height, params.grid_stride_px);
@@ -967,8 +652,8 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
         build_hull(params, grid, edges, inliers, pl, ws);
 
     // 6-7: every pixel classified; enclosed on-plane patches given back to the objects.
-    std::size_t kept = classify_pixels(grid, K, cloud, normals, active, pl, band, cos_inlier, ws, classes);
-    kept += restore_islands(params, cloud, active, pl, ws, classes);
+    std::size_t kept = detail::classify_pixels(grid, K, cloud, normals, active, pl, band, cos_inlier, ws, classes);
+    kept += detail::restore_islands(params, cloud, active, pl, ws, classes);
     result.kept = kept;
     return result;
 }

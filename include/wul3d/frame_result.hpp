@@ -10,7 +10,7 @@
 #include "wul3d/clustering.hpp"
 #include "wul3d/image.hpp"
 #include "wul3d/objects.hpp"
-#include "wul3d/plane.hpp"
+#include "wul3d/support_plane.hpp"
 #include "wul3d/segmentation.hpp"
 
 namespace wul3d {

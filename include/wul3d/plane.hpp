@@ -6,14 +6,14 @@
 /// pixel grid, fitted by least squares and merged when coplanar; the support is chosen
 /// among them by orientation (it faces up in the image) and by the points standing on it,
 /// not by size alone (a wall or the floor can be larger than the table).
-///
-/// Plane convention: n . X + d = 0 with n a unit vector towards the camera, so d > 0 and
-/// s(X) = n . X + d is the height of X above the plane (metres, camera side positive).
+/// The plane's convention and the result's types: support_plane.hpp.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "wul3d/camera.hpp"
 #include "wul3d/cloud.hpp"
+#include "wul3d/support_plane.hpp"
 
 namespace wul3d {
 
@@ -46,66 +46,20 @@ struct PlaneParams {
     void validate() const;  ///< throws ParamError naming the field
 };
 
-/// A fitted plane and what its choice rested on.
-struct Plane {
-    float nx = 0, ny = 0, nz = 0, d = 0;  ///< n . X + d = 0, |n| = 1, n towards the camera
-    std::size_t inliers = 0;  ///< grid points on it (distance and normal agree)
-    std::size_t above = 0;    ///< grid points standing on it (0 < height <= max, foot on it);
-                              ///< 0 if not counted (a candidate that could not be the support)
-    float up = 0;             ///< -n_y
-    float height(float x, float y, float z) const { return nx * x + ny * y + nz * z + d; }
-};
-
-/// Per-pixel result classes of remove_support_plane.
-enum PlaneClass : std::uint8_t {
-    kPlaneRemoved = 0,     ///< not active, on or below the support, or off its extent
-    kPlaneObject = 1,      ///< above the support and over it: object material
-    kPlaneFoot = 2,        ///< on the support's band but not facing like it: maybe a foot
-    kPlaneInside = 3,      ///< on the band but enclosed by object points: a container's inside
-};
-
-struct PlaneResult {
-    bool found = false;           ///< false: no support; every active point is kept
-    Plane support;                ///< valid when found
-    std::vector<Plane> candidates;  ///< every merged plane that met min_extent
-    std::size_t kept = 0;         ///< pixels of class kPlaneObject or kPlaneFoot
-};
-
 /// Scratch of remove_support_plane; allocates nothing after the first frame of a size.
-struct PlaneWorkspace {
-    /// The grid's points gathered once (every grid_stride_px-th pixel), structure of arrays.
-    struct GridPoints {
-        std::vector<float> x, y, z, nx, ny, nz;
-        std::vector<std::uint8_t> active, usable;  ///< usable: active with a normal
-    } grid;
-    std::vector<int> region;          ///< grid point -> region id, -1 none
-    std::vector<int> stack;
-    std::vector<double> sums;         ///< per region: count, sum x, y, z, xx, xy, xz, yy, yz, zz
-    std::vector<std::uint8_t> hull;   ///< grid-resolution mask of the support's extent
-    std::vector<int> hull_points;     ///< (gu, gv) pairs: each grid row's outermost inliers
-    std::vector<Plane> fitted;        ///< the merged planes, fitted, inliers counted
-    std::vector<float> layer_t;       ///< per grid point: height over the chosen support in
-                                      ///< half bands (1e9 if it does not face like it)
-    std::vector<int> by_extent;       ///< candidate indices, largest extent first
-    std::vector<std::uint32_t> candidate_bits;  ///< per grid point: bit r = inlier of rank r
-    std::vector<int> shared;          ///< inliers two candidates share (ranks i > j)
-    std::vector<std::uint8_t> sliver; ///< per rank: cuts through a larger candidate, not scored
-    std::vector<std::uint8_t> tall_foot;  ///< per grid cell: something rises from it past
-                                          ///< max_object_height_m over the candidate counted
-    std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
-    /// Runs of on-band pixels, row by row, and their union-find components (islands).
-    struct Run {
-        int row, begin, end;  ///< pixels [begin, end) of the row
-        int parent;           ///< union-find parent (a run index)
-    };
-    std::vector<Run> runs;
-    std::vector<int> row_first_run;     ///< per row + 1: index of its first run
-    /// Per run, then summed into its root run: heights over the plane, pixels (roots only),
-    /// flags 1 = open (image border, or beside removed points off the band), 2 = beside
-    /// object points.
-    std::vector<double> island_height;
-    std::vector<int> island_size;
-    std::vector<std::uint8_t> island_flags;
+/// Opaque: its buffers are plane.cpp's (src/plane_internal.hpp).
+class PlaneWorkspace {
+public:
+    PlaneWorkspace();
+    ~PlaneWorkspace();
+    PlaneWorkspace(PlaneWorkspace&&) noexcept;
+    PlaneWorkspace& operator=(PlaneWorkspace&&) noexcept;
+
+    struct Buffers;      ///< src/plane_internal.hpp
+    Buffers& buffers();  ///< for plane.cpp's phases (made again after a move)
+
+private:
+    std::unique_ptr<Buffers> b_;
 };
 
 /// Finds the support plane among the `active` points and classifies every pixel

@@ -1,7 +1,7 @@
 #pragma once
 /// @file segmentation.hpp
 /// Object instances on the pixel grid, from the points left after support-plane removal
-/// (plane.hpp). The geometric segmenter cuts the surface where it folds inward (a concave
+/// (plane.hpp, support_plane.hpp). The geometric segmenter cuts the surface where it folds inward (a concave
 /// crease: a per-pixel version of LCCP's convexity test between neighbouring normals) and
 /// where depth jumps, takes connected components, then re-attaches the cut pixels and the
 /// objects' feet to the component they touch, merges segments that meet along a boundary
@@ -17,7 +17,7 @@
 
 #include "wul3d/cloud.hpp"
 #include "wul3d/image.hpp"
-#include "wul3d/plane.hpp"
+#include "wul3d/support_plane.hpp"
 
 namespace wul3d {
 
