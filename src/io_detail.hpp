@@ -76,6 +76,18 @@ void check_index(std::size_t i, std::size_t n);
 /// The PNG files of `dir` by stem, sorted; InputError if it cannot be listed.
 std::vector<std::filesystem::path> list_pngs(const std::filesystem::path& dir);
 
+/// A frame's 16-bit millimetre depth at `path` into `f.depth`, and `K` as its intrinsics:
+/// InputError when sized intrinsics differ from the depth's size (`from` says where they
+/// came from); unsized ones take the depth's size and are checked then.
+void read_mm_depth_with_intrinsics(const std::string& path, const PinholeIntrinsics& K,
+                                   const std::string& from, ImageScratch& scratch, RgbdFrame& f);
+
+/// A registered sequence's intrinsics when the caller gave them (checked; `from` =
+/// "given") or an organized PCD at `pcd` holds them (fitted to its points, as read_pcd_frame
+/// does; `from` names the file); false when neither, for the caller's own fallback.
+bool given_or_pcd_intrinsics(const SourceOptions& options, const std::filesystem::path& pcd,
+                             PinholeIntrinsics& K, std::string& from);
+
 /// `p` made absolute and without a trailing separator, so that filename() and
 /// parent_path() mean the folder itself and its parent even for "." or "seq/".
 std::filesystem::path normalized(const std::filesystem::path& p);

@@ -65,18 +65,7 @@ public:
         item.is_raw = false;
         RgbdFrame& f = item.frame;
         f.name = name(i);
-        f.intrinsics = K_;
-        const std::string depth = frames_.depth[i].string();
-        read_depth_png_into(depth, 0.001f, depth_scratch_, f.depth, [&](int w, int h) {
-            if (K_.sized() && !K_.same_size(w, h))
-                throw InputError(depth + ": depth is " + size_str(w, h) + " but the intrinsics (" +
-                                 from_ + ") are " + size_str(K_.width, K_.height));
-        });
-        if (!K_.sized()) {
-            f.intrinsics.width = f.depth.width;
-            f.intrinsics.height = f.depth.height;
-            f.intrinsics.validate(depth + ": the intrinsics (" + from_ + ")");
-        }
+        read_mm_depth_with_intrinsics(frames_.depth[i].string(), K_, from_, depth_scratch_, f);
         const std::string color = frames_.color[i].string();
         read_color_image_into(color, color_scratch_, f.color, [&](int w, int h) {
             check_same_size(color, w, h, f.depth.width, f.depth.height);
@@ -111,17 +100,7 @@ std::unique_ptr<FrameSource> open_osd(const std::string& path, const fs::path& r
     PinholeIntrinsics K;
     std::string from;
     const fs::path pcd = root / "pcd" / (frames.depth.front().stem().string() + ".pcd");
-    if (options.intrinsics) {
-        K = *options.intrinsics;
-        from = "given";
-        if (K.sized())
-            K.validate("the given intrinsics");
-        else
-            K.validate_unsized("the given intrinsics");
-    } else if (present(pcd)) {
-        K = read_pcd_frame(pcd.string()).intrinsics;
-        from = "recovered from " + pcd.string();
-    } else {
+    if (!given_or_pcd_intrinsics(options, pcd, K, from)) {
         K = intrinsics_preset("kinect_v1");
         from = "Kinect v1 defaults, no " + pcd.string();
     }

@@ -73,6 +73,39 @@ std::vector<fs::path> list_pngs(const fs::path& dir) {
     return files;
 }
 
+void read_mm_depth_with_intrinsics(const std::string& path, const PinholeIntrinsics& K,
+                                   const std::string& from, ImageScratch& scratch, RgbdFrame& f) {
+    f.intrinsics = K;
+    read_depth_png_into(path, 0.001f, scratch, f.depth, [&](int w, int h) {
+        if (K.sized() && !K.same_size(w, h))
+            throw InputError(path + ": depth is " + size_str(w, h) + " but the intrinsics (" +
+                             from + ") are " + size_str(K.width, K.height));
+    });
+    if (!K.sized()) {
+        f.intrinsics.width = f.depth.width;
+        f.intrinsics.height = f.depth.height;
+        f.intrinsics.validate(path + ": the intrinsics (" + from + ")");
+    }
+}
+
+bool given_or_pcd_intrinsics(const SourceOptions& options, const fs::path& pcd,
+                             PinholeIntrinsics& K, std::string& from) {
+    if (options.intrinsics) {
+        K = *options.intrinsics;
+        from = "given";
+        if (K.sized())
+            K.validate("the given intrinsics");
+        else
+            K.validate_unsized("the given intrinsics");
+        return true;
+    }
+    std::error_code ec;
+    if (!fs::exists(pcd, ec)) return false;  // anything there: read_pcd_frame refuses a non-file
+    K = read_pcd_frame(pcd.string()).intrinsics;
+    from = "recovered from " + pcd.string();
+    return true;
+}
+
 fs::path normalized(const fs::path& p) {
     fs::path n = fs::absolute(p).lexically_normal();
     if (n.filename().empty() && n.has_parent_path() && n != n.root_path()) n = n.parent_path();
@@ -369,18 +402,7 @@ public:
         item.is_raw = false;
         RgbdFrame& f = item.frame;
         f.name = name(i);
-        f.intrinsics = K_;
-        const std::string depth = depth_[i].string();
-        detail::read_depth_png_into(depth, 0.001f, depth_scratch_, f.depth, [&](int w, int h) {
-            if (K_.sized() && !K_.same_size(w, h))
-                throw InputError(depth + ": depth is " + size_str(w, h) + " but the intrinsics (" +
-                                 from_ + ") are " + size_str(K_.width, K_.height));
-        });
-        if (!K_.sized()) {
-            f.intrinsics.width = f.depth.width;
-            f.intrinsics.height = f.depth.height;
-            f.intrinsics.validate(depth + ": the intrinsics (" + from_ + ")");
-        }
+        detail::read_mm_depth_with_intrinsics(depth_[i].string(), K_, from_, depth_scratch_, f);
         const fs::path color = seq_ / "rgb" / depth_[i].filename();
         if (present(color)) {
             detail::read_color_image_into(color.string(), color_scratch_, f.color, [&](int w, int h) {
@@ -407,20 +429,9 @@ std::unique_ptr<FrameSource> open_ocid(const std::string& path, const fs::path& 
     PinholeIntrinsics K;
     std::string from;
     const fs::path pcd = seq / "pcd" / (depth.front().stem().string() + ".pcd");
-    if (options.intrinsics) {
-        K = *options.intrinsics;
-        from = "given";
-        if (K.sized())
-            K.validate("the given intrinsics");
-        else
-            K.validate_unsized("the given intrinsics");
-    } else if (something_at(pcd)) {
-        K = read_pcd_frame(pcd.string()).intrinsics;
-        from = "recovered from " + pcd.string();
-    } else {
+    if (!detail::given_or_pcd_intrinsics(options, pcd, K, from))
         throw InputError(path + ": an OCID sequence without " + pcd.string() +
                          " to recover the intrinsics from; give them (--intrinsics)");
-    }
     return std::make_unique<OcidSource>(seq, std::move(depth), K, from);
 }
 

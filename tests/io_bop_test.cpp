@@ -26,13 +26,7 @@ const char* const kStems[] = {"000000", "000003"};
 const char* const kSamples[] = {"image_0000", "image_0005"};
 
 wul3d::RgbdFrame sample_frame(int i) {
-    const fs::path dir = wul3d::test::sample_dir() / "uois_tabletop" / kSamples[i];
-    wul3d::RgbdFrame f;
-    const wul3d::IntrinsicsFile K = wul3d::read_intrinsics_json((dir / "intrinsics.json").string());
-    f.intrinsics = K.intrinsics;
-    f.depth = wul3d::read_depth_png((dir / "depth.png").string(), K.depth_scale_m_per_unit);
-    f.color = wul3d::read_color_image((dir / "color.png").string());
-    return f;
+    return wul3d::test::read_sample_frame(kSamples[i]);
 }
 
 /// The camera image i is given: the sample's, with the principal point moved for the

@@ -21,13 +21,7 @@ using wul3d::test::TempDir;
 const char* const kStems[] = {"result_2018-08-20-11-25-02", "result_2018-08-20-11-25-10"};
 
 wul3d::RgbdFrame sample_frame() {
-    const fs::path dir = wul3d::test::sample_dir() / "uois_tabletop/image_0000";
-    wul3d::RgbdFrame f;
-    const wul3d::IntrinsicsFile K = wul3d::read_intrinsics_json((dir / "intrinsics.json").string());
-    f.intrinsics = K.intrinsics;
-    f.depth = wul3d::read_depth_png((dir / "depth.png").string(), K.depth_scale_m_per_unit);
-    f.color = wul3d::read_color_image((dir / "color.png").string());
-    return f;
+    return wul3d::test::read_sample_frame("image_0000");
 }
 
 /// ROOT/ARID20/<place>/top/seq01 with two frames; pcd/ unless `with_pcd` is false.

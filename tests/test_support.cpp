@@ -12,10 +12,22 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "wul3d/io.hpp"
+
 namespace wul3d::test {
 namespace fs = std::filesystem;
 
 fs::path sample_dir() { return fs::path(WUL3D_SAMPLE_DIR); }
+
+wul3d::RgbdFrame read_sample_frame(const std::string& name) {
+    const fs::path dir = sample_dir() / (name.find('/') == std::string::npos ? "uois_tabletop/" + name : name);
+    wul3d::RgbdFrame f;
+    const wul3d::IntrinsicsFile K = wul3d::read_intrinsics_json((dir / "intrinsics.json").string());
+    f.intrinsics = K.intrinsics;
+    f.depth = wul3d::read_depth_png((dir / "depth.png").string(), K.depth_scale_m_per_unit);
+    f.color = wul3d::read_color_image((dir / "color.png").string());
+    return f;
+}
 fs::path cli_path() { return fs::path(WUL3D_CLI); }
 
 TempDir::TempDir() {

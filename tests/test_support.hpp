@@ -8,10 +8,15 @@
 #include <utility>
 #include <vector>
 
+#include "wul3d/frame.hpp"
+
 namespace wul3d::test {
 
 /// data/samples of the source tree (shipped real frames, MIT and BSD licensed).
 std::filesystem::path sample_dir();
+/// A shipped frame folder (depth.png, color.png, intrinsics.json) read with the library's
+/// single-file readers: uois_tabletop/<name> unless `name` holds a '/'.
+wul3d::RgbdFrame read_sample_frame(const std::string& name);
 /// Path of the built `wul3d` command.
 std::filesystem::path cli_path();
 
