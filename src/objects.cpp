@@ -99,7 +99,31 @@ void ObjectParams::validate() const {
     require(surface_change_rgb > 0, "surface_change_rgb", surface_change_rgb, "> 0");
 }
 
-ObjectTracker::ObjectTracker(const ObjectParams& params) : params_(params) {
+/// ObjectTracker's per-frame results, passed from phase to phase and reused from frame to
+/// frame. S segments, K = max_tracks slots.
+struct ObjectTracker::Scratch {
+    std::vector<std::uint8_t> changed;      ///< per pixel, 1 where its surface changed
+    std::vector<double> votes, seg_sums;   ///< per segment: weight mass per slot; count, x, y, z
+    std::vector<int> seg_slot;              ///< per segment, its slot (-1: none)
+    std::vector<std::uint8_t> slot_taken;   ///< per slot, 1 where a segment took it
+    std::vector<std::uint8_t> slot_of;      ///< per pixel, its arg-max slot + 1, 0 none
+    std::vector<double> obj_sums;           ///< per slot, point moments and colour sums
+    std::vector<int> obj_boxes;             ///< per slot, u_min, v_min, u_max, v_max
+    std::vector<int> object_of_slot;        ///< per slot, its index in step's `out` (-1: none)
+    // Per band of rows (kBands), reduced in band order:
+    std::vector<std::uint64_t> band_votes;
+    std::vector<double> band_seg_sums, band_obj_sums;
+    std::vector<int> band_boxes, band_cluster_count;
+    std::vector<float> band_extents;
+    std::vector<std::uint8_t> band_segment_seen;
+};
+
+ObjectTracker::~ObjectTracker() = default;
+ObjectTracker::ObjectTracker(ObjectTracker&&) noexcept = default;
+ObjectTracker& ObjectTracker::operator=(ObjectTracker&&) noexcept = default;
+
+ObjectTracker::ObjectTracker(const ObjectParams& params)
+    : params_(params), s_(std::make_unique<Scratch>()) {
     params_.validate();
     tracks_.resize(static_cast<std::size_t>(params_.max_tracks));
 }
@@ -127,6 +151,7 @@ void ObjectTracker::free_slot(int slot) {
 void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments,
                          const LabelImage& clusters, LabelImage& objects,
                          std::vector<DetectedObject>& out) {
+    if (!s_) s_ = std::make_unique<Scratch>();  // a moved-from tracker, used again
     if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
     // Pixels whose surface changed forget their weights (in weigh_pixels, after the votes);
     // a scene cut forgets everything.
@@ -160,14 +185,14 @@ void ObjectTracker::allocate(int width, int height) {
     height_ = height;
     mu_.assign(N, PixelWeights{});
     has_mu_.assign(N, 0);
-    slot_of_.assign(N, 0);
+    s_->slot_of.assign(N, 0);
     prev_z_.assign(N, 0.0f);
     prev_rgb_.assign(3 * N, 0);
-    changed_.assign(N, 0);
+    s_->changed.assign(N, 0);
     reset();
 }
 
-// In: the cloud, prev_z_, prev_rgb_, has_mu_. Out: changed_ (1 where a pixel that held
+// In: the cloud, prev_z_, prev_rgb_, has_mu_. Out: s_->changed (1 where a pixel that held
 // weights now sees another surface: an object arrived, left or moved over it), prev_z_ and
 // prev_rgb_ set to this frame. Returns true on a scene cut: most surfaces moved at once.
 // Cost: one pass over N pixels, no allocation.
@@ -185,7 +210,7 @@ bool ObjectTracker::mark_surface_changes(const OrganizedCloud& cloud) {
     const std::uint8_t* const has_mu = has_mu_.data();
     float* const prev_z = prev_z_.data();
     std::uint8_t* const prev_rgb = prev_rgb_.data();
-    std::uint8_t* const changed = changed_.data();
+    std::uint8_t* const changed = s_->changed.data();
     const auto Nn = static_cast<std::ptrdiff_t>(N);
 #pragma omp parallel for schedule(static) reduction(+ : both, moved, held, held_moved)
     for (std::ptrdiff_t i = 0; i < Nn; ++i) {
@@ -224,14 +249,14 @@ bool ObjectTracker::mark_surface_changes(const OrganizedCloud& cloud) {
 void ObjectTracker::start_afresh() {
     std::fill(mu_.begin(), mu_.end(), PixelWeights{});
     std::fill(has_mu_.begin(), has_mu_.end(), 0);
-    std::fill(changed_.begin(), changed_.end(), 0);
+    std::fill(s_->changed.begin(), s_->changed.end(), 0);
     tracks_.assign(static_cast<std::size_t>(params_.max_tracks), Track{});
     ++scene_cuts_;
 }
 
-// In: segments, the cloud, mu_. Out: votes_ ((S+1) x K: each segment's sum of its pixels'
+// In: segments, the cloud, mu_. Out: s_->votes ((S+1) x K: each segment's sum of its pixels'
 // weights per slot, i.e. its overlap with the previous frames' objects as the paper's
-// weights remember them) and seg_sums_ ((S+1) x kSegSums: pixel count and x, y, z sums).
+// weights remember them) and s_->seg_sums ((S+1) x kSegSums: pixel count and x, y, z sums).
 // Votes are summed in integer units of the weights: exact in any order.
 // Cost: one pass over N pixels (6 weights each), then O(B x S x K); allocates only when S
 // grows.
@@ -240,12 +265,12 @@ void ObjectTracker::measure_segments(const OrganizedCloud& cloud, const LabelIma
     const int W = cloud.width, H = cloud.height;
     const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
     const std::size_t S1 = static_cast<std::size_t>(n_segments + 1);
-    band_votes_.assign(kBands * S1 * Kz, 0);
-    band_seg_sums_.assign(kBands * S1 * kSegSums, 0.0);
+    s_->band_votes.assign(kBands * S1 * Kz, 0);
+    s_->band_seg_sums.assign(kBands * S1 * kSegSums, 0.0);
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kBands; ++band) {
-        std::uint64_t* const votes = band_votes_.data() + static_cast<std::size_t>(band) * S1 * Kz;
-        double* const sums = band_seg_sums_.data() + static_cast<std::size_t>(band) * S1 * kSegSums;
+        std::uint64_t* const votes = s_->band_votes.data() + static_cast<std::size_t>(band) * S1 * Kz;
+        double* const sums = s_->band_seg_sums.data() + static_cast<std::size_t>(band) * S1 * kSegSums;
         const std::size_t p0 = static_cast<std::size_t>(H * band / kBands) * W;
         const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kBands) * W;
         for (std::size_t p = p0; p < p1; ++p) {
@@ -262,19 +287,19 @@ void ObjectTracker::measure_segments(const OrganizedCloud& cloud, const LabelIma
             for (int q = 0; q < PixelWeights::kSlots; ++q) vs[w.cluster[q]] += w.mu[q];
         }
     }
-    votes_.assign(S1 * Kz, 0.0);
-    seg_sums_.assign(S1 * kSegSums, 0.0);
+    s_->votes.assign(S1 * Kz, 0.0);
+    s_->seg_sums.assign(S1 * kSegSums, 0.0);
     for (int band = 0; band < kBands; ++band) {
-        const std::uint64_t* votes = band_votes_.data() + static_cast<std::size_t>(band) * S1 * Kz;
-        const double* sums = band_seg_sums_.data() + static_cast<std::size_t>(band) * S1 * kSegSums;
-        for (std::size_t i = 0; i < S1 * Kz; ++i) votes_[i] += static_cast<double>(votes[i]);
-        for (std::size_t i = 0; i < S1 * kSegSums; ++i) seg_sums_[i] += sums[i];
+        const std::uint64_t* votes = s_->band_votes.data() + static_cast<std::size_t>(band) * S1 * Kz;
+        const double* sums = s_->band_seg_sums.data() + static_cast<std::size_t>(band) * S1 * kSegSums;
+        for (std::size_t i = 0; i < S1 * Kz; ++i) s_->votes[i] += static_cast<double>(votes[i]);
+        for (std::size_t i = 0; i < S1 * kSegSums; ++i) s_->seg_sums[i] += sums[i];
     }
-    for (double& v : votes_) v /= static_cast<double>(PixelWeights::kOne);
+    for (double& v : s_->votes) v /= static_cast<double>(PixelWeights::kOne);
 }
 
-// In: votes_, seg_sums_, tracks_. Out: seg_slot_ (S+1: the slot each segment continues,
-// -1 none yet) and slot_taken_ (K). A segment and a live track pair when the votes cover
+// In: s_->votes, s_->seg_sums, tracks_. Out: s_->seg_slot (S+1: the slot each segment continues,
+// -1 none yet) and s_->slot_taken (K). A segment and a live track pair when the votes cover
 // min_overlap of the smaller; pairs are taken greedily, one to one, largest vote first
 // (ties: smaller segment, then smaller slot).
 // Cost: O(S x K log(S x K)); allocates the list of pairs.
@@ -289,25 +314,25 @@ void ObjectTracker::match_by_overlap(int n_segments) {
     for (int s = 1; s <= S; ++s)
         for (int j = 0; j < K; ++j) {
             const Track& t = tracks_[static_cast<std::size_t>(j)];
-            const double v = votes_[static_cast<std::size_t>(s) * Kz + static_cast<std::size_t>(j)];
+            const double v = s_->votes[static_cast<std::size_t>(s) * Kz + static_cast<std::size_t>(j)];
             if (t.id == 0 || v <= 0) continue;
-            const double size = seg_sums_[static_cast<std::size_t>(s) * kSegSums];
+            const double size = s_->seg_sums[static_cast<std::size_t>(s) * kSegSums];
             if (v >= params_.min_overlap * std::min(size, static_cast<double>(t.pixels)))
                 pairs.push_back({v, s, j});
         }
     std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
         return a.vote != b.vote ? a.vote > b.vote : (a.s != b.s ? a.s < b.s : a.j < b.j);
     });
-    seg_slot_.assign(static_cast<std::size_t>(S + 1), -1);
-    slot_taken_.assign(Kz, 0);
+    s_->seg_slot.assign(static_cast<std::size_t>(S + 1), -1);
+    s_->slot_taken.assign(Kz, 0);
     for (const Pair& pr : pairs) {
-        if (seg_slot_[static_cast<std::size_t>(pr.s)] >= 0 || slot_taken_[static_cast<std::size_t>(pr.j)]) continue;
-        seg_slot_[static_cast<std::size_t>(pr.s)] = pr.j;
-        slot_taken_[static_cast<std::size_t>(pr.j)] = 1;
+        if (s_->seg_slot[static_cast<std::size_t>(pr.s)] >= 0 || s_->slot_taken[static_cast<std::size_t>(pr.j)]) continue;
+        s_->seg_slot[static_cast<std::size_t>(pr.s)] = pr.j;
+        s_->slot_taken[static_cast<std::size_t>(pr.j)] = 1;
     }
 }
 
-// In and out: seg_slot_, slot_taken_, tracks_. Each segment left over, in order, takes the
+// In and out: s_->seg_slot, s_->slot_taken, tracks_. Each segment left over, in order, takes the
 // nearest untaken track within max_jump_m of its centroid and of a similar size (an object
 // that moved faster than its overlap), else a new track id in a free slot, else in the
 // slot lost longest (whose weights are forgotten); with no slot left it is dropped.
@@ -315,14 +340,14 @@ void ObjectTracker::match_by_overlap(int n_segments) {
 void ObjectTracker::match_by_distance_or_start(int n_segments) {
     const int S = n_segments, K = params_.max_tracks;
     for (int s = 1; s <= S; ++s) {
-        if (seg_slot_[static_cast<std::size_t>(s)] >= 0) continue;
-        const double* ss = seg_sums_.data() + static_cast<std::size_t>(s) * kSegSums;
+        if (s_->seg_slot[static_cast<std::size_t>(s)] >= 0) continue;
+        const double* ss = s_->seg_sums.data() + static_cast<std::size_t>(s) * kSegSums;
         const double cx = ss[1] / ss[0], cy = ss[2] / ss[0], cz = ss[3] / ss[0];
         int best = -1;
         double best_d = params_.max_jump_m;
         for (int j = 0; j < K; ++j) {
             const Track& t = tracks_[static_cast<std::size_t>(j)];
-            if (t.id == 0 || slot_taken_[static_cast<std::size_t>(j)]) continue;
+            if (t.id == 0 || s_->slot_taken[static_cast<std::size_t>(j)]) continue;
             const double ratio = ss[0] / std::max<double>(1.0, static_cast<double>(t.pixels));
             if (ratio < 0.33 || ratio > 3.0) continue;
             const double d = std::sqrt((cx - t.x) * (cx - t.x) + (cy - t.y) * (cy - t.y) + (cz - t.z) * (cz - t.z));
@@ -337,7 +362,7 @@ void ObjectTracker::match_by_distance_or_start(int n_segments) {
                 if (tracks_[static_cast<std::size_t>(j)].id == 0) best = j;
             if (best < 0) {
                 for (int j = 0; j < K; ++j) {
-                    if (slot_taken_[static_cast<std::size_t>(j)]) continue;
+                    if (s_->slot_taken[static_cast<std::size_t>(j)]) continue;
                     const Track& t = tracks_[static_cast<std::size_t>(j)];
                     if (best < 0 || t.lost > tracks_[static_cast<std::size_t>(best)].lost ||
                         (t.lost == tracks_[static_cast<std::size_t>(best)].lost &&
@@ -349,27 +374,27 @@ void ObjectTracker::match_by_distance_or_start(int n_segments) {
             }
             tracks_[static_cast<std::size_t>(best)].id = next_id_++;
         }
-        seg_slot_[static_cast<std::size_t>(s)] = best;
-        slot_taken_[static_cast<std::size_t>(best)] = 1;
+        s_->seg_slot[static_cast<std::size_t>(s)] = best;
+        s_->slot_taken[static_cast<std::size_t>(best)] = 1;
     }
 }
 
-// The paper's weights on objects. In: segments, seg_slot_, slot_taken_, changed_, the
+// The paper's weights on objects. In: segments, s_->seg_slot, s_->slot_taken, s_->changed, the
 // cloud's validity. Out: mu_ and has_mu_ (each segment pixel adds psi to its slot's weight:
 // eq. 2, 7, 8, the same update_weights as the clusters; a changed pixel forgets first; a
-// pixel with depth outside every segment forgets), slot_of_ (arg-max slot + 1 among the
+// pixel with depth outside every segment forgets), s_->slot_of (arg-max slot + 1 among the
 // slots taken this frame, 0 none).
 // Cost: one pass over N pixels, no allocation.
 void ObjectTracker::weigh_pixels(const OrganizedCloud& cloud, const LabelImage& segments) {
     const std::size_t N = cloud.size();
     // Raw pointers, as in mark_surface_changes.
     const std::uint16_t* const seg = segments.labels.data();
-    const int* const seg_slot = seg_slot_.data();
-    const std::uint8_t* const taken = slot_taken_.data();
+    const int* const seg_slot = s_->seg_slot.data();
+    const std::uint8_t* const taken = s_->slot_taken.data();
     const std::uint8_t* const valid = cloud.valid.data();
-    std::uint8_t* const changed = changed_.data();
+    std::uint8_t* const changed = s_->changed.data();
     std::uint8_t* const has_mu = has_mu_.data();
-    std::uint8_t* const slot_of = slot_of_.data();
+    std::uint8_t* const slot_of = s_->slot_of.data();
     PixelWeights* const mu = mu_.data();
     const float psi = params_.psi;
     const auto Nn = static_cast<std::ptrdiff_t>(N);
@@ -408,18 +433,18 @@ void ObjectTracker::weigh_pixels(const OrganizedCloud& cloud, const LabelImage& 
     }
 }
 
-// In: slot_of_, the cloud. Out: obj_sums_ (K x kObjSums: point moments and colour sums per
-// slot) and obj_boxes_ (K x 4: u_min, v_min, u_max, v_max; W, H, -1, -1 where empty).
+// In: s_->slot_of, the cloud. Out: s_->obj_sums (K x kObjSums: point moments and colour sums per
+// slot) and s_->obj_boxes (K x 4: u_min, v_min, u_max, v_max; W, H, -1, -1 where empty).
 // Cost: one pass over N pixels, then O(B x K); no allocation after the first frame.
 void ObjectTracker::sum_objects(const OrganizedCloud& cloud) {
     const int W = cloud.width, H = cloud.height;
     const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
-    band_obj_sums_.assign(kBands * Kz * kObjSums, 0.0);
-    band_boxes_.assign(kBands * Kz * 4, 0);
+    s_->band_obj_sums.assign(kBands * Kz * kObjSums, 0.0);
+    s_->band_boxes.assign(kBands * Kz * 4, 0);
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kBands; ++band) {
-        double* const sums = band_obj_sums_.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
-        int* const boxes = band_boxes_.data() + static_cast<std::size_t>(band) * Kz * 4;
+        double* const sums = s_->band_obj_sums.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
+        int* const boxes = s_->band_boxes.data() + static_cast<std::size_t>(band) * Kz * 4;
         for (std::size_t j = 0; j < Kz; ++j) {
             boxes[4 * j] = W;  // umin, vmin, umax, vmax
             boxes[4 * j + 1] = H;
@@ -428,8 +453,8 @@ void ObjectTracker::sum_objects(const OrganizedCloud& cloud) {
         for (int v = H * band / kBands; v < H * (band + 1) / kBands; ++v)
             for (int u = 0; u < W; ++u) {
                 const std::size_t p = static_cast<std::size_t>(v) * W + u;
-                if (!slot_of_[p]) continue;
-                const std::size_t j = slot_of_[p] - 1u;
+                if (!s_->slot_of[p]) continue;
+                const std::size_t j = s_->slot_of[p] - 1u;
                 double* o = sums + j * kObjSums;
                 detail::add_moments(o, cloud.x[p], cloud.y[p], cloud.z[p]);
                 o[10] += cloud.r[p]; o[11] += cloud.g[p]; o[12] += cloud.b[p];
@@ -438,38 +463,38 @@ void ObjectTracker::sum_objects(const OrganizedCloud& cloud) {
                 box[1] = std::min(box[1], v); box[3] = std::max(box[3], v);
             }
     }
-    obj_sums_.assign(Kz * kObjSums, 0.0);
-    obj_boxes_.resize(Kz * 4);
+    s_->obj_sums.assign(Kz * kObjSums, 0.0);
+    s_->obj_boxes.resize(Kz * 4);
     for (std::size_t j = 0; j < Kz; ++j) {
-        obj_boxes_[4 * j] = W;
-        obj_boxes_[4 * j + 1] = H;
-        obj_boxes_[4 * j + 2] = obj_boxes_[4 * j + 3] = -1;
+        s_->obj_boxes[4 * j] = W;
+        s_->obj_boxes[4 * j + 1] = H;
+        s_->obj_boxes[4 * j + 2] = s_->obj_boxes[4 * j + 3] = -1;
     }
     for (int band = 0; band < kBands; ++band) {
-        const double* sums = band_obj_sums_.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
-        const int* boxes = band_boxes_.data() + static_cast<std::size_t>(band) * Kz * 4;
-        for (std::size_t i = 0; i < Kz * kObjSums; ++i) obj_sums_[i] += sums[i];
+        const double* sums = s_->band_obj_sums.data() + static_cast<std::size_t>(band) * Kz * kObjSums;
+        const int* boxes = s_->band_boxes.data() + static_cast<std::size_t>(band) * Kz * 4;
+        for (std::size_t i = 0; i < Kz * kObjSums; ++i) s_->obj_sums[i] += sums[i];
         for (std::size_t i = 0; i < Kz * 4; i += 4) {
-            obj_boxes_[i] = std::min(obj_boxes_[i], boxes[i]);
-            obj_boxes_[i + 1] = std::min(obj_boxes_[i + 1], boxes[i + 1]);
-            obj_boxes_[i + 2] = std::max(obj_boxes_[i + 2], boxes[i + 2]);
-            obj_boxes_[i + 3] = std::max(obj_boxes_[i + 3], boxes[i + 3]);
+            s_->obj_boxes[i] = std::min(s_->obj_boxes[i], boxes[i]);
+            s_->obj_boxes[i + 1] = std::min(s_->obj_boxes[i + 1], boxes[i + 1]);
+            s_->obj_boxes[i + 2] = std::max(s_->obj_boxes[i + 2], boxes[i + 2]);
+            s_->obj_boxes[i + 3] = std::max(s_->obj_boxes[i + 3], boxes[i + 3]);
         }
     }
 }
 
-// In: obj_sums_, obj_boxes_, tracks_. Out: `out`, one object per live slot with at least
+// In: s_->obj_sums, s_->obj_boxes, tracks_. Out: `out`, one object per live slot with at least
 // min_points pixels (smaller ones are dropped: their pixels become background), in slot
 // order: id, pixels, centroid, OBB axes (largest spread first), 2D box, mean colour; and
-// object_of_slot_ (K: its index in `out`, -1 none).
+// s_->object_of_slot (K: its index in `out`, -1 none).
 // Cost: O(K) and a 3x3 eigen-decomposition per object; allocates the objects.
 void ObjectTracker::describe_objects(std::vector<DetectedObject>& out) {
     const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
     out.clear();
-    object_of_slot_.assign(Kz, -1);
+    s_->object_of_slot.assign(Kz, -1);
     for (std::size_t j = 0; j < Kz; ++j) {
-        if (!(obj_sums_[j * kObjSums] >= params_.min_points && tracks_[j].id != 0)) continue;
-        const double* o = obj_sums_.data() + j * kObjSums;
+        if (!(s_->obj_sums[j * kObjSums] >= params_.min_points && tracks_[j].id != 0)) continue;
+        const double* o = s_->obj_sums.data() + j * kObjSums;
         const double n = o[0];
         DetectedObject d;
         d.track_id = d.id = tracks_[j].id;
@@ -483,15 +508,15 @@ void ObjectTracker::describe_objects(std::vector<DetectedObject>& out) {
             for (int b = 0; b < 3; ++b)
                 d.obb_axes[static_cast<std::size_t>(3 * a + b)] =
                     static_cast<float>(eig.eigenvectors()(b, 2 - a));  // largest spread first
-        const int* box = obj_boxes_.data() + 4 * j;
+        const int* box = s_->obj_boxes.data() + 4 * j;
         d.u_min = box[0]; d.u_max = box[2]; d.v_min = box[1]; d.v_max = box[3];
         d.mean_rgb = {static_cast<float>(o[10] / n), static_cast<float>(o[11] / n), static_cast<float>(o[12] / n)};
-        object_of_slot_[j] = static_cast<int>(out.size());
+        s_->object_of_slot[j] = static_cast<int>(out.size());
         out.push_back(std::move(d));
     }
 }
 
-// In: slot_of_, object_of_slot_, `out`, the cloud, segments, clusters. Out: `objects` (the
+// In: s_->slot_of, s_->object_of_slot, `out`, the cloud, segments, clusters. Out: `objects` (the
 // label image: track id, 0 background) and, per band of rows and object, the extents
 // (axis-aligned and along the OBB axes), the pixels per cluster and the segments seen.
 // Returns C + 1, the range of cluster labels counted.
@@ -511,22 +536,22 @@ std::size_t ObjectTracker::write_labels_and_extents(const OrganizedCloud& cloud,
 #pragma omp parallel for schedule(static) reduction(max : max_cluster)
     for (std::ptrdiff_t p = 0; p < Nc; ++p) max_cluster = std::max<int>(max_cluster, clusters.labels[static_cast<std::size_t>(p)]);
     const std::size_t C1 = static_cast<std::size_t>(max_cluster) + 1;
-    band_extents_.assign(kBands * O * kExt, 0.0f);
-    band_cluster_count_.assign(kBands * O * C1, 0);
-    band_segment_seen_.assign(kBands * O * S1, 0);
+    s_->band_extents.assign(kBands * O * kExt, 0.0f);
+    s_->band_cluster_count.assign(kBands * O * C1, 0);
+    s_->band_segment_seen.assign(kBands * O * S1, 0);
     // Raw pointers, as in mark_surface_changes: the byte stores (labels' high bytes aside,
     // `seen`) would make the compiler reload every vector's data pointer on each pixel.
-    const std::uint8_t* const slot_of = slot_of_.data();
-    const int* const object_of_slot = object_of_slot_.data();
+    const std::uint8_t* const slot_of = s_->slot_of.data();
+    const int* const object_of_slot = s_->object_of_slot.data();
     std::uint16_t* const labels_out = objects.labels.data();
     const float *const cx = cloud.x.data(), *const cy = cloud.y.data(), *const cz = cloud.z.data();
     const std::uint16_t* const cluster_of = clusters.labels.empty() ? nullptr : clusters.labels.data();
     const std::uint16_t* const segment_of = segments.labels.data();
 #pragma omp parallel for schedule(static)
     for (int band = 0; band < kBands; ++band) {
-        float* const ext = band_extents_.data() + static_cast<std::size_t>(band) * O * kExt;
-        int* const ccount = band_cluster_count_.data() + static_cast<std::size_t>(band) * O * C1;
-        std::uint8_t* const seen = band_segment_seen_.data() + static_cast<std::size_t>(band) * O * S1;
+        float* const ext = s_->band_extents.data() + static_cast<std::size_t>(band) * O * kExt;
+        int* const ccount = s_->band_cluster_count.data() + static_cast<std::size_t>(band) * O * C1;
+        std::uint8_t* const seen = s_->band_segment_seen.data() + static_cast<std::size_t>(band) * O * S1;
         for (std::size_t i = 0; i < O; ++i)
             for (int a = 0; a < 6; ++a) {
                 ext[i * kExt + static_cast<std::size_t>(a)] = INFINITY;
@@ -576,7 +601,7 @@ void ObjectTracker::finish_objects(int n_segments, std::size_t n_cluster_labels,
             e[a + 6] = -INFINITY;
         }
         for (int band = 0; band < kBands; ++band) {
-            const float* be = band_extents_.data() + (static_cast<std::size_t>(band) * O + i) * kExt;
+            const float* be = s_->band_extents.data() + (static_cast<std::size_t>(band) * O + i) * kExt;
             for (int a = 0; a < 6; ++a) {
                 e[a] = std::min(e[a], be[a]);
                 e[a + 6] = std::max(e[a + 6], be[a + 6]);
@@ -595,20 +620,20 @@ void ObjectTracker::finish_objects(int n_segments, std::size_t n_cluster_labels,
         for (std::size_t l = 1; l < C1; ++l) {
             int cnt = 0;
             for (int band = 0; band < kBands; ++band)
-                cnt += band_cluster_count_[(static_cast<std::size_t>(band) * O + i) * C1 + l];
+                cnt += s_->band_cluster_count[(static_cast<std::size_t>(band) * O + i) * C1 + l];
             if (cnt > 0 && static_cast<double>(cnt) >= 0.05 * static_cast<double>(d.pixels))
                 d.source_clusters.push_back(static_cast<int>(l));
         }
         for (std::size_t sgm = 1; sgm < S1; ++sgm)
             for (int band = 0; band < kBands; ++band)
-                if (band_segment_seen_[(static_cast<std::size_t>(band) * O + i) * S1 + sgm]) {
+                if (s_->band_segment_seen[(static_cast<std::size_t>(band) * O + i) * S1 + sgm]) {
                     d.source_segments.push_back(static_cast<int>(sgm));
                     break;
                 }
     }
 }
 
-// In: obj_sums_. Out: tracks_: a slot with pixels this frame remembers its size and
+// In: s_->obj_sums. Out: tracks_: a slot with pixels this frame remembers its size and
 // centroid; one without counts a frame lost, and is retired (weights forgotten) after
 // max_lost_frames.
 // Cost: O(K), and O(N) per slot retired; no allocation.
@@ -617,7 +642,7 @@ void ObjectTracker::follow_tracks() {
     for (std::size_t j = 0; j < Kz; ++j) {
         Track& t = tracks_[j];
         if (t.id == 0) continue;
-        const double* o = obj_sums_.data() + j * kObjSums;
+        const double* o = s_->obj_sums.data() + j * kObjSums;
         if (o[0] > 0) {
             t.lost = 0;
             t.pixels = static_cast<std::size_t>(o[0]);

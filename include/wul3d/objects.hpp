@@ -9,6 +9,7 @@
 /// clusters (labels.png) or objects (objects.png) alike.
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "wul3d/cloud.hpp"
@@ -68,6 +69,9 @@ struct DetectedObject {
 class ObjectTracker {
 public:
     explicit ObjectTracker(const ObjectParams& params);  ///< validates params
+    ~ObjectTracker();
+    ObjectTracker(ObjectTracker&&) noexcept;
+    ObjectTracker& operator=(ObjectTracker&&) noexcept;
 
     /// `segments`: 0 background, 1..n (segment_objects). `clusters` may be empty. Writes
     /// `objects` (0 background, else track id) and one DetectedObject per track present.
@@ -121,22 +125,10 @@ private:
     std::vector<float> prev_z_;           ///< last frame's depth (0 = none), for scene cuts
     std::vector<std::uint8_t> prev_rgb_;  ///< last frame's colour, 3 bytes a pixel
 
-    // This frame's results, passed from phase to phase; members, reused from frame to frame.
-    // S segments, K = max_tracks slots.
-    std::vector<std::uint8_t> changed_;      ///< per pixel, 1 where its surface changed
-    std::vector<double> votes_, seg_sums_;   ///< per segment: weight mass per slot; count, x, y, z
-    std::vector<int> seg_slot_;              ///< per segment, its slot (-1: none)
-    std::vector<std::uint8_t> slot_taken_;   ///< per slot, 1 where a segment took it
-    std::vector<std::uint8_t> slot_of_;      ///< per pixel, its arg-max slot + 1, 0 none
-    std::vector<double> obj_sums_;           ///< per slot, point moments and colour sums
-    std::vector<int> obj_boxes_;             ///< per slot, u_min, v_min, u_max, v_max
-    std::vector<int> object_of_slot_;        ///< per slot, its index in step's `out` (-1: none)
-    // Per band of rows (objects.cpp, kBands), reduced in band order:
-    std::vector<std::uint64_t> band_votes_;
-    std::vector<double> band_seg_sums_, band_obj_sums_;
-    std::vector<int> band_boxes_, band_cluster_count_;
-    std::vector<float> band_extents_;
-    std::vector<std::uint8_t> band_segment_seen_;
+    // This frame's results, passed from phase to phase, reused from frame to frame
+    // (objects.cpp).
+    struct Scratch;
+    std::unique_ptr<Scratch> s_;
 };
 
 /// Follows one user-picked object through the labels of successive frames.
