@@ -326,158 +326,215 @@ private:
 
 }  // namespace
 
-RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
-    RunObserver silent;
-    RunObserver& obs = observer ? *observer : silent;
-    FeedOptions feed_options = o.feed;
-    feed_options.read_ahead = 2;  // the next frames decode while this one is processed
-    FrameFeed feed(feed_options, o.stop);
-    check_out_apart_from_inputs(o);
-    if (!feed.live()) {
-        // Every name before the first frame: a run must not fail at frame 50,000 for it.
-        for (std::size_t i = 0; i < feed.size(); ++i) check_frame_name(feed.source()->name(i));
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// One run of run_sequence: the feed, the pipeline and the writers behind it, and the
+/// phases in order (open, then step until the end, drain, finish). Its members live as long
+/// as the run; the writers stop (and join) before what they write from goes.
+class RunLoop {
+public:
+    RunLoop(const RunOptions& o, RunObserver& obs)
+        : o_(o), obs_(obs), feed_(feed_options(o), o.stop), n_total_(open_out_dir()),
+          lock_(o.out_dir), pipeline_(o.params), selection_(o.select) {
+        remove_stale_temporaries(o.out_dir);  // of a run killed mid-write (SIGKILL, power)
     }
-    // A recording has a known length; a camera runs until max_frames, a stop or its end.
-    const std::size_t n_total =
-        feed.live() ? o.max_frames
-                    : (o.max_frames ? std::min(o.max_frames, feed.size()) : feed.size());
-    prepare_out_dir(o.out_dir, o.overwrite);
-    const OutputLock lock(o.out_dir);  // one writer at a time: frames.jsonl would interleave
-    remove_stale_temporaries(o.out_dir);  // of a run killed mid-write (SIGKILL, power)
-    const fs::path out_dir(o.out_dir);
 
-    Pipeline pipeline(o.params);
-    Selection selection(o.select);
-    SourceItem item;
-    StageLog log;
-    bool said_depth_only = false;
-    using Clock = std::chrono::steady_clock;
-    const auto run_start = Clock::now();
-    obs.started(n_total);  // may refuse the run (a video writer that cannot start)
-    FramesLog frames_log((out_dir / kFramesFile).string());
+    /// Runs every frame, then writes summary.json; rethrows the error that ended the run.
+    RunSummary run() {
+        obs_.started(n_total_);  // may refuse the run (a video writer that cannot start)
+        FramesLog frames_log((out_dir() / kFramesFile).string());
+        frames_log_ = &frames_log;
+        const ScopedTeam stages_team(threads_.stages);
+        detail::WriteBehind<PendingFrame> writes(
+            static_cast<std::size_t>(threads_.writers) + 2, threads_.writers,
+            [this](PendingFrame& p) { write(p); });
+        writes_ = &writes;
+        try {
+            while (step()) {}
+            while (commit(true)) {}
+        } catch (const std::exception& e) {
+            fail(e);
+            // The frames processed before a bad input frame are still written and listed;
+            // after a failed write, none is listed past it.
+            try {
+                while (!write_failed_ && commit(true)) {}
+            } catch (const std::exception&) {
+            }
+        }
+        try {
+            obs_.frames_done();  // e.g. a video that cannot be finished: an error like a frame's
+        } catch (const std::exception& e) {
+            if (!failed_) fail(e);
+        }
+        return finish();
+    }
 
-    RunSummary s;
-    const RunThreads threads = run_threads();
-    const ScopedTeam stages_team(threads.stages);
-    detail::WriteBehind<PendingFrame> writes(
-        static_cast<std::size_t>(threads.writers) + 2, threads.writers, [&o](PendingFrame& p) {
-            omp_set_num_threads(1);  // a writer's overlay is one thread's work among several
-            const auto t0 = Clock::now();
-            write_frame(o.out_dir, p.name, p.has_cloud ? &p.cloud : nullptr, p.frame(), p.result,
-                        p.outputs);
-            p.output_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-        });
-    // The oldest frame in flight, once written: its line in frames.jsonl, the observer, the
-    // count, on this thread and in frame order. False when none is (or, without `wait`, not
-    // yet). Rethrows its write's error.
-    bool write_failed = false;
-    auto commit = [&](bool wait) {
+private:
+    static FeedOptions feed_options(const RunOptions& o) {
+        FeedOptions f = o.feed;
+        f.read_ahead = 2;  // the next frames decode while this one is processed
+        return f;
+    }
+    fs::path out_dir() const { return fs::path(o_.out_dir); }
+
+    /// OUT checked against the inputs and every frame's name, then made ready; returns the
+    /// frames to run (a recording's length, or max_frames; 0 = until the camera ends).
+    std::size_t open_out_dir() {
+        check_out_apart_from_inputs(o_);
+        if (!feed_.live()) {
+            // Every name before the first frame: a run must not fail at frame 50,000 for it.
+            for (std::size_t i = 0; i < feed_.size(); ++i) check_frame_name(feed_.source()->name(i));
+        }
+        const std::size_t n = feed_.live() ? o_.max_frames
+                                           : (o_.max_frames ? std::min(o_.max_frames, feed_.size())
+                                                            : feed_.size());
+        prepare_out_dir(o_.out_dir, o_.overwrite);
+        return n;
+    }
+
+    /// A writer thread's job: one frame's folder.
+    void write(PendingFrame& p) const {
+        omp_set_num_threads(1);  // a writer's overlay is one thread's work among several
+        const auto t0 = Clock::now();
+        write_frame(o_.out_dir, p.name, p.has_cloud ? &p.cloud : nullptr, p.frame(), p.result,
+                    p.outputs);
+        p.output_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    }
+
+    /// The oldest frame in flight, once written: its line in frames.jsonl, the observer, the
+    /// count, on this thread and in frame order. False when none is (or, without `wait`, not
+    /// yet). Rethrows its write's error.
+    bool commit(bool wait) {
         std::exception_ptr error;
-        const PendingFrame* p = writes.oldest(wait, error);
+        const PendingFrame* p = writes_->oldest(wait, error);
         if (!p) return false;
-        writes.release();  // safe to read *p below: only next() refills a slot, on this thread
+        writes_->release();  // safe to read *p below: only next() refills a slot, on this thread
         if (error) {
-            write_failed = true;
+            write_failed_ = true;
             std::rethrow_exception(error);
         }
-        log.add(p->result.times, p->output_ms);
-        frames_log.append(p->line);
-        const double fps = 1000.0 / std::max(1e-9, log.compute_ms.median());
-        obs.frame(RunFrame{p->name, s.frames, n_total, p->frame(), p->result, p->outputs.selected,
-                           p->outputs.selected_id, fps});
-        ++s.frames;
+        log_.add(p->result.times, p->output_ms);
+        frames_log_->append(p->line);
+        const double fps = 1000.0 / std::max(1e-9, log_.compute_ms.median());
+        obs_.frame(RunFrame{p->name, s_.frames, n_total_, p->frame(), p->result,
+                            p->outputs.selected, p->outputs.selected_id, fps});
+        ++s_.frames;
         return true;
-    };
+    }
 
-    std::size_t taken = 0;      // frames processed and handed to the writers
-    std::exception_ptr lost;    // DeviceLost: rethrown once the outputs are final
-    std::exception_ptr failed;  // any other error: rethrown once summary.json is written
-    try {
-        for (;;) {
-            while (commit(false)) {}
-            if (n_total && taken >= n_total) {
-                s.stopped_by = feed.live() || n_total < feed.size() ? "frames" : "end";
-                break;
-            }
-            if (writes.full()) {
-                commit(true);
-                continue;
-            }
-            if (!feed.next_frame(item, s.stopped_by, lost)) break;
-            const std::string name = feed.name();
-            if (feed.live()) check_frame_name(name);
-            const FrameResult* result = nullptr;
+    /// One turn of the loop: commit what is written, then read and process the next frame and
+    /// hand it to the writers. False at the end (all frames, a stop, the feed's end).
+    bool step() {
+        while (commit(false)) {}
+        if (n_total_ && taken_ >= n_total_) {
+            s_.stopped_by = feed_.live() || n_total_ < feed_.size() ? "frames" : "end";
+            return false;
+        }
+        if (writes_->full()) {
+            commit(true);
+            return true;
+        }
+        if (!feed_.next_frame(item_, s_.stopped_by, lost_)) return false;
+        const std::string name = feed_.name();
+        if (feed_.live()) check_frame_name(name);
+        const FrameResult* result = process(name);
+        if (!result) {  // SIGINT/SIGTERM mid-frame: this frame is not written
+            s_.stopped_by = "signal";
+            return false;
+        }
+        const RgbdFrame& frame = item_.is_raw ? pipeline_.registered() : item_.frame;
+        if (!frame.has_color() && !said_depth_only_) {
+            obs_.note(name + " has no colour image; clustering on position and normals only");
+            said_depth_only_ = true;
+        }
+        selection_.update(*result);
+        take_frame(writes_->next(), name, item_, pipeline_, *result, selection_, o_);
+        writes_->submit();
+        ++taken_;
+        return true;
+    }
+
+    /// The pipeline on the frame read; nullptr when a stop request ended it mid-frame. An
+    /// InputError names its frame ("image_0003: k = 7 is larger...").
+    const FrameResult* process(const std::string& name) {
+        try {
+            return item_.is_raw ? &pipeline_.process(item_.raw, *feed_.calibration(),
+                                                     o_.feed.source.registration)
+                                : &pipeline_.process(item_.frame);
+        } catch (const Stopped&) {
+            return nullptr;
+        } catch (const InputError& e) {
+            const std::string what = e.what();
+            if (what.rfind(name + ": ", 0) == 0) throw;
+            throw InputError(name + ": " + what);
+        }
+    }
+
+    /// A bad frame, a full disk: the frames before it are complete, and summary.json says
+    /// what ended the run.
+    void fail(const std::exception& e) {
+        failed_ = std::current_exception();
+        s_.stopped_by = "error";
+        s_.error = e.what();
+    }
+
+    /// The summary's figures, summary.json, then the error that ended the run if any.
+    RunSummary finish() {
+        s_.ms_per_frame_median = log_.compute_ms.median();
+        s_.fps = s_.ms_per_frame_median > 0 ? 1000.0 / s_.ms_per_frame_median : 0.0;
+        s_.peak_rss_mb = peak_rss_mb();
+        s_.wall_s = std::chrono::duration<double>(Clock::now() - start_).count();
+        s_.end_to_end_fps = s_.wall_s > 0 ? static_cast<double>(s_.frames) / s_.wall_s : 0.0;
+        if (lost_) {
             try {
-                result = item.is_raw ? &pipeline.process(item.raw, *feed.calibration(),
-                                                         o.feed.source.registration)
-                                     : &pipeline.process(item.frame);
-            } catch (const Stopped&) {  // SIGINT/SIGTERM mid-frame: this frame is not written
-                s.stopped_by = "signal";
-                break;
-            } catch (const InputError& e) {  // each line names its frame ("k = 7 is larger...")
-                const std::string what = e.what();
-                if (what.rfind(name + ": ", 0) == 0) throw;
-                throw InputError(name + ": " + what);
+                std::rethrow_exception(lost_);
+            } catch (const std::exception& e) {
+                s_.error = e.what();
             }
-            const RgbdFrame& frame = item.is_raw ? pipeline.registered() : item.frame;
-            if (!frame.has_color() && !said_depth_only) {
-                obs.note(name + " has no colour image; clustering on position and normals only");
-                said_depth_only = true;
-            }
-            selection.update(*result);
-            take_frame(writes.next(), name, item, pipeline, *result, selection, o);
-            writes.submit();
-            ++taken;
         }
-        while (commit(true)) {}
-    } catch (const std::exception& e) {
-        // A bad frame, a full disk: the frames before it are complete, and summary.json says
-        // what ended the run.
-        failed = std::current_exception();
-        s.stopped_by = "error";
-        s.error = e.what();
-        // The frames processed before a bad input frame are still written and listed; after
-        // a failed write, none is listed past it.
         try {
-            while (!write_failed && commit(true)) {}
+            write_text_file((out_dir() / kSummaryFile).string(),
+                            json_text(summary_json(o_, feed_, s_, log_, selection_, threads_), 2) + "\n");
         } catch (const std::exception&) {
+            if (!failed_) throw;  // the first error is the one to report (a full disk, twice)
         }
-    }
-    try {
-        obs.frames_done();  // e.g. a video that cannot be finished: an error like a frame's
-    } catch (const std::exception& e) {
-        if (!failed) {
-            failed = std::current_exception();
-            s.stopped_by = "error";
-            s.error = e.what();
-        }
+        if (failed_) std::rethrow_exception(failed_);
+        obs_.finished(s_);
+        if (lost_) std::rethrow_exception(lost_);
+        if (feed_.live() && s_.frames == 0)
+            throw InputError(feed_.description() + ": ended before the first frame");
+        return s_;
     }
 
-    s.ms_per_frame_median = log.compute_ms.median();
-    s.fps = s.ms_per_frame_median > 0 ? 1000.0 / s.ms_per_frame_median : 0.0;
-    s.peak_rss_mb = peak_rss_mb();
-    s.wall_s = std::chrono::duration<double>(Clock::now() - run_start).count();
-    s.end_to_end_fps = s.wall_s > 0 ? static_cast<double>(s.frames) / s.wall_s : 0.0;
-    if (lost) {
-        try {
-            std::rethrow_exception(lost);
-        } catch (const std::exception& e) {
-            s.error = e.what();
-        }
-    }
-    try {
-        write_text_file((out_dir / kSummaryFile).string(),
-                        json_text(summary_json(o, feed, s, log, selection, threads), 2) + "\n");
-    } catch (const std::exception&) {
-        if (!failed) throw;  // the first error is the one to report (a full disk, twice)
-    }
-    if (failed) std::rethrow_exception(failed);
-    obs.finished(s);
+    const RunOptions& o_;
+    RunObserver& obs_;
+    FrameFeed feed_;
+    std::size_t n_total_;     // frames to run; 0 = until a live camera ends
+    const OutputLock lock_;   // one writer at a time: frames.jsonl would interleave
+    Pipeline pipeline_;
+    Selection selection_;
+    SourceItem item_;
+    StageLog log_;
+    RunSummary s_;
+    const RunThreads threads_ = run_threads();
+    const Clock::time_point start_ = Clock::now();
+    FramesLog* frames_log_ = nullptr;                      // run()'s, while it runs
+    detail::WriteBehind<PendingFrame>* writes_ = nullptr;  // run()'s, while it runs
+    bool said_depth_only_ = false;
+    bool write_failed_ = false;
+    std::size_t taken_ = 0;      // frames processed and handed to the writers
+    std::exception_ptr lost_;    // DeviceLost: rethrown once the outputs are final
+    std::exception_ptr failed_;  // any other error: rethrown once summary.json is written
+};
 
-    if (lost) std::rethrow_exception(lost);
-    if (feed.live() && s.frames == 0)
-        throw InputError(feed.description() + ": ended before the first frame");
-    return s;
+}  // namespace
+
+RunSummary run_sequence(const RunOptions& o, RunObserver* observer) {
+    RunObserver silent;
+    RunLoop loop(o, observer ? *observer : silent);
+    return loop.run();
 }
 
 }  // namespace wul3d
