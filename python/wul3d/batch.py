@@ -565,18 +565,54 @@ def _worker_name() -> str:
         return f"{socket.gethostname()}:{os.getpid()}"
 
 
+def _close_once(extension):
+    """Makes a worker extension's close() a no-op the second time. Dask 2022.12 can close a
+    worker twice when its batch ends the workers (a SIGINT or SIGTERM to the process group),
+    and its shuffle extension asserts on the second close: the worker process then dies with
+    a traceback on stderr after the batch's own one line."""
+    close = extension.close
+
+    async def close_once():
+        if not getattr(extension, "closed", False):
+            await close()
+
+    extension.close = close_once
+
+
+class _QuietWhileClosing(logging.Filter):
+    """Drops a worker's log records once it is closing: ending the workers logs Dask's and
+    tornado's shutdown races as errors, noise after the batch's own one line."""
+
+    def __init__(self, worker):
+        super().__init__()
+        self.worker = worker
+
+    def filter(self, record):
+        status = getattr(getattr(self.worker, "status", None), "name", "")
+        return status not in ("closing", "closing_gracefully", "closed", "failed")
+
+
 class IgnoreStopSignals:
     """A Dask worker plugin for the batch's local workers: they ignore SIGINT and SIGTERM.
     Ctrl-C (and a service manager's SIGTERM) reach the whole process group; the batch, not
-    each worker with a traceback, handles them, and then ends the workers itself. (A plugin,
-    not a preload: it is applied to restarted workers too.)"""
+    each worker with a traceback, handles them, and then ends the workers itself; a second close of a
+    worker is harmless (_close_once) and a closing worker logs nothing (_QuietWhileClosing). (A plugin, not a preload: it is applied to restarted
+    workers too.)"""
 
     name = "wul3d-ignore-stop-signals"
 
-    def setup(self, worker):  # noqa: ARG002
+    def setup(self, worker):
         if threading.current_thread() is threading.main_thread():
             for s in (signal.SIGINT, signal.SIGTERM):
                 signal.signal(s, signal.SIG_IGN)
+        shuffle = getattr(worker, "extensions", {}).get("shuffle")
+        if shuffle is not None and hasattr(shuffle, "close"):
+            _close_once(shuffle)
+        quiet = _QuietWhileClosing(worker)
+        loggers = [logging.getLogger(n) for n in list(logging.root.manager.loggerDict)
+                   if n.split(".")[0] in _DASK_LOGGERS] + [logging.getLogger()]
+        for handler in {h for lg in loggers for h in lg.handlers}:
+            handler.addFilter(quiet)
 
 
 def _end_local_workers(cluster):
@@ -655,9 +691,14 @@ class _Signals:
         return False
 
 
+_DASK_LOGGERS = ("distributed", "tornado", "asyncio", "bokeh")
+
+
 def _quiet_dask():
-    """No more log lines from Dask: it reports the workers being closed as errors."""
-    for name in ("distributed", "tornado", "asyncio", "bokeh"):
+    """No more log lines from Dask: it reports the workers being closed as errors. Its
+    loggers and their children that have a level of their own (tornado.application)."""
+    names = [n for n in logging.root.manager.loggerDict if n.split(".")[0] in _DASK_LOGGERS]
+    for name in (*_DASK_LOGGERS, *names):
         logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
 
