@@ -525,62 +525,54 @@ bool is_bag_file(const std::string& path) {
     return in.read(head, sizeof head) && std::memcmp(head, kMagic, sizeof head) == 0;
 }
 
-std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOptions& options) {
-    const fs::path root(path);
-    std::error_code ec;
-    const auto status = fs::status(root, ec);
-    if (!fs::exists(status)) throw InputError(path + ": no such file or directory");
-    if (options.format == InputFormat::Bag ||
-        (options.format == InputFormat::Auto && is_bag_file(path))) {
-        return open_bag(path, options);
-    }
-    if (!options.bag_topics.empty()) {
+namespace {
+
+/// A format that one file or one folder's layout says (a bag, a PCD, an OCID sequence, an
+/// OSD tree, a BOP scene, a TUM sequence), or the one `options.format` names; nullptr when
+/// none applies and the input is read as frame folders.
+std::unique_ptr<FrameSource> open_recording(const std::string& path, const fs::path& root,
+                                            const fs::file_status& status,
+                                            const SourceOptions& options) {
+    const InputFormat f = options.format;
+    const bool any = f == InputFormat::Auto;
+    if (f == InputFormat::Bag || (any && is_bag_file(path))) return open_bag(path, options);
+    if (!options.bag_topics.empty())
         throw ParamError("topics are for ROS bags, but " + path + " is no bag");
-    }
-    if (options.format == InputFormat::Pcd ||
-        (options.format == InputFormat::Auto && is_pcd_path(root))) {
+    const auto registered = [&](const char* what) {
         if (!options.calibration.empty())
             throw ParamError("a calibration is for unregistered input, but " + path +
-                             " is read as a PCD (registered)");
+                             " is read as " + what + " (registered)");
+    };
+    if (f == InputFormat::Pcd || (any && is_pcd_path(root))) {
+        registered("a PCD");
         return std::make_unique<PcdSource>(root, options.intrinsics);
     }
-    if (!fs::is_directory(status)) {
-        throw InputError(path + ": not a folder (" + kNoFramesHint + ")");
-    }
-    if (options.format == InputFormat::Ocid || options.format == InputFormat::Auto) {
+    if (!fs::is_directory(status)) throw InputError(path + ": not a folder (" + kNoFramesHint + ")");
+    if (f == InputFormat::Ocid || any) {
         std::vector<fs::path> depth = ocid_depth_files(root);
         if (!depth.empty()) return open_ocid(path, root, std::move(depth), options);
-        if (options.format == InputFormat::Ocid)
+        if (f == InputFormat::Ocid)
             throw InputError(path + ": not an OCID sequence (expected rgb/ and depth/ holding "
                                     "result_*.png)");
     }
-    if (options.format == InputFormat::Osd ||
-        (options.format == InputFormat::Auto && detail::is_osd_tree(root))) {
+    if (f == InputFormat::Osd || (any && detail::is_osd_tree(root)))
         return detail::open_osd(path, root, options);
-    }
-    if (options.format == InputFormat::Bop ||
-        (options.format == InputFormat::Auto && detail::is_bop_scene(root))) {
+    if (f == InputFormat::Bop || (any && detail::is_bop_scene(root)))
         return detail::open_bop(path, root, options);
-    }
-
-    InputFormat format = options.format;
-    if (format == InputFormat::Auto && something_at(root / "rgb.txt") && something_at(root / "depth.txt")) {
-        format = InputFormat::Tum;
-    }
-    if (format == InputFormat::Tum) {
-        if (!options.calibration.empty()) {
-            throw ParamError("a calibration is for unregistered input, but " + path +
-                             " is read as TUM RGB-D (registered)");
-        }
+    if (f == InputFormat::Tum ||
+        (any && something_at(root / "rgb.txt") && something_at(root / "depth.txt"))) {
+        registered("TUM RGB-D");
         return open_tum(path, root, options);
     }
+    return nullptr;
+}
 
-    FrameDirs dirs;
+/// The frame folders at `root`; a folder without any that holds OCID sequences or BOP
+/// scenes further down gets a line that names one (one sequence at a time).
+FrameDirs frame_dirs_or_hint(const std::string& path, const fs::path& root) {
     try {
-        dirs = find_frame_dirs(path, root);
+        return find_frame_dirs(path, root);
     } catch (const InputError&) {
-        // An OCID tree above its sequences, a BOP split or dataset above its scenes: one
-        // sequence at a time.
         const fs::path seq = find_ocid_sequence(root, 4);
         if (!seq.empty())
             throw InputError(path + ": an OCID tree; give one sequence folder (one with rgb/ "
@@ -591,8 +583,36 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
                              scene.string() + "), or run them all with python3 -m wul3d.batch");
         throw;
     }
+}
+
+/// Unregistered frame folders' calibration: the one given (a file, or kinect_v2), else the
+/// calibration.json found beside the frames.
+StereoCalibration unregistered_calibration(const std::string& path, const SourceOptions& options,
+                                           const std::optional<fs::path>& found) {
+    if (options.intrinsics)
+        throw ParamError("intrinsics cannot be given for unregistered input: the calibration "
+                         "holds both cameras");
+    if (options.calibration == "kinect_v2") return kinect_v2_default_calibration();
+    if (!options.calibration.empty()) return read_calibration_json(options.calibration);
+    if (found) return read_calibration_json(found->string());
+    throw InputError(path + ": unregistered input needs a calibration: give a calibration "
+                            "JSON file or 'kinect_v2' (--calibration), or put "
+                            "calibration.json beside the frames");
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOptions& options) {
+    const fs::path root(path);
+    std::error_code ec;
+    const auto status = fs::status(root, ec);
+    if (!fs::exists(status)) throw InputError(path + ": no such file or directory");
+    if (auto source = open_recording(path, root, status, options)) return source;
+
+    FrameDirs dirs = frame_dirs_or_hint(path, root);
     // "Beside the frames": in the folder of a sequence's frame folders; for a single frame
     // folder, in it or in its parent.
+    InputFormat format = options.format;
     std::optional<fs::path> calib_file;
     if (options.calibration.empty() && format != InputFormat::Frames) {
         if (format == InputFormat::Unregistered || dirs.single) {
@@ -605,7 +625,6 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
         format = (!options.calibration.empty() || calib_file) ? InputFormat::Unregistered
                                                               : InputFormat::Frames;
     }
-
     if (format == InputFormat::Frames) {
         if (!options.calibration.empty()) {
             throw ParamError("a calibration is for unregistered input, but " + path +
@@ -613,25 +632,8 @@ std::unique_ptr<FrameSource> open_source(const std::string& path, const SourceOp
         }
         return std::make_unique<FramesSource>(std::move(dirs), options.intrinsics);
     }
-
-    // Unregistered.
-    if (options.intrinsics) {
-        throw ParamError("intrinsics cannot be given for unregistered input: the calibration "
-                         "holds both cameras");
-    }
-    StereoCalibration calib;
-    if (options.calibration == "kinect_v2") {
-        calib = kinect_v2_default_calibration();
-    } else if (!options.calibration.empty()) {
-        calib = read_calibration_json(options.calibration);
-    } else if (calib_file) {
-        calib = read_calibration_json(calib_file->string());
-    } else {
-        throw InputError(path + ": unregistered input needs a calibration: give a calibration "
-                                "JSON file or 'kinect_v2' (--calibration), or put "
-                                "calibration.json beside the frames");
-    }
-    return std::make_unique<UnregisteredSource>(std::move(dirs), calib);
+    return std::make_unique<UnregisteredSource>(
+        std::move(dirs), unregistered_calibration(path, options, calib_file));
 }
 
 }  // namespace wul3d
