@@ -197,6 +197,100 @@ nlohmann::json score_json(const ImageScore& s) {
             {"matches", matches}};
 }
 
+/// One pair's ground truth (BOP's masks combined; ids up to `bg_max` as background) and
+/// prediction (all background when there is none: `missing` counts it), of one size.
+std::pair<LabelImage, LabelImage> read_pair(const FramePair& f, int bg_max, int& missing) {
+    LabelImage gt = f.bop ? combine_bop_masks(*f.bop) : read_label_png(f.gt.string());
+    if (bg_max > 0)
+        for (std::uint16_t& l : gt.labels)
+            if (l <= bg_max) l = 0;
+    LabelImage pred;
+    if (f.pred.empty()) {
+        ++missing;
+        pred.width = gt.width;
+        pred.height = gt.height;
+        pred.labels.assign(gt.labels.size(), 0);
+    } else {
+        pred = read_label_png(f.pred.string());
+    }
+    if (pred.width != gt.width || pred.height != gt.height)
+        throw InputError(f.pred.string() + " is " + std::to_string(pred.width) + "x" +
+                         std::to_string(pred.height) + " but " + f.gt.string() + " is " +
+                         std::to_string(gt.width) + "x" + std::to_string(gt.height));
+    return {std::move(gt), std::move(pred)};
+}
+
+/// --per-image's line of one frame.
+void print_image(const FramePair& f, const ImageScore& s) {
+    std::cout << f.name << ": overlap P/R/F " << pct(s.overlap_p) << " " << pct(s.overlap_r)
+              << " " << pct(s.overlap_f) << ", boundary P/R/F " << pct(s.boundary_p) << " "
+              << pct(s.boundary_r) << " " << pct(s.boundary_f) << ", %>=75 "
+              << pct(s.detected_share) << ", objects " << s.gt_objects << " (predicted "
+              << s.pred_objects << ")" << (f.pred.empty() ? ", no prediction" : "") << "\n";
+}
+
+/// The table of the whole set on stdout, and the same as --json's "summary".
+nlohmann::json print_summary(const EvalOptions& o, const std::vector<ImageScore>& scores,
+                             int missing) {
+    const EvalSummary m = summarize(scores);
+    std::cout << "wul3d eval: " << m.images << " image" << (m.images == 1 ? "" : "s") << ", "
+              << m.gt_objects << " objects (" << o.pred_file << " vs " << o.gt_file
+              << ", boundary tolerance " << scores.front().boundary_tolerance_px << " px"
+              << (missing ? ", " + std::to_string(missing) + " without prediction" : "")
+              << ")\n";
+    std::cout << "Overlap P   " << pct(m.overlap_p) << "\n"
+              << "Overlap R   " << pct(m.overlap_r) << "\n"
+              << "Overlap F   " << pct(m.overlap_f) << "\n"
+              << "Boundary P  " << pct(m.boundary_p) << "\n"
+              << "Boundary R  " << pct(m.boundary_r) << "\n"
+              << "Boundary F  " << pct(m.boundary_f) << "\n"
+              << "%>=75       " << pct(m.detected_share) << "\n"
+              << "images      " << m.images << "\n"
+              << "objects     " << m.gt_objects << "\n";
+    return {{"overlap_p", m.overlap_p},
+            {"overlap_r", m.overlap_r},
+            {"overlap_f", m.overlap_f},
+            {"boundary_p", m.boundary_p},
+            {"boundary_r", m.boundary_r},
+            {"boundary_f", m.boundary_f},
+            {"detected_share", m.detected_share},
+            {"images", m.images},
+            {"gt_objects", m.gt_objects},
+            {"pred_objects", m.pred_objects},
+            {"detected", m.detected},
+            {"missing_predictions", missing}};
+}
+
+/// --temporal's table on stdout, and the same as --json's "temporal".
+nlohmann::json print_temporal(const TemporalReport& t) {
+    std::cout << "Temporal: " << t.frames << " frames, " << t.objects.size()
+              << " ground-truth objects\n"
+              << "ID switches          " << t.id_switches << "\n"
+              << "ID switches/object   " << std::fixed << std::setprecision(2)
+              << t.switches_per_object << "\n"
+              << "ID switches max      " << t.max_switches << "\n"
+              << "Flicker              " << pct(t.flicker) << "\n"
+              << "Object flicker       " << pct(t.object_flicker) << "\n";
+    for (const ObjectTrackScore& s : t.objects)
+        std::cout << "  object " << s.gt_id << ": visible " << s.frames_visible
+                  << " frames, matched " << s.frames_matched << ", switches " << s.switches
+                  << "\n";
+    nlohmann::json objs = nlohmann::json::array();
+    for (const ObjectTrackScore& s : t.objects)
+        objs.push_back({{"gt_id", s.gt_id},
+                        {"frames_visible", s.frames_visible},
+                        {"frames_matched", s.frames_matched},
+                        {"switches", s.switches}});
+    return {{"frames", t.frames},
+            {"frame_pairs", t.frame_pairs},
+            {"id_switches", t.id_switches},
+            {"switches_per_object", t.switches_per_object},
+            {"max_switches", t.max_switches},
+            {"flicker", t.flicker},
+            {"object_flicker", t.object_flicker},
+            {"objects", objs}};
+}
+
 void run(EvalOptions o) {
     // An OCID sequence's own background ids, unless given.
     if (is_ocid_sequence(o.gt) && o.gt_background_max == 0)
@@ -217,36 +311,14 @@ void run(EvalOptions o) {
     nlohmann::json images = nlohmann::json::array();
     int missing = 0;
     for (const FramePair& f : frames) {
-        LabelImage gt = f.bop ? combine_bop_masks(*f.bop) : read_label_png(f.gt.string());
-        if (o.gt_background_max > 0)
-            for (std::uint16_t& l : gt.labels)
-                if (l <= o.gt_background_max) l = 0;
-        LabelImage pred;
-        if (f.pred.empty()) {
-            ++missing;
-            pred.width = gt.width;
-            pred.height = gt.height;
-            pred.labels.assign(gt.labels.size(), 0);
-        } else {
-            pred = read_label_png(f.pred.string());
-        }
-        if (pred.width != gt.width || pred.height != gt.height)
-            throw InputError(f.pred.string() + " is " + std::to_string(pred.width) + "x" +
-                             std::to_string(pred.height) + " but " + f.gt.string() + " is " +
-                             std::to_string(gt.width) + "x" + std::to_string(gt.height));
+        const auto [gt, pred] = read_pair(f, o.gt_background_max, missing);
         ImageScore s;
         try {
             s = sequence ? sequence->add(pred, gt) : score_image(pred, gt, params);
         } catch (const InputError& e) {
             throw InputError(f.name + " (" + f.gt.string() + "): " + e.what());
         }
-        if (o.per_image)
-            std::cout << f.name << ": overlap P/R/F " << pct(s.overlap_p) << " "
-                      << pct(s.overlap_r) << " " << pct(s.overlap_f) << ", boundary P/R/F "
-                      << pct(s.boundary_p) << " " << pct(s.boundary_r) << " "
-                      << pct(s.boundary_f) << ", %>=75 " << pct(s.detected_share) << ", objects "
-                      << s.gt_objects << " (predicted " << s.pred_objects << ")"
-                      << (f.pred.empty() ? ", no prediction" : "") << "\n";
+        if (o.per_image) print_image(f, s);
         nlohmann::json j = score_json(s);
         j["name"] = f.name;
         j["gt_path"] = f.gt.string();
@@ -255,68 +327,13 @@ void run(EvalOptions o) {
         scores.push_back(std::move(s));
     }
 
-    const EvalSummary m = summarize(scores);
-    std::cout << "wul3d eval: " << m.images << " image" << (m.images == 1 ? "" : "s") << ", "
-              << m.gt_objects << " objects (" << o.pred_file << " vs " << o.gt_file
-              << ", boundary tolerance " << scores.front().boundary_tolerance_px << " px"
-              << (missing ? ", " + std::to_string(missing) + " without prediction" : "")
-              << ")\n";
-    std::cout << "Overlap P   " << pct(m.overlap_p) << "\n"
-              << "Overlap R   " << pct(m.overlap_r) << "\n"
-              << "Overlap F   " << pct(m.overlap_f) << "\n"
-              << "Boundary P  " << pct(m.boundary_p) << "\n"
-              << "Boundary R  " << pct(m.boundary_r) << "\n"
-              << "Boundary F  " << pct(m.boundary_f) << "\n"
-              << "%>=75       " << pct(m.detected_share) << "\n"
-              << "images      " << m.images << "\n"
-              << "objects     " << m.gt_objects << "\n";
-
     nlohmann::json out;
     out["pred"] = o.pred;
     out["gt"] = o.gt;
     out["pred_file"] = o.pred_file;
     out["gt_file"] = o.gt_file;
-    out["summary"] = {{"overlap_p", m.overlap_p},
-                      {"overlap_r", m.overlap_r},
-                      {"overlap_f", m.overlap_f},
-                      {"boundary_p", m.boundary_p},
-                      {"boundary_r", m.boundary_r},
-                      {"boundary_f", m.boundary_f},
-                      {"detected_share", m.detected_share},
-                      {"images", m.images},
-                      {"gt_objects", m.gt_objects},
-                      {"pred_objects", m.pred_objects},
-                      {"detected", m.detected},
-                      {"missing_predictions", missing}};
-    if (sequence) {
-        const TemporalReport t = sequence->report();
-        std::cout << "Temporal: " << t.frames << " frames, " << t.objects.size()
-                  << " ground-truth objects\n"
-                  << "ID switches          " << t.id_switches << "\n"
-                  << "ID switches/object   " << std::fixed << std::setprecision(2)
-                  << t.switches_per_object << "\n"
-                  << "ID switches max      " << t.max_switches << "\n"
-                  << "Flicker              " << pct(t.flicker) << "\n"
-                  << "Object flicker       " << pct(t.object_flicker) << "\n";
-        for (const ObjectTrackScore& s : t.objects)
-            std::cout << "  object " << s.gt_id << ": visible " << s.frames_visible
-                      << " frames, matched " << s.frames_matched << ", switches " << s.switches
-                      << "\n";
-        nlohmann::json objs = nlohmann::json::array();
-        for (const ObjectTrackScore& s : t.objects)
-            objs.push_back({{"gt_id", s.gt_id},
-                            {"frames_visible", s.frames_visible},
-                            {"frames_matched", s.frames_matched},
-                            {"switches", s.switches}});
-        out["temporal"] = {{"frames", t.frames},
-                           {"frame_pairs", t.frame_pairs},
-                           {"id_switches", t.id_switches},
-                           {"switches_per_object", t.switches_per_object},
-                           {"max_switches", t.max_switches},
-                           {"flicker", t.flicker},
-                           {"object_flicker", t.object_flicker},
-                           {"objects", objs}};
-    }
+    out["summary"] = print_summary(o, scores, missing);
+    if (sequence) out["temporal"] = print_temporal(sequence->report());
     out["images"] = images;
     if (!o.json.empty()) write_text_file(o.json, json_text(out, 2) + "\n");
     std::cout << std::flush;
