@@ -63,7 +63,13 @@ private:
     void handle_keys();
     void draw_object_list();
     void draw_selected();
-    void draw_controls(const Rect& area);
+    void draw_controls(const Rect& area);  // the left panel, its sections below in order
+    void draw_source();
+    void draw_playback();
+    void draw_parameters();
+    void draw_timings();
+    void draw_view_options();
+    void draw_keys();
     void draw_cloud(const Rect& area);
     void draw_image(const char* title, ImageTexture& texture, const Rect& area, bool clickable,
                     Rect* image_rect);

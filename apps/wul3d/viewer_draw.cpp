@@ -23,6 +23,19 @@ void Viewer::draw_controls(const Rect& area) {
     ImGui::SetNextWindowSize(ImVec2(area.w, area.h));
     ImGui::Begin("wul3d view", nullptr, kPanelFlags & ~ImGuiWindowFlags_NoScrollbar &
                                             ~ImGuiWindowFlags_NoScrollWithMouse);
+    draw_source();
+    draw_playback();
+    draw_object_list();
+    draw_parameters();
+    draw_timings();
+    draw_selected();
+    draw_view_options();
+    draw_keys();
+    ImGui::End();
+}
+
+/// The recording (or camera) and the frame on screen.
+void Viewer::draw_source() {
     if (live_) {
         ImGui::TextWrapped("%s", live_->description().c_str());
         ImGui::Text("%s   %llu captured, %llu dropped%s", frame_->name.c_str(),
@@ -33,7 +46,10 @@ void Viewer::draw_controls(const Rect& area) {
         ImGui::TextWrapped("%s", cfg_.input.c_str());
         ImGui::Text("frame %zu / %zu   %s", current_ + 1, source_->size(), frame_->name.c_str());
     }
+}
 
+/// Play, pause, step, loop, real time.
+void Viewer::draw_playback() {
     if (ImGui::CollapsingHeader("Playback", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (ImGui::Button(playing_ ? "Pause" : "Play", ImVec2(70, 0))) playing_ = !playing_;
         ImGui::SameLine();
@@ -45,9 +61,10 @@ void Viewer::draw_controls(const Rect& area) {
         ImGui::Checkbox("Loop", &loop_);
         ImGui::Checkbox("Real time (30 FPS at most)", &real_time_);
     }
+}
 
-    draw_object_list();
-
+/// The clustering's parameters, applied (and re-seeded) at the next frame.
+void Viewer::draw_parameters() {
     if (ImGui::CollapsingHeader("Parameters")) {
         ImGui::PushItemWidth(170);
         ClusterParams& c = pending_.cluster;
@@ -84,7 +101,10 @@ void Viewer::draw_controls(const Rect& area) {
             ImGui::PopStyleColor();
         }
     }
+}
 
+/// The pipeline's rate and each stage's share of the frame.
+void Viewer::draw_timings() {
     if (ImGui::CollapsingHeader("Timings", ImGuiTreeNodeFlags_DefaultOpen)) {
         const StageTimes& t = result_->times;
         ImGui::Text("pipeline %.1f FPS (%.1f ms)   window %.0f FPS",
@@ -113,9 +133,10 @@ void Viewer::draw_controls(const Rect& area) {
                            s.reseeded);
         ImGui::PopStyleColor();
     }
+}
 
-    draw_selected();
-
+/// What the 3D view shows and colours.
+void Viewer::draw_view_options() {
     if (ImGui::CollapsingHeader("3D view", ImGuiTreeNodeFlags_DefaultOpen)) {
         bool changed = ImGui::RadioButton("objects", &cloud_colour_mode_, kObjects);
         ImGui::SameLine();
@@ -132,7 +153,10 @@ void Viewer::draw_controls(const Rect& area) {
         if (ImGui::Button("Reset view (R)")) camera_.reset(scene_depth_, view_fov_y_);
         if (changed) rebuild_cloud();
     }
+}
 
+/// The keyboard and mouse, as a reminder.
+void Viewer::draw_keys() {
     if (ImGui::CollapsingHeader("Keys")) {
         ImGui::TextColored(kDimColour,
                            "space play/pause   N or right step\n"
@@ -142,7 +166,6 @@ void Viewer::draw_controls(const Rect& area) {
                            "3D: left drag orbit, right drag pan,\n"
                            "    wheel zoom, click select");
     }
-    ImGui::End();
 }
 
 void Viewer::draw_object_list() {
