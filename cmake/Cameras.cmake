@@ -2,7 +2,7 @@
 # CMakeLists.txt after the wul3d library target is defined.
 #
 # Each backend in src/capture/ is compiled only when its library is found through
-# pkg-config, and then defines WUL3D_WITH_<NAME> for src/capture.cpp. A backend that is not
+# pkg-config, and then defines WUL3D_WITH_<NAME> for src/capture/capture.cpp. A backend that is not
 # built makes `--camera NAME` say so and exit 2.
 #   freenect   Kinect v1, libfreenect     Debian: libfreenect-dev (fakenect: libfreenect-bin)
 #   openni2    OpenNI2 devices, .oni      Debian: libopenni2-dev

@@ -66,7 +66,7 @@ private:
 /// classes, segments, objects) comes from the pixel's source block: its own when its depth
 /// is on the block's surface, else the nearest in depth of the 3 x 3 blocks around; at the
 /// objects' outlines (the clusters' without params.objects) the input's colour places the
-/// outline (src/decimated_source.hpp gives the rules). A pixel out of the depth range, or
+/// outline (src/stages/decimated_source.hpp gives the rules). A pixel out of the depth range, or
 /// without a source, is no point. Each object's pixels and 2D box are counted again at the
 /// input's size, and objects left under params.min_object_pixels are dropped. Everything
 /// else of `small` (stats, plane, object_list) is copied; `out.times` is not set. The same

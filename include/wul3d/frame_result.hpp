@@ -17,7 +17,7 @@ namespace wul3d {
 
 /// Milliseconds spent in each stage on one frame (0 for a stage that did not run). On two
 /// threads the clustering (with its colours) and the plane and segmentation stages may run
-/// side by side (src/side_by_side.hpp): each is timed as it ran, and `overlap` is the time
+/// side by side (src/stages/side_by_side.hpp): each is timed as it ran, and `overlap` is the time
 /// they shared.
 struct StageTimes {
     double registration = 0, decimation = 0, backprojection = 0, normals = 0, background = 0,

@@ -47,7 +47,7 @@ struct PlaneParams {
 };
 
 /// Scratch of remove_support_plane; allocates nothing after the first frame of a size.
-/// Opaque: its buffers are plane.cpp's (src/plane_internal.hpp).
+/// Opaque: its buffers are plane.cpp's (src/stages/plane_internal.hpp).
 class PlaneWorkspace {
 public:
     PlaneWorkspace();
@@ -55,7 +55,7 @@ public:
     PlaneWorkspace(PlaneWorkspace&&) noexcept;
     PlaneWorkspace& operator=(PlaneWorkspace&&) noexcept;
 
-    struct Buffers;      ///< src/plane_internal.hpp
+    struct Buffers;      ///< src/stages/plane_internal.hpp
     Buffers& buffers();  ///< for plane.cpp's phases (made again after a move)
 
 private:

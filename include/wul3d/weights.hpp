@@ -2,7 +2,7 @@
 /// @file weights.hpp
 /// The paper's per-pixel membership weights mu (eq. 2, 7, 8), shared by the clusters
 /// (ClusterState, clustering.hpp: one weight per cluster) and the object tracks
-/// (ObjectTracker, objects.hpp: one per track slot). Defined in src/clustering.cpp, where
+/// (ObjectTracker, objects.hpp: one per track slot). Defined in src/stages/clustering.cpp, where
 /// the clusters' per-pixel loop inlines the update.
 #include <cstdint>
 
@@ -21,7 +21,7 @@ int update_weights(float* mu, int k, int winner, float psi);
 /// of k: 24 bytes a pixel, where dense float weights at 1920x1080 and k = 100 would take
 /// 830 MB. A weight is dropped only when a seventh cluster wins while six are kept; it is
 /// then the smallest (with psi = 1 at most 1/64 after six other winners). Labels and eq. (9)
-/// colours match dense float weights on real sequences (tests/clustering_test.cpp). Six
+/// colours match dense float weights on real sequences (tests/stages/clustering_test.cpp). Six
 /// slots, not eight, is what brings 1920x1080 under the speed issue's 160 MB floor; labels
 /// on osd_mosd and osd_moving came out identical to eight.
 struct PixelWeights {

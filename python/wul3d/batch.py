@@ -46,7 +46,7 @@ BATCH_JSON = "batch.json"
 DONE_MARKER = "summary.json"  # written last by the run loop
 FRAMES_FILE = "frames.jsonl"
 # The files wul3d writes in a frame folder: the library's frame_output_files()
-# (src/output.cpp), copied: batch.py imports without the compiled module (the discovery
+# (src/run/output.cpp), copied: batch.py imports without the compiled module (the discovery
 # fuzzer); tests/python/test_batch_hostile.py checks the copy against _frame_output_files().
 FRAME_OUTPUT_FILES = frozenset({
     "labels.png", "colors.png", "selected.png", "objects.png", "objects.json",

@@ -19,7 +19,7 @@
 #include <optional>
 #include <sstream>
 
-#include "../io_detail.hpp"
+#include "io/io_detail.hpp"
 #include "wul3d/bag.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/ros_image.hpp"

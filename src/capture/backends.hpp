@@ -1,5 +1,5 @@
 #pragma once
-// Private to src/capture.cpp and src/capture/*.cpp: the camera backends. Each is compiled only
+// Private to src/capture/capture.cpp and src/capture/*.cpp: the camera backends. Each is compiled only
 // when its library was found (CMakeLists.txt defines WUL3D_WITH_<NAME>); open_camera
 // dispatches to them. `arg` is what follows "backend:" in --camera, possibly empty.
 #include <memory>

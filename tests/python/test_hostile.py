@@ -140,7 +140,7 @@ def png(path, array, bit_depth, colour_type):
 
 def tiny_tum(root, n):
     """A TUM sequence of n 8 x 8 frames (a tilted surface with a box on it, as
-    tests/run_robust_test.cpp), one pair of images listed n times under distinct stamps."""
+    tests/run/robust_test.cpp), one pair of images listed n times under distinct stamps."""
     (root / "rgb").mkdir(parents=True)
     (root / "depth").mkdir()
     v, u = np.mgrid[0:8, 0:8]

@@ -1,5 +1,5 @@
 #pragma once
-// Private to src/io_*.cpp: image readers that reuse the caller's buffers, so that a
+// Private to src/io/ (and src/bag/): image readers that reuse the caller's buffers, so that a
 // FrameSource allocates nothing per frame once the first frame has been read.
 #include <cstdint>
 #include <cstdio>

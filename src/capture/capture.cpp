@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <utility>
 
-#include "capture/backends.hpp"
+#include "backends.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {

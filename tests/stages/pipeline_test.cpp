@@ -7,7 +7,7 @@
 #include <map>
 #include <set>
 
-#include "side_by_side.hpp"  // src/: the pipeline's private choice, tested here
+#include "stages/side_by_side.hpp"  // src/stages/: the pipeline's private choice, tested here
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"

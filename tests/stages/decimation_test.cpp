@@ -12,7 +12,7 @@
 
 #include <omp.h>
 
-#include "decimated_source.hpp"
+#include "stages/decimated_source.hpp"
 #include "synthetic_scene.hpp"
 #include "test_support.hpp"
 #include "wul3d/error.hpp"

@@ -146,7 +146,7 @@ int update_weights(PixelWeights& w, int winner, float psi) {
     // without a data-dependent branch: on a new scene the winner is kept or not at random
     // and the scalar loop's branches mispredict. Same float operations in the same order
     // (sums of 16-bit integers are exact in float), so the result is bit-identical
-    // (tests/clustering_test.cpp, PixelWeights.VectorUpdateMatchesScalar).
+    // (tests/stages/clustering_test.cpp, PixelWeights.VectorUpdateMatchesScalar).
     constexpr int S = PixelWeights::kSlots;
     static_assert(sizeof(PixelWeights) == 4 * S && S == 6, "24-byte layout: cluster[6], mu[6]");
     if (w.mu[0] == static_cast<std::uint16_t>(PixelWeights::kOne) && w.cluster[0] == winner)
