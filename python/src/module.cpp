@@ -712,7 +712,6 @@ PYBIND11_MODULE(_wul3d, m) {
     m.def(
         "parameters",
         [] {
-            static const char* const kKind[] = {"int", "int", "float", "str", "bool"};
             const wul3d::PipelineParams defaults;
             const py::dict values = params_dict(defaults);
             py::list rows;
@@ -720,7 +719,7 @@ PYBIND11_MODULE(_wul3d, m) {
                 py::dict row;
                 row["name"] = s.name;
                 row["stage"] = s.stage;
-                row["type"] = kKind[static_cast<int>(s.kind)];
+                row["type"] = python_type(s.kind);
                 // A float row's default as its float's digits (0.0033, as --help says).
                 row["default"] = s.kind == wul3d::ParamKind::Float
                                      ? py::object(py::float_(std::stod(wul3d::value_text(s.get(defaults)))))

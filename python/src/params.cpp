@@ -56,8 +56,18 @@ std::string wrap_last_line(const std::string& text) {
 
 }  // namespace
 
+const char* python_type(ParamKind kind) {
+    switch (kind) {
+        case ParamKind::Int:
+        case ParamKind::UInt64: return "int";
+        case ParamKind::Float: return "float";
+        case ParamKind::Choice: return "str";
+        case ParamKind::Switch: return "bool";
+    }
+    return "";
+}
+
 std::string params_doc() {
-    static const char* const kPythonType[] = {"int", "int", "float", "str", "bool"};
     const PipelineParams defaults;
     std::string presets, doc;
     for (const auto& [name, help] : preset_names_and_help())
@@ -67,7 +77,7 @@ std::string params_doc() {
         const ParamValue def = s.get(defaults);
         const std::string* name = std::get_if<std::string>(&def);
         const bool* on = std::get_if<bool>(&def);
-        doc += std::string("    ") + s.name + " (" + kPythonType[static_cast<int>(s.kind)] + "): " +
+        doc += std::string("    ") + s.name + " (" + python_type(s.kind) + "): " +
                s.help;
         if (s.kind == ParamKind::Int || s.kind == ParamKind::Float) doc += ", " + range_text(s);
         const std::string shown = name ? "\"" + *name + "\"" : on ? (*on ? "True" : "False") : value_text(def);

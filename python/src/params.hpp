@@ -42,6 +42,9 @@ PipelineParams make_params(const ParamArgs& a);
 /// The parameters in force as a dict, one key per row (without units: "zmin").
 py::dict params_dict(const PipelineParams& p);
 
+/// The Python type a row's values have: "int", "float", "str" or "bool".
+const char* python_type(ParamKind kind);
+
 /// The "Args:" lines of a docstring, one per row and the preset, from the table.
 std::string params_doc();
 
