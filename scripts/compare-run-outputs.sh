@@ -43,12 +43,20 @@ def load(out):
     for f in frames or []: f.pop("ms", None)
     return s, frames
 a, b = load(sys.argv[1]), load(sys.argv[2])
-# A key one build writes and the other does not (summary.json's "outputs", added later) is
-# named, not counted: every key both write must agree.
-added = sorted(set(a[0]) ^ set(b[0]))
+# A key one build writes and the other does not (summary.json's "outputs", a new parameter,
+# a new figure of frames.jsonl) is named, not counted: every key both write must agree.
+def one_side(what, x, y):
+    added = sorted(set(x) ^ set(y))
+    for k in added: x.pop(k, None); y.pop(k, None)
+    return [f"{what}{k}" for k in added]
+added = one_side("", a[0], b[0])
+if isinstance(a[0].get("parameters"), dict) and isinstance(b[0].get("parameters"), dict):
+    added += one_side("parameters.", a[0]["parameters"], b[0]["parameters"])
+frame_keys = set()
+for fa, fb in zip(a[1] or [], b[1] or []): frame_keys.update(one_side("frames.jsonl: ", fa, fb))
+added += sorted(frame_keys)
 if added:
-    print(f"summary.json keys in one build only (not compared): {', '.join(added)}")
-    for k in added: a[0].pop(k, None); b[0].pop(k, None)
+    print(f"keys in one build only (not compared): {', '.join(added)}")
 sys.exit(0 if a == b else f"summary.json / frames.jsonl differ beyond timings: {sys.argv[1]}")
 PY
   if [[ $ok == 0 ]]; then status=1; echo "$name: DIFFERS"; continue; fi

@@ -94,9 +94,15 @@ std::vector<ParamSpec> make_table() {
                     [](P& p, const V& v) { p.range.zmax_m = as_float(v); }),
                 true, false),
         // Step 4: normals (normals.hpp).
-        row("normal_radius", "normals", K::Int, "px", 1, 64, "Normal neighbour distance, pixels",
+        row("normal_radius", "normals", K::Int, "px", 1, 64, "Least normal neighbour distance, pixels (more where the depth is noisy: normal_tilt_noise)",
             [](const P& p) { return int_value(p.normals.radius_px); },
             [](P& p, const V& v) { p.normals.radius_px = static_cast<int>(as_int(v)); }),
+        open_at(row("normal_tilt_noise", "normals", K::Float, "deg", 0, 90,
+                    "Normals: the radius grows with the depth's measured noise until it tilts a "
+                    "normal by at most this, degrees (0: --normal-radius always)",
+                    [](const P& p) { return float_value(p.normals.max_tilt_noise_deg); },
+                    [](P& p, const V& v) { p.normals.max_tilt_noise_deg = as_float(v); }),
+                false, true),
         // The object stages: segmentation (segmentation.hpp), the plane, the tracks.
         choice("segmenter", "segmentation", "geometric|kmeans|hybrid",
                "Object segmentation: geometric, kmeans or hybrid",

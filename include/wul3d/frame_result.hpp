@@ -38,6 +38,11 @@ struct FrameResult {
     std::vector<std::uint8_t> active;   ///< points in the depth range
     std::size_t active_points = 0;
     FrameStats stats;
+    /// The depth's noise measured on this frame (measure_depth_noise, normals.hpp) and the
+    /// normal radius it chose (normal_radius_for), both in the pixels the stages ran on (the
+    /// decimated ones with PipelineParams::decimation > 1).
+    float depth_noise_px = 0.0f;
+    int normal_radius_px = 0;
     PlaneResult plane;                         ///< the support found (plane.found)
     std::vector<std::uint8_t> plane_classes;   ///< PlaneClass per pixel
     LabelImage segments;                       ///< this frame's segments, 0 = background

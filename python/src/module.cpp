@@ -62,6 +62,8 @@ struct Result {
     double call_ms = 0;  ///< the C++ Pipeline::process call, timed by the binding
     FrameStats stats;
     std::size_t active_points = 0;
+    float depth_noise_px = 0.0f;
+    int normal_radius_px = 0;
     SegmentStats segment_stats;
     py::object instances_py, plane_py, times_py, stats_py;  ///< made on first read
 };
@@ -128,6 +130,8 @@ Result make_result(const FrameResult& r, const ImageSelection& selection, Buffer
     out.plane.support = r.plane.support;
     out.times = r.times;
     out.stats = r.stats;
+    out.depth_noise_px = r.depth_noise_px;
+    out.normal_radius_px = r.normal_radius_px;
     out.active_points = r.active_points;
     out.segment_stats = r.segment_stats;
     return out;
@@ -168,6 +172,8 @@ py::dict stats_dict(const Result& r) {
     out["seeded"] = r.stats.seeded;
     out["reseeded"] = r.stats.reseeded;
     out["mean_f"] = r.stats.mean_f;
+    out["depth_noise_px"] = r.depth_noise_px;
+    out["normal_radius_px"] = r.normal_radius_px;
     out["segments"] = r.segment_stats.segments;
     out["merges"] = r.segment_stats.merges;
     out["containers"] = r.segment_stats.containers;

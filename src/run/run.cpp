@@ -64,6 +64,8 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"seeded", r.stats.seeded},
             {"reseeded", r.stats.reseeded},
             {"mean_f", r.stats.mean_f},
+            {"depth_noise_px", r.depth_noise_px},
+            {"normal_radius_px", r.normal_radius_px},
             {"ms", r.times.total()},
             {"support_plane", r.plane.found},
             {"segments", r.segment_stats.segments},

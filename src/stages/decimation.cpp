@@ -402,6 +402,8 @@ void mark_edge_blocks(const LabelImage& outline, ExpandBuffers& buf) {
 /// second frame of a size).
 void shape_result(const FrameResult& small, int W, int H, bool objects, FrameResult& r) {
     r.stats = small.stats;
+    r.depth_noise_px = small.depth_noise_px;
+    r.normal_radius_px = small.normal_radius_px;
     r.plane = small.plane;
     r.segment_stats = small.segment_stats;
     r.object_list = small.object_list;

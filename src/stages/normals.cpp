@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <sstream>
 
 #if defined(__SSE2__)
@@ -25,6 +26,52 @@ void NormalParams::validate() const {
         msg << "normal max_depth_jump_rel = " << max_depth_jump_rel << ": must be > 0";
         throw ParamError(msg.str());
     }
+    if (!(max_tilt_noise_deg >= 0 && max_tilt_noise_deg < 90)) {
+        std::ostringstream msg;
+        msg << "normal max_tilt_noise_deg = " << max_tilt_noise_deg << ": must be in [0, 90)";
+        throw ParamError(msg.str());
+    }
+}
+
+float measure_depth_noise(const OrganizedCloud& cloud, float fx, std::vector<float>& scratch) {
+    constexpr int kStep = 3;                 // every third pixel of every third row
+    constexpr double kKeep = 0.9;            // the largest tenth are edges
+    // E|x| over the smallest 90% of |N(0, 1)|, times sqrt(6) (the second difference of three
+    // independent samples has 6 times their variance): 0.6573 * 2.4495.
+    constexpr double kGaussian = 1.6100;
+    const int W = cloud.width, H = cloud.height;
+    scratch.clear();
+    if (!(fx > 0) || W < 3 || H < 3) return 0.0f;
+    const std::uint8_t* const ok = cloud.valid.data();
+    const float* const z = cloud.z.data();
+    // |d2(1/z)| * z * fx: the noise of 1/z (which a plane keeps linear in u and v) scaled to
+    // the point's depth and pixel footprint (sigma_z = z^2 sigma(1/z), footprint z / fx).
+    auto sample = [&](std::size_t a, std::size_t p, std::size_t b) {
+        if (!(ok[a] & ok[p] & ok[b])) return;
+        const float d2 = 1.0f / z[a] - 2.0f / z[p] + 1.0f / z[b];
+        scratch.push_back(std::fabs(d2) * z[p] * fx);
+    };
+    for (int v = 1; v + 1 < H; v += kStep) {
+        const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(W);
+        for (int u = 1; u + 1 < W; u += kStep) {
+            const std::size_t p = row + static_cast<std::size_t>(u);
+            sample(p - 1, p, p + 1);
+            sample(p - static_cast<std::size_t>(W), p, p + static_cast<std::size_t>(W));
+        }
+    }
+    if (scratch.size() < 64) return 0.0f;
+    const auto kept = static_cast<std::ptrdiff_t>(kKeep * static_cast<double>(scratch.size()));
+    std::nth_element(scratch.begin(), scratch.begin() + kept, scratch.end());
+    double sum = 0.0;
+    for (auto it = scratch.begin(); it != scratch.begin() + kept; ++it) sum += *it;
+    return static_cast<float>(sum / static_cast<double>(kept) / kGaussian);
+}
+
+int normal_radius_for(const NormalParams& params, float noise_px) {
+    if (!(params.max_tilt_noise_deg > 0) || !(noise_px > 0)) return params.radius_px;
+    const double tilt = std::tan(static_cast<double>(params.max_tilt_noise_deg) * std::numbers::pi / 180.0);
+    const double r = std::round(static_cast<double>(noise_px) / (std::sqrt(2.0) * tilt));
+    return static_cast<int>(std::clamp(r, static_cast<double>(params.radius_px), 64.0));
 }
 
 void NormalMap::resize(int w, int h) {

@@ -20,6 +20,7 @@ PipelineParams PipelineParams::paper() {
     p.range.zmin_m = 0.5f;  // Kinect v2's working range (paper, section II.A)
     p.range.zmax_m = 4.5f;
     p.decimation = 1;  // every point, as the paper clusters them
+    p.normals.max_tilt_noise_deg = 0.0f;  // the paper's fixed neighbourhood
     return p;
 }
 
@@ -100,6 +101,7 @@ struct Pipeline::Impl {
     PipelineParams stage_params_;  ///< params_.stage_params()
     OrganizedCloud cloud_;
     NormalMap normals_;
+    std::vector<float> noise_scratch_;  ///< measure_depth_noise's samples
     ClusterState state_;
     ObjectTracker tracker_;
     PlaneWorkspace plane_ws_;
@@ -179,7 +181,13 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     throw_if_stop_requested("the back-projection");
 
     t = Clock::now();
-    estimate_normals(params.normals, cloud_, normals_);
+    // The neighbourhood the camera's noise needs (normals.hpp), measured on this frame.
+    r.depth_noise_px =
+        measure_depth_noise(cloud_, static_cast<float>(frame.intrinsics.fx), noise_scratch_);
+    r.normal_radius_px = normal_radius_for(params.normals, r.depth_noise_px);
+    NormalParams normal_params = params.normals;
+    normal_params.radius_px = r.normal_radius_px;
+    estimate_normals(normal_params, cloud_, normals_);
     r.times.normals = ms_since(t);
     throw_if_stop_requested("the normals");
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <random>
+#include <vector>
 
 #include "wul3d/camera.hpp"
 #include "wul3d/error.hpp"
@@ -127,6 +129,86 @@ TEST(NormalParams, Validate) {
     p.radius_px = 2;
     p.max_depth_jump_rel = 0;
     EXPECT_THROW(p.validate(), ParamError);
+    p.max_depth_jump_rel = 0.02f;
+    p.max_tilt_noise_deg = 90;
+    EXPECT_THROW(p.validate(), ParamError);
+    p.max_tilt_noise_deg = -1;
+    EXPECT_THROW(p.validate(), ParamError);
+    p.max_tilt_noise_deg = 0;  // off
+    EXPECT_NO_THROW(p.validate());
+}
+
+namespace {
+
+// The tilted plane of TiltedPlaneWithin2Degrees, its depth off by Gaussian noise of
+// `noise_px` pixel footprints (z / fx), and two raised boxes whose edges are no noise.
+OrganizedCloud noisy_plane(double noise_px, std::uint32_t seed) {
+    const double nx = -0.30, ny = -0.45, nz = -0.84;
+    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const double d = nz / len * 1.5;
+    OrganizedCloud c = cast([&](float dx, float dy) {
+        const double t = d / ((nx * dx + ny * dy + nz) / len);
+        const bool box = (std::fabs(dx - 0.1f) < 0.05f || std::fabs(dx + 0.2f) < 0.04f) && std::fabs(dy) < 0.1f;
+        return t > 0 ? static_cast<float>(t - (box ? 0.1 : 0.0)) : kInf;
+    });
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    for (std::size_t p = 0; p < c.size(); ++p) {
+        if (!c.valid[p]) continue;
+        const double z = c.z[p], z_noisy = z + gauss(rng) * noise_px * z / kK.fx;
+        const double k = z_noisy / z;
+        c.x[p] = static_cast<float>(c.x[p] * k);
+        c.y[p] = static_cast<float>(c.y[p] * k);
+        c.z[p] = static_cast<float>(z_noisy);
+    }
+    return c;
+}
+
+}  // namespace
+
+// measure_depth_noise gives back the noise put on a tilted plane with box edges on it,
+// whatever its level, and nothing for an exact one: the plane's slope and the boxes' edges
+// are not noise.
+TEST(DepthNoise, MeasuresTheGaussianNoiseOnATiltedPlaneWithEdges) {
+    std::vector<float> scratch;
+    EXPECT_LT(measure_depth_noise(noisy_plane(0.0, 1), static_cast<float>(kK.fx), scratch), 0.02f);
+    for (const double noise : {0.3, 1.0, 2.5}) {
+        const float measured = measure_depth_noise(noisy_plane(noise, 7), static_cast<float>(kK.fx), scratch);
+        EXPECT_NEAR(measured, noise, 0.12 * noise) << "noise " << noise << " px";
+    }
+    // Too few samples to say: 0.
+    OrganizedCloud empty;
+    empty.resize(kK.width, kK.height);
+    EXPECT_EQ(measure_depth_noise(empty, static_cast<float>(kK.fx), scratch), 0.0f);
+    EXPECT_EQ(measure_depth_noise(noisy_plane(1.0, 7), 0.0f, scratch), 0.0f);
+}
+
+// The radius: radius_px for a quiet camera, wider with the noise so that the tilt it causes
+// (noise / (sqrt(2) r) radians) stays under max_tilt_noise_deg, capped at 64; fixed when off.
+TEST(DepthNoise, NormalRadiusGrowsWithTheNoiseFromTheLeastRadius) {
+    NormalParams p;  // radius 2, 12 degrees
+    EXPECT_EQ(normal_radius_for(p, 0.0f), 2);
+    EXPECT_EQ(normal_radius_for(p, 0.3f), 2);  // a Kinect v1
+    EXPECT_EQ(normal_radius_for(p, 1.8f), 6);  // 1.8 / (sqrt(2) tan 12 deg) = 5.99
+    EXPECT_EQ(normal_radius_for(p, 1000.0f), 64);
+    p.radius_px = 8;
+    EXPECT_EQ(normal_radius_for(p, 1.8f), 8);
+    p.radius_px = 2;
+    p.max_tilt_noise_deg = 0;
+    EXPECT_EQ(normal_radius_for(p, 1.8f), 2);
+    // The tilt at the chosen radius is within the bound on a noisy plane.
+    p.max_tilt_noise_deg = 12;
+    std::vector<float> scratch;
+    const OrganizedCloud c = noisy_plane(1.8, 3);
+    p.radius_px = normal_radius_for(p, measure_depth_noise(c, static_cast<float>(kK.fx), scratch));
+    NormalMap n;
+    estimate_normals(p, c, n);
+    std::vector<double> tilt;
+    for (std::size_t q = 0; q < c.size(); ++q)
+        if (n.valid[q]) tilt.push_back(angle_deg(n.nx[q], n.ny[q], n.nz[q], -0.30, -0.45, -0.84));
+    ASSERT_GT(tilt.size(), c.size() / 2);
+    std::nth_element(tilt.begin(), tilt.begin() + static_cast<std::ptrdiff_t>(tilt.size() / 2), tilt.end());
+    EXPECT_LT(tilt[tilt.size() / 2], 12.0);  // the median over the plane and the boxes
 }
 
 // Smoothing: on a noisy plane the averaged normals lie closer to the true one than the raw
