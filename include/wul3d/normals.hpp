@@ -23,25 +23,32 @@ struct NormalParams {
     /// max_depth_jump_rel * z * radius_px (scales with depth, like sensor noise); > 0.
     float max_depth_jump_rel = 0.02f;
     /// The radius grows (up to 64) until the depth's noise tilts a normal by at most this,
-    /// degrees (normal_radius_for); [0, 90), 0: radius_px whatever the noise. The default is
-    /// the support plane's grow angle (PlaneParams::grow_angle_deg), which its normals must meet.
-    float max_tilt_noise_deg = 12.0f;
+    /// degrees, in each direction (normal_radius_for); [0, 90), 0: radius_px whatever the
+    /// noise. 7: the tilt's size then stays mostly within the support plane's grow angle of
+    /// 12 degrees (chosen on the generated tune seeds: docs/ABLATION.md, "Normals").
+    float max_tilt_noise_deg = 7.0f;
 
     void validate() const;  ///< throws ParamError
 };
 
-/// The depth's noise in one frame, in pixel footprints: the standard deviation of a point's
-/// depth divided by the distance between neighbouring pixels at that depth (z / fx), over
-/// the frame. A structured-light Kinect v1 measures about 0.6 at 1-1.5 m, an active-stereo
-/// camera without its smoothing filters about 1.8. Measured on second differences of
-/// inverse depth (zero on any plane, so slopes do not count), along rows and columns on
-/// every third pixel; the largest tenth are edges, not noise, and are dropped. Calibrated
-/// on Gaussian noise (tests/stages/normals_test.cpp). 0 when fewer than 64 samples exist.
-/// `scratch` is reused. Cost: O(N / 9) plus a selection on the samples.
+/// The depth's noise in one frame as it tilts normals, in pixel footprints: the standard
+/// deviation of a point's position along its surface's normal divided by the distance
+/// between neighbouring points on that surface, over the frame. For a surface facing the
+/// camera that is the depth's noise over the pixel footprint z / fx; a surface seen at an
+/// angle a has its noise times cos a over neighbours 1 / cos a further apart, so it counts
+/// cos^2 a as much (a table seen at 45 degrees, half). At the default decimation real
+/// Kinect v1 frames measure 0.1-0.2, a RealSense with its filters about 0.1, the generator's
+/// active-stereo camera 0.5-1.2. Measured on second differences of inverse depth along rows
+/// and columns (zero on any plane: slopes are not noise) on every third pixel, with the
+/// slope from the points 12 pixels either side; steeper than 80 degrees, and the largest
+/// tenth, are edges and are dropped. Calibrated on Gaussian noise, within 12 % up to 2.5
+/// (tests/stages/normals_test.cpp). 0 when fewer than 64 samples exist. `scratch` is
+/// reused. Cost: O(N / 9) plus a selection on the samples.
 float measure_depth_noise(const OrganizedCloud& cloud, float fx, std::vector<float>& scratch);
 
-/// The radius the normals of a frame with depth noise `noise_px` need: a normal from points
-/// r pixels either side tilts by about noise / (sqrt(2) r) radians, so
+/// The radius the normals of a frame with depth noise `noise_px` (measure_depth_noise) need:
+/// a normal from points r pixels either side tilts by about noise / (sqrt(2) r) radians in
+/// each direction, so
 /// r = round(noise / (sqrt(2) tan(max_tilt_noise_deg))), at least radius_px, at most 64.
 /// radius_px when max_tilt_noise_deg is 0.
 int normal_radius_for(const NormalParams& params, float noise_px);

@@ -34,29 +34,40 @@ void NormalParams::validate() const {
 }
 
 float measure_depth_noise(const OrganizedCloud& cloud, float fx, std::vector<float>& scratch) {
-    constexpr int kStep = 3;                 // every third pixel of every third row
-    constexpr double kKeep = 0.9;            // the largest tenth are edges
+    constexpr int kStep = 3;        // every third pixel of every third row
+    constexpr int kSlope = 12;       // the surface's slope from the points this far either side
+    constexpr float kMaxSlope2 = 33.0f;  // tan^2 of 80 degrees: steeper is an edge, not a surface
+    constexpr double kKeep = 0.9;   // the largest tenth are edges
     // E|x| over the smallest 90% of |N(0, 1)|, times sqrt(6) (the second difference of three
     // independent samples has 6 times their variance): 0.6573 * 2.4495.
     constexpr double kGaussian = 1.6100;
     const int W = cloud.width, H = cloud.height;
     scratch.clear();
-    if (!(fx > 0) || W < 3 || H < 3) return 0.0f;
+    if (!(fx > 0) || W <= 2 * kSlope || H <= 2 * kSlope) return 0.0f;
     const std::uint8_t* const ok = cloud.valid.data();
     const float* const z = cloud.z.data();
-    // |d2(1/z)| * z * fx: the noise of 1/z (which a plane keeps linear in u and v) scaled to
-    // the point's depth and pixel footprint (sigma_z = z^2 sigma(1/z), footprint z / fx).
-    auto sample = [&](std::size_t a, std::size_t p, std::size_t b) {
-        if (!(ok[a] & ok[p] & ok[b])) return;
-        const float d2 = 1.0f / z[a] - 2.0f / z[p] + 1.0f / z[b];
-        scratch.push_back(std::fabs(d2) * z[p] * fx);
-    };
-    for (int v = 1; v + 1 < H; v += kStep) {
-        const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(W);
-        for (int u = 1; u + 1 < W; u += kStep) {
-            const std::size_t p = row + static_cast<std::size_t>(u);
-            sample(p - 1, p, p + 1);
-            sample(p - static_cast<std::size_t>(W), p, p + static_cast<std::size_t>(W));
+    const auto row = static_cast<std::size_t>(W);
+    for (int v = kSlope; v + kSlope < H; v += kStep) {
+        for (int u = kSlope; u + kSlope < W; u += kStep) {
+            const std::size_t p = static_cast<std::size_t>(v) * row + static_cast<std::size_t>(u);
+            const std::size_t du = kSlope, dv = kSlope * row;
+            if (!(ok[p] & ok[p - 1] & ok[p + 1] & ok[p - row] & ok[p + row] & ok[p - du] & ok[p + du] &
+                  ok[p - dv] & ok[p + dv]))
+                continue;
+            // The slope (depth per pixel footprint z / fx) in u and v, and the cos^2 of the
+            // angle between the surface's normal and the view that it gives.
+            const float footprint = z[p] / fx;
+            const float gu = (z[p + du] - z[p - du]) / (2.0f * kSlope * footprint);
+            const float gv = (z[p + dv] - z[p - dv]) / (2.0f * kSlope * footprint);
+            const float slope2 = gu * gu + gv * gv;
+            if (slope2 > kMaxSlope2) continue;
+            const float cos2 = 1.0f / (1.0f + slope2);
+            // |d2(1/z)| * z * fx: the noise of 1/z (which a plane keeps linear in u and v)
+            // in pixel footprints (sigma_z = z^2 sigma(1/z)); times cos^2: along the
+            // surface's normal (cos), over the distance between neighbours on it (1 / cos).
+            const float scale = z[p] * fx * cos2;
+            scratch.push_back(std::fabs(1.0f / z[p - 1] - 2.0f / z[p] + 1.0f / z[p + 1]) * scale);
+            scratch.push_back(std::fabs(1.0f / z[p - row] - 2.0f / z[p] + 1.0f / z[p + row]) * scale);
         }
     }
     if (scratch.size() < 64) return 0.0f;

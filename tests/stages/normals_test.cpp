@@ -140,14 +140,16 @@ TEST(NormalParams, Validate) {
 
 namespace {
 
-// The tilted plane of TiltedPlaneWithin2Degrees, its depth off by Gaussian noise of
-// `noise_px` pixel footprints (z / fx), and two raised boxes whose edges are no noise.
-OrganizedCloud noisy_plane(double noise_px, std::uint32_t seed) {
-    const double nx = -0.30, ny = -0.45, nz = -0.84;
-    const double len = std::sqrt(nx * nx + ny * ny + nz * nz);
-    const double d = nz / len * 1.5;
+constexpr double kTilted[3] = {-0.30, -0.45, -0.84};  // TiltedPlaneWithin2Degrees' plane
+constexpr double kFacing[3] = {0.0, 0.0, -1.0};       // a plane facing the camera
+
+// A plane of normal n through (0, 0, 1.5) with two boxes 10 cm before it (their edges are no
+// noise), its depth off by Gaussian noise of `noise_px` pixel footprints (z / fx).
+OrganizedCloud noisy_plane(const double (&n)[3], double noise_px, std::uint32_t seed) {
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double d = n[2] / len * 1.5;
     OrganizedCloud c = cast([&](float dx, float dy) {
-        const double t = d / ((nx * dx + ny * dy + nz) / len);
+        const double t = d / ((n[0] * dx + n[1] * dy + n[2]) / len);
         const bool box = (std::fabs(dx - 0.1f) < 0.05f || std::fabs(dx + 0.2f) < 0.04f) && std::fabs(dy) < 0.1f;
         return t > 0 ? static_cast<float>(t - (box ? 0.1 : 0.0)) : kInf;
     });
@@ -164,51 +166,72 @@ OrganizedCloud noisy_plane(double noise_px, std::uint32_t seed) {
     return c;
 }
 
+// cos^2 of the angle between the plane's normal and the view axis.
+double cos2(const double (&n)[3]) { return n[2] * n[2] / (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); }
+
+double median_tilt_deg(const OrganizedCloud& c, int radius_px, const double (&n)[3]) {
+    NormalParams p;
+    p.radius_px = radius_px;
+    p.max_tilt_noise_deg = 0;
+    NormalMap normals;
+    estimate_normals(p, c, normals);
+    std::vector<double> tilt;
+    for (std::size_t q = 0; q < c.size(); ++q)
+        if (normals.valid[q]) tilt.push_back(angle_deg(normals.nx[q], normals.ny[q], normals.nz[q], n[0], n[1], n[2]));
+    if (tilt.empty()) return 180.0;
+    std::nth_element(tilt.begin(), tilt.begin() + static_cast<std::ptrdiff_t>(tilt.size() / 2), tilt.end());
+    return tilt[tilt.size() / 2];
+}
+
 }  // namespace
 
-// measure_depth_noise gives back the noise put on a tilted plane with box edges on it,
-// whatever its level, and nothing for an exact one: the plane's slope and the boxes' edges
-// are not noise.
-TEST(DepthNoise, MeasuresTheGaussianNoiseOnATiltedPlaneWithEdges) {
+// measure_depth_noise gives back the noise put on a plane with box edges on it, whatever its
+// level, seen along the plane's normal over the neighbours' distance on it: noise x cos^2 of
+// the plane's tilt from the view (1 facing the camera, 0.71 for the tilted plane). An exact
+// plane measures nothing: its slope and the boxes' edges are not noise.
+TEST(DepthNoise, MeasuresTheGaussianNoiseOnPlanesWithEdges) {
     std::vector<float> scratch;
-    EXPECT_LT(measure_depth_noise(noisy_plane(0.0, 1), static_cast<float>(kK.fx), scratch), 0.02f);
+    const auto fx = static_cast<float>(kK.fx);
+    EXPECT_LT(measure_depth_noise(noisy_plane(kTilted, 0.0, 1), fx, scratch), 0.02f);
     for (const double noise : {0.3, 1.0, 2.5}) {
-        const float measured = measure_depth_noise(noisy_plane(noise, 7), static_cast<float>(kK.fx), scratch);
-        EXPECT_NEAR(measured, noise, 0.12 * noise) << "noise " << noise << " px";
+        EXPECT_NEAR(measure_depth_noise(noisy_plane(kFacing, noise, 7), fx, scratch), noise, 0.12 * noise)
+            << "facing, noise " << noise << " px";
+        const double expect = noise * cos2(kTilted);
+        EXPECT_NEAR(measure_depth_noise(noisy_plane(kTilted, noise, 7), fx, scratch), expect, 0.12 * expect)
+            << "tilted, noise " << noise << " px";
     }
     // Too few samples to say: 0.
     OrganizedCloud empty;
     empty.resize(kK.width, kK.height);
-    EXPECT_EQ(measure_depth_noise(empty, static_cast<float>(kK.fx), scratch), 0.0f);
-    EXPECT_EQ(measure_depth_noise(noisy_plane(1.0, 7), 0.0f, scratch), 0.0f);
+    EXPECT_EQ(measure_depth_noise(empty, fx, scratch), 0.0f);
+    EXPECT_EQ(measure_depth_noise(noisy_plane(kFacing, 1.0, 7), 0.0f, scratch), 0.0f);
 }
 
 // The radius: radius_px for a quiet camera, wider with the noise so that the tilt it causes
 // (noise / (sqrt(2) r) radians) stays under max_tilt_noise_deg, capped at 64; fixed when off.
+// On a noisy plane the radius chosen keeps the normals' tilt near that bound.
 TEST(DepthNoise, NormalRadiusGrowsWithTheNoiseFromTheLeastRadius) {
-    NormalParams p;  // radius 2, 12 degrees
+    NormalParams p;  // radius 2, 7 degrees
     EXPECT_EQ(normal_radius_for(p, 0.0f), 2);
-    EXPECT_EQ(normal_radius_for(p, 0.3f), 2);  // a Kinect v1
-    EXPECT_EQ(normal_radius_for(p, 1.8f), 6);  // 1.8 / (sqrt(2) tan 12 deg) = 5.99
+    EXPECT_EQ(normal_radius_for(p, 0.2f), 2);  // a Kinect v1 measures 0.1-0.2
+    EXPECT_EQ(normal_radius_for(p, 1.0f), 6);  // 1.0 / (sqrt(2) tan 7 deg) = 5.76
     EXPECT_EQ(normal_radius_for(p, 1000.0f), 64);
     p.radius_px = 8;
-    EXPECT_EQ(normal_radius_for(p, 1.8f), 8);
+    EXPECT_EQ(normal_radius_for(p, 1.0f), 8);
     p.radius_px = 2;
     p.max_tilt_noise_deg = 0;
-    EXPECT_EQ(normal_radius_for(p, 1.8f), 2);
-    // The tilt at the chosen radius is within the bound on a noisy plane.
-    p.max_tilt_noise_deg = 12;
+    EXPECT_EQ(normal_radius_for(p, 1.0f), 2);
+
+    p.max_tilt_noise_deg = 7;
     std::vector<float> scratch;
-    const OrganizedCloud c = noisy_plane(1.8, 3);
-    p.radius_px = normal_radius_for(p, measure_depth_noise(c, static_cast<float>(kK.fx), scratch));
-    NormalMap n;
-    estimate_normals(p, c, n);
-    std::vector<double> tilt;
-    for (std::size_t q = 0; q < c.size(); ++q)
-        if (n.valid[q]) tilt.push_back(angle_deg(n.nx[q], n.ny[q], n.nz[q], -0.30, -0.45, -0.84));
-    ASSERT_GT(tilt.size(), c.size() / 2);
-    std::nth_element(tilt.begin(), tilt.begin() + static_cast<std::ptrdiff_t>(tilt.size() / 2), tilt.end());
-    EXPECT_LT(tilt[tilt.size() / 2], 12.0);  // the median over the plane and the boxes
+    for (const auto* n : {&kFacing, &kTilted}) {
+        const OrganizedCloud c = noisy_plane(*n, 1.5, 3);
+        const int r = normal_radius_for(p, measure_depth_noise(c, static_cast<float>(kK.fx), scratch));
+        EXPECT_GT(r, 4);
+        // The median of a tilt whose two components have 7 degrees' spread: 8.2 degrees.
+        EXPECT_LT(median_tilt_deg(c, r, *n), 10.0) << "radius " << r;
+        EXPECT_GT(median_tilt_deg(c, 2, *n), 20.0) << "radius 2 (test premise)";
+    }
 }
 
 // Smoothing: on a noisy plane the averaged normals lie closer to the true one than the raw

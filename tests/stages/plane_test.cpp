@@ -200,6 +200,45 @@ TEST(RemoveSupportPlane, TiltedTable_RemovesTableKeepsBoxesAndTheirFeet) {
     }
 }
 
+// A camera looking down at 80 degrees (an OCID-like pile seen from above): the table faces
+// up in the image only by cos 80 = 0.17, which the support's facing test must still take,
+// while a wall facing any camera that looks down has -n_y <= 0.
+TEST(RemoveSupportPlane, CameraLookingAlmostStraightDown_TheTableIsTheSupport) {
+    Scene s;
+    s.width = 320;
+    s.height = 240;
+    s.pitch_rad = 80.0f * 3.14159265f / 180.0f;
+    s.table_y = 1.0f;
+    s.table_near = -0.8f;
+    s.table_far = 1.2f;
+    s.table_half_width = 1.0f;
+    SceneBox a;
+    a.x = 0.1f;
+    a.z = 0.2f;
+    s.boxes = {a};
+    std::vector<int> truth;
+    Prepared f = prepared(render_scene(s, &truth));
+    PlaneWorkspace ws;
+    std::vector<std::uint8_t> classes;
+    PlaneParams old_facing;
+    old_facing.min_up = 0.25f;
+    ASSERT_FALSE(f.remove_plane(old_facing, ws, classes).found) << "-n_y >= 0.25 should refuse it (test premise)";
+    const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
+    ASSERT_TRUE(r.found);
+    EXPECT_NEAR(r.support.ny, -std::cos(s.pitch_rad), 0.02f);
+    EXPECT_NEAR(r.support.nz, -std::sin(s.pitch_rad), 0.02f);
+    std::size_t table = 0, table_kept = 0, box = 0, box_kept = 0;
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        const bool kept = classes[p] != kPlaneRemoved;
+        if (truth[p] == kTruthTable) { ++table; table_kept += kept; }
+        if (truth[p] == kTruthBox0) { ++box; box_kept += kept; }
+    }
+    ASSERT_GT(table, 10000u);
+    EXPECT_LT(static_cast<double>(table_kept) / static_cast<double>(table), 0.005);
+    ASSERT_GT(box, 500u);
+    EXPECT_GT(static_cast<double>(box_kept) / static_cast<double>(box), 0.97);
+}
+
 // A box standing where the frame's bottom cuts it, on a table that runs on out of the
 // frame toward the camera: its nearest points' feet (moved down the table's normal) fall
 // below the frame, off the image. They are tested on the frame's bottom row, which the
