@@ -185,6 +185,15 @@ struct SegmentParams {
                                        ///< (within 25 degrees of the support plane): a wall;
                                        ///< an object on the table the frame cuts shows its
                                        ///< top (its top edge counts for all); [0, 1]
+    /// Low supports: a kept segment no higher than low_support_max_m over the support that
+    /// covers low_support_min_area_m2 of it and holds two kept segments or more (they touch
+    /// it and rise scope_contact_m above it) is a board or a tray lying on the floor, a
+    /// second support under the objects: background, not an object. 0.1 m: a 3 cm board on
+    /// a carpet, a tray's 4 cm rim, and the noise of the segment's highest point; [0, 0.5],
+    /// 0 = off.
+    float low_support_max_m = 0.1f;
+    float low_support_min_area_m2 = 0.07f;  ///< ... its area on the support at least (a book is
+                                            ///< 0.06); > 0
 
     void validate() const;  ///< throws ParamError naming the field
 };

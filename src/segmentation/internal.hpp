@@ -92,6 +92,7 @@ struct SegmentWorkspace::Buffers {
     std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
                                                   ///< bottom; pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
+    std::vector<int> scope_held;  ///< per segment, the kept segments it holds (low supports)
     /// What the scope counts of one segment in one strip of rows (scope_lo, hi, ...).
     struct ScopeCounts {
         float lo, hi;

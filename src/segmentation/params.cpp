@@ -78,6 +78,9 @@ void SegmentParams::validate() const {
     require(occluded_max_deg > 0 && occluded_max_deg < 90, "occluded_max_deg", occluded_max_deg, "in (0, 90)");
     require(scope_contact_m > 0, "scope_contact_m", scope_contact_m, "> 0");
     require(scope_max_height_m > 0, "scope_max_height_m", scope_max_height_m, "> 0");
+    require(low_support_max_m >= 0 && low_support_max_m <= 0.5f, "low_support_max_m", low_support_max_m,
+            "in [0, 0.5]");
+    require(low_support_min_area_m2 > 0, "low_support_min_area_m2", low_support_min_area_m2, "> 0");
     require(scope_max_outside >= 0 && scope_max_outside <= 1, "scope_max_outside", scope_max_outside, "in [0, 1]");
     require(scope_upright_share >= 0 && scope_upright_share <= 1, "scope_upright_share", scope_upright_share, "in [0, 1]");
 }

@@ -297,12 +297,11 @@ void count_upright(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 /// A box seen from steeply above shows its top alone, its sides in shadow or edge-on, and
 /// its body hides its foot. A box hanging over the table, seen obliquely, shows the table
 /// under its middle. Cost: a few reads per segment.
-bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::size_t l) {
-    const int p = ws.scope_any_px[l];
-    if (p < 0 || ws.sizes[l] == 0) return false;
+/// The organized grid's scale at pixel p: pixels per unit of x/z (fx) and of y/z (fy), from
+/// a neighbour with depth on either side; false where p has none. Cost: a few reads.
+bool grid_scale(const Ctx& x, int p, float& fx, float& fy) {
     const int W = x.W, u = p % W, v = p / W;
     const auto P = static_cast<std::size_t>(p);
-    // The grid's scale at p: pixels per unit of x/z (y/z), from a neighbour with depth.
     auto scale = [&](int du, int dv) -> float {
         const int uu = u + du, vv = v + dv;
         if (uu < 0 || uu >= W || vv < 0 || vv >= x.H) return 0.0f;
@@ -311,10 +310,20 @@ bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::s
         const float d = du ? x.c.x[q] / x.c.z[q] - x.c.x[P] / x.c.z[P] : x.c.y[q] / x.c.z[q] - x.c.y[P] / x.c.z[P];
         return std::fabs(d) > 1e-9f ? static_cast<float>(du + dv) / d : 0.0f;
     };
-    float fx = scale(1, 0), fy = scale(0, 1);
+    fx = scale(1, 0);
+    fy = scale(0, 1);
     if (!(fx > 0.0f)) fx = scale(-1, 0);
     if (!(fy > 0.0f)) fy = scale(0, -1);
-    if (!(fx > 0.0f) || !(fy > 0.0f)) return false;
+    return fx > 0.0f && fy > 0.0f;
+}
+
+bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::size_t l) {
+    const int p = ws.scope_any_px[l];
+    if (p < 0 || ws.sizes[l] == 0) return false;
+    const int W = x.W, u = p % W, v = p / W;
+    const auto P = static_cast<std::size_t>(p);
+    float fx = 0.0f, fy = 0.0f;
+    if (!grid_scale(x, p, fx, fy)) return false;
     const double m = ws.sizes[l];
     const auto cx = static_cast<float>(ws.scope_sx[l] / m), cy = static_cast<float>(ws.scope_sy[l] / m),
                cz = static_cast<float>(ws.scope_sz[l] / m);
@@ -370,6 +379,42 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     }
 }
 
+/// Segment l's area on the support, square metres: its pixels times the area one pixel covers
+/// at its mean point, a plane parallel to the support seen along the ray to that point.
+/// 0 where the grid's scale is unknown. Cost: a few reads.
+double area_on_support(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::size_t l) {
+    float fx = 0.0f, fy = 0.0f;
+    if (ws.sizes[l] == 0 || ws.scope_any_px[l] < 0 || !grid_scale(x, ws.scope_any_px[l], fx, fy)) return 0.0;
+    const double m = ws.sizes[l];
+    const double cx = ws.scope_sx[l] / m, cy = ws.scope_sy[l] / m, cz = ws.scope_sz[l] / m;
+    const double ray = std::sqrt(cx * cx + cy * cy + cz * cz);
+    const double cos_view = std::fabs(pl.nx * cx + pl.ny * cy + pl.nz * cz) / ray;
+    if (!(cos_view > 0.05)) return 0.0;
+    return m * (cz / fx) * (cz / fy) / cos_view;
+}
+
+/// Low supports (SegmentParams::low_support_max_m): kept segments that lie low, cover
+/// low_support_min_area_m2 of the support and hold two kept segments or more (that touch
+/// them and rise scope_contact_m higher) are left out, keep 0: a board or a tray on the
+/// floor. What they hold stays kept. Cost: O(n) and one pass over ws.edges.
+void drop_low_supports(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
+    const SegmentParams& prm = x.prm;
+    if (!(prm.low_support_max_m > 0)) return;
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    auto& keep = ws.scope_keep;
+    auto low = [&](std::size_t l) { return keep[l] == 3 && ws.scope_hi[l] <= prm.low_support_max_m; };
+    std::vector<int>& held = ws.scope_held;
+    held.assign(L, 0);
+    for (const std::uint64_t e : ws.edges) {
+        const auto a = static_cast<std::size_t>(e >> 33), b = static_cast<std::size_t>((e >> 1) & 0xffffffffu);
+        if (keep[a] != 3 || keep[b] != 3) continue;
+        if (low(a) && ws.scope_hi[b] > ws.scope_hi[a] + prm.scope_contact_m) ++held[a];
+        if (low(b) && ws.scope_hi[a] > ws.scope_hi[b] + prm.scope_contact_m) ++held[b];
+    }
+    for (std::size_t l = 1; l < L; ++l)
+        if (held[l] >= 2 && area_on_support(x, pl, ws, l) >= prm.low_support_min_area_m2) keep[l] = 0;
+}
+
 /// Clears the labels of the segments not kept. Returns those of min_points or more (within
 /// the frame's edge). Cost: one parallel pass over the pixels.
 int clear_out_of_scope(const SegmentParams& prm, SegmentBuffers& ws, int n) {
@@ -398,6 +443,7 @@ int keep_held(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     measure_scope(x, pl, edge, far_z, ws, n);
     count_upright(x, pl, ws, n);
     decide_scope(x, pl, ws, n);
+    drop_low_supports(x, pl, ws, n);
     return clear_out_of_scope(x.prm, ws, n);
 }
 

@@ -169,3 +169,54 @@ TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
     EXPECT_NE(ib, 0);
     EXPECT_EQ(stats.out_of_scope, 0);
 }
+
+// A board 2 cm thick lying on the table, 60 x 40 cm, with two boxes standing on it, and a
+// book (30 x 22 cm, 3 cm thick) with nothing on it: the board lies low, covers 0.24 m^2 and
+// holds two segments that rise over it, so it is a second support, background; the boxes on
+// it stay objects, and so does the book, which holds nothing.
+TEST(SegmentObjects, Scope_BoardHoldingObjectsIsASupportNotAnObject) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox board;
+    board.x = 0.05f;
+    board.z = 1.15f;
+    board.w = 0.6f;
+    board.h = 0.02f;
+    board.d = 0.4f;
+    board.r = 180; board.g = 180; board.b = 170;
+    SceneBox a;
+    a.x = -0.1f;
+    a.z = 1.1f;
+    a.w = a.h = a.d = 0.12f;
+    a.lift = board.h;  // standing on the board
+    SceneBox b = a;
+    b.x = 0.18f;
+    b.z = 1.2f;
+    b.r = 30; b.g = 60; b.b = 220;
+    SceneBox book;
+    book.x = -0.3f;
+    book.z = 0.75f;
+    book.w = 0.3f;
+    book.h = 0.03f;
+    book.d = 0.22f;
+    book.r = 40; book.g = 160; book.b = 60;
+    s.boxes = {board, a, b, book};
+    const PlaneStage st = up_to_the_plane(s);
+    auto run = [&](float low_support_max_m) {
+        SegmentParams params;
+        params.low_support_max_m = low_support_max_m;
+        return segment(st, params);
+    };
+    int board_id = 0;
+    const LabelImage off = run(0.0f);
+    ASSERT_GT(dominant_share(off.labels, st.truth, kTruthBox0, &board_id), 0.8);
+    ASSERT_NE(board_id, 0) << "without the rule the board should be an object (test premise)";
+
+    const LabelImage out = run(SegmentParams{}.low_support_max_m);
+    dominant_share(out.labels, st.truth, kTruthBox0, &board_id);
+    EXPECT_EQ(board_id, 0) << "the board is an object";
+    for (int i = 1; i <= 3; ++i) {
+        int id = 0;
+        EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + i, &id), 0.9) << "box " << i;
+        EXPECT_NE(id, 0) << "box " << i << " (3: the book) is no object";
+    }
+}
