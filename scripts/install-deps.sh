@@ -41,6 +41,8 @@
 #                                                  colour/depth/camera_info synchronizer; built only when found
 #   libvisualization-msgs-dev libdiagnostic-msgs-dev  its boxes (MarkerArray) and its /diagnostics
 #   python3-roslaunch python3-rosmaster rosout     roscore and roslaunch: the node's tests start a roscore
+#   python3-rosbag python3-sensor-msgs             the batch's bag test writes its bags with rosbag's
+#                                                  own Python writer (tests/python/test_batch_bags.py)
 #   (`run --video` uses libopencv-dev's videoio, whose FFmpeg backend Debian builds in)
 set -euo pipefail
 
@@ -95,6 +97,8 @@ packages=(
   libvisualization-msgs-dev
   libdiagnostic-msgs-dev
   python3-roslaunch
+  python3-rosbag
+  python3-sensor-msgs
   python3-rosmaster
   rosout
 )

@@ -3,7 +3,8 @@
     python3 -m wul3d.batch ROOT --out OUT [--scheduler ADDRESS | --workers N] [run options]
 
 Finds every sequence under ROOT (a TUM sequence, an OCID sequence, an OSD-0.2-depth tree, a
-BOP scene, a folder of frame folders, or ROOT itself when it is one frame), runs each as one Dask task with wul3d.run (the library's run loop, the
+BOP scene, a ROS 1 bag, a folder of frame folders, or ROOT itself when it is one frame or one
+bag), runs each as one Dask task with wul3d.run (the library's run loop, the
 same outputs as `wul3d run`), and writes OUT/<sequence path relative to ROOT>/ in the layout
 of `wul3d run`, and OUT/batch.json with per-sequence and total figures and, where the
 frames carry label.png, the UOIS table.
@@ -135,6 +136,13 @@ def _is_dir(path) -> bool:
     return st is not None and stat.S_ISDIR(st.st_mode)
 
 
+def _is_bag(path) -> bool:
+    """A ROS 1 bag file as the batch finds one: a plain file (links followed) named *.bag,
+    not hidden. `wul3d run` checks its first bytes (`#ROSBAG V2.0`) when it reads it."""
+    name = os.path.basename(os.fsdecode(path))
+    return name.endswith(".bag") and not name.startswith(".") and _is_file(path)
+
+
 def _is_dataset_sequence(d) -> bool:
     """A dataset as downloaded that `wul3d run` takes whole: an OCID sequence (rgb/ and
     depth/ holding result_*.png), an OSD-0.2-depth tree (image_color/) or a BOP scene
@@ -163,6 +171,8 @@ class Discovery:
 
 def _discover(root) -> Discovery:
     root = os.fsdecode(root)
+    if _is_bag(root):
+        return Discovery(["."], [], [])
     st = _stat(root)
     if st is None or not stat.S_ISDIR(st.st_mode):
         raise FileNotFoundError(f"{text(root)}: no such folder")
@@ -184,11 +194,14 @@ def _discover(root) -> Discovery:
         except OSError as e:
             unread.append((rel, e.strerror or type(e).__name__))
             return
-        subdirs = []
+        subdirs, bags = [], []
         for e in entries:
             if e.name.startswith("."):
                 continue
             cst = _stat(e.path)
+            if cst is not None and stat.S_ISREG(cst.st_mode) and e.name.endswith(".bag"):
+                bags.append(rel + (e.name,))
+                continue
             if cst is None or not stat.S_ISDIR(cst.st_mode):
                 continue
             try:
@@ -199,6 +212,7 @@ def _discover(root) -> Discovery:
         if _is_tum(path) or _is_dataset_sequence(path):
             found.append(rel)
             return
+        found.extend(bags)  # each bag a sequence of its own
         frames = {name for name, _, _ in subdirs if _is_frame(os.path.join(path, name))}
         if frames:
             found.append(rel)
@@ -237,9 +251,11 @@ def discover(root) -> list:
     """The sequences under `root`, as paths relative to it ("." for root itself), sorted.
 
     A TUM sequence (rgb.txt and depth.txt), an OCID sequence, an OSD-0.2-depth tree or a
-    BOP scene (docs/INPUTS.md, sections 5 and 6) is one sequence; a folder whose sub-folders are
-    frames (depth.png) is one sequence of those frames, as `wul3d run FOLDER` reads it; root
-    itself being one frame is a sequence of one. Other folders are searched further (a
+    BOP scene (docs/INPUTS.md, sections 5 and 6) is one sequence; so is each ROS 1 bag
+    (`*.bag`, section 4; its output folder keeps the name, OUT/<path>/rec.bag/), and root
+    itself may be one; a folder whose sub-folders are frames (depth.png) is one sequence of
+    those frames, as `wul3d run FOLDER` reads it; root itself being one frame is a sequence
+    of one. Other folders are searched further (a
     folder can hold frames and sequences of its own). Hidden folders are skipped.
     Symbolic links to folders are followed, each folder once (by device and inode): a loop
     back into the tree, or two links to one folder, find nothing twice; a sequence reached
@@ -738,7 +754,7 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
     content, also written to OUT/batch.json.
 
     Args:
-        root: the dataset folder.
+        root: the dataset folder (or one bag file).
         out: the output folder (shared by every worker). It may not be `root`, lie inside it
             or hold it, nor any folder a link under `root` leads to (BatchError, before
             anything is written); it is locked for the whole batch (BatchError when another
