@@ -98,12 +98,6 @@ struct SegmentParams {
                                  ///< longer than color_max_compact allows are one material
                                  ///< (they interleave); the same tests judge the split
                                  ///< between two materials: stripes beside a plain box
-    bool color_rejoin = true;  ///< after the colour cue, the convexity merge again between
-                               ///< segments that it found apart and that are one material
-                               ///< (their mean colours' chromaticities within
-                               ///< color_min_distance, brightness within color_min_step):
-                               ///< a box's pieces that the wall of the box lying on it
-                               ///< kept apart
     // Stacks (needs the support plane; not kmeans): a segment whose upward faces lie at two
     // heights over the support, nothing facing up between them, is two objects, one resting
     // on the other; it is cut just over the lower one's top.
@@ -130,15 +124,7 @@ struct SegmentParams {
     bool rim_islands = true;            ///< object regions no segment reached (a small cup's
                                         ///< inside at --decimate 2, every pixel on a crease)
                                         ///< are candidates too; those joined to nothing are
-                                        ///< dropped unless lone (island_min_width_px)
-    /// Lone islands: an island the rim test joined to nothing is an object of its own (a
-    /// bowl's inside whose rim fitted no circle, an object's top seen between nearer ones)
-    /// when no segment continues into it with continuous depth, it lies behind every segment
-    /// it meets (not in depth between two, as the mixed pixels of an occluding edge and the
-    /// pieces of a broken surface do), and it is this wide at least: 2 x pixels / outline
-    /// pairs, in input pixels (scaled with --decimate); a band of mixed pixels is narrower.
-    /// It holds min_points too. >= 0, 0 = no island is kept.
-    int island_min_width_px = 6;
+                                        ///< dropped
     bool rim_far = true;                ///< a second candidate circle per pair, fitted to the
                                         ///< front's edge and the inside's far outline at the
                                         ///< rim's height (its far rim), when the front spans
@@ -221,10 +207,8 @@ struct SegmentStats {
     int texture_splits = 0;  ///< of color_splits, those between a texture and another
                              ///< material (color_textures)
     int stack_splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
-    int merges = 0;        ///< segment pairs joined across a non-concave boundary (and
-                           ///< after the colour cue: color_rejoin)
+    int merges = 0;        ///< segment pairs joined across a non-concave boundary
     int containers = 0;    ///< insides joined to their container across the rim
-    int islands_kept = 0;  ///< lone islands kept as objects (island_min_width_px)
     int occluded = 0;      ///< parts of one surface joined across the object before them
     std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
     std::size_t reattached = 0;  ///< cut pixels and feet re-attached

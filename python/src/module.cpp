@@ -177,7 +177,6 @@ py::dict stats_dict(const Result& r) {
     out["segments"] = r.segment_stats.segments;
     out["merges"] = r.segment_stats.merges;
     out["containers"] = r.segment_stats.containers;
-    out["islands_kept"] = r.segment_stats.islands_kept;
     out["occluded_joins"] = r.segment_stats.occluded;
     out["gaps_filled"] = r.segment_stats.gaps_filled;
     out["color_splits"] = r.segment_stats.color_splits;

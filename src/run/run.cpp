@@ -71,7 +71,6 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"segments", r.segment_stats.segments},
             {"merges", r.segment_stats.merges},
             {"containers", r.segment_stats.containers},
-            {"islands_kept", r.segment_stats.islands_kept},
             {"occluded_joins", r.segment_stats.occluded},
             {"gaps_filled", r.segment_stats.gaps_filled},
             {"color_splits", r.segment_stats.color_splits},

@@ -651,7 +651,7 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
 }
 
 /// Part 1 of each split segment takes a new label, n + 1, n + 2, ... in segment order (not
-/// thread order), with the split segment's ws.origin. Returns the splits, and adds those by
+/// thread order). Returns the splits, and adds those by
 /// material to `by_material`. Cost: one pass over the split segments' pixels.
 int number_splits(SegmentBuffers& ws, int n, int& by_material) {
     int splits = 0, next = n;
@@ -659,7 +659,6 @@ int number_splits(SegmentBuffers& ws, int n, int& by_material) {
         if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
         by_material += ws.split[static_cast<std::size_t>(l)] == kSplitByMaterial;
         const int id = ++next;
-        ws.origin[static_cast<std::size_t>(id)] = ws.origin[static_cast<std::size_t>(l)];
         const int o = ws.offsets[static_cast<std::size_t>(l)];
         const int m = ws.offsets[static_cast<std::size_t>(l) + 1] - o;
         for (int i = 0; i < m; ++i) {
@@ -711,14 +710,10 @@ int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, i
 /// same tests judge a split between the segment's materials (split_by_materials). A second
 /// round tries the two parts of each split segment again: three flush boxes of three colours
 /// need two cuts. In: ws.label (1..n with gaps). Out: ws.label with the new parts numbered
-/// n + 1, n + 2, ... (round 1's in segment order, then round 2's), and ws.origin, each
-/// label's segment before the cue; `by_material` counts the splits between materials. Cost:
+/// n + 1, n + 2, ... (round 1's in segment order, then round 2's); `by_material` counts the splits between materials. Cost:
 /// split_round once, twice when it split anything.
 int color_splits(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, int& by_material) {
     by_material = 0;
-    // Each label's segment before the cue; a round adds at most one label per segment.
-    ws.origin.resize(4 * static_cast<std::size_t>(n) + 1);
-    for (int l = 0; l <= n; ++l) ws.origin[static_cast<std::size_t>(l)] = l;
     ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
     const int first = split_round(x, support, ws, n, by_material);
     if (first == 0) return 0;

@@ -3,7 +3,7 @@
 // a depth step, where neither the crease test nor the merge can join them. Where the front
 // segment's edge along the step is a level circular arc on the support (circle_fit.hpp) and
 // the back segment stands inside that circle and reaches up to it, the back is the front's
-// inside and joins it. Regions no segment reached take part as islands (lone_islands.cpp).
+// inside and joins it. Regions no segment reached take part as islands (islands.cpp).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -351,20 +351,17 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 /// another's circular, level edge across a depth step, lying inside that circle and reaching
 /// up to it, is the other's inside (a bowl's or a cup's) and joins it. With rim_islands the
 /// regions no segment reached take part as segments n + 1, ... (add_islands), and after the
-/// joins those that joined no segment are lone objects or unlabelled again
-/// (keep_lone_islands): the root of a joined set is its smallest label, so what is left above
-/// n joined only islands; n grows by the islands when any is kept. In: ws.label (1..n with
-/// gaps). Out: ws.label with the insides joined. Cost: one pass over the pixels and a sort of
-/// the boundary pairs; then per candidate a few passes over its boundary, and one over the
-/// rows of the candidates' insides; with islands, add_islands and keep_lone_islands.
+/// joins those that joined no segment are unlabelled again (drop_islands): the root of a
+/// joined set is its smallest label, so what is left above n joined only islands. In:
+/// ws.label (1..n with gaps). Out: ws.label with the insides joined. Cost: one pass over the
+/// pixels and a sort of the boundary pairs; then per candidate a few passes over its
+/// boundary, and one over the rows of the candidates' insides; with islands, add_islands and
+/// drop_islands.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     if (!support || x.prm.rim_min_boundary <= 0 || n < 1) return;
     const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
     stats.containers = join_rims(x, *support, ws, n + islands);
-    if (islands > 0) {
-        stats.islands_kept = keep_lone_islands(x, ws, n, islands);
-        if (stats.islands_kept > 0) n += islands;
-    }
+    if (islands > 0) drop_islands(x, ws, n);
 }
 
 }  // namespace wul3d::detail

@@ -63,10 +63,6 @@ struct SegmentWorkspace::Buffers {
     std::vector<int> by_size;          ///< colour cue: the segments tried, largest first
     std::vector<std::uint64_t> edges;  ///< (segment pair, concave bit) per boundary pair
     std::vector<int> parent;           ///< union-find over segments
-    std::vector<int> origin;           ///< colour cue: the segment (before it) each label
-                                       ///< comes from
-    std::vector<std::array<double, 4>> material;  ///< rejoin: per segment, sums of r, g, b
-                                                  ///< and the pixels
     std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
                                                                   ///< offset per line (steps)
     std::vector<std::uint8_t> occluded_outline;  ///< occlusion: 1 = outline pixel, one row
@@ -78,8 +74,6 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
     std::vector<int> rim_next;         ///< candidates of one back segment, linked
     std::vector<int> rim_far_px;       ///< the back's far rim, of the pair being fitted
-    std::vector<int> island_pixels, island_outline;  ///< lone islands: per island
-    std::vector<std::uint8_t> island_lone;           ///< 1 = kept
     // Floor gaps:
     std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
     std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
@@ -348,19 +342,14 @@ using Rule = void (*)(const Ctx& x, const Plane* support, SegmentBuffers& ws, in
 void merge_segments(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Containers (containers.cpp; SegmentParams, "Containers"): joins a container's inside,
-/// seen over its rim, to the container; with rim_islands, keeps the lone islands
-/// (lone_islands.cpp). Nothing without a support. stats.containers, islands_kept.
+/// seen over its rim, to the container; with rim_islands, the regions no segment reached
+/// take part (islands.cpp). Nothing without a support. stats.containers.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
-/// The colour cue (colour_cue.cpp; hybrid): splits segments in two by colour; ws.origin
-/// holds each label's segment before the cue. stats.color_splits, texture_splits (those
+/// The colour cue (colour_cue.cpp; hybrid): splits segments in two by colour.
+/// stats.color_splits, texture_splits (those
 /// between a texture and another material, SegmentParams::color_textures).
 void split_by_colour(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
-
-/// The convexity merge again after the colour cue split anything (merge.cpp;
-/// SegmentParams::color_rejoin), between the parts of different segments that are one
-/// material. Adds to stats.merges.
-void rejoin_materials(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Stacks (stacks.cpp; SegmentParams, "Stacks"; `support` not null): cuts a segment whose
 /// upward faces lie at two heights in two. stats.stack_splits.
@@ -378,19 +367,15 @@ void join_occluded(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& 
 /// labels of the segments the support does not hold. stats.support_scope, out_of_scope.
 void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
-// ---- islands (lone_islands.cpp), for the container rule ------------------------------------
+// ---- islands (islands.cpp), for the container rule -----------------------------------------
 
 /// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
 /// segment reached, of min_seed_points or more, become segments n + 1, ... for the rim
 /// test. Returns the islands added.
 int add_islands(const Ctx& x, SegmentBuffers& ws, int n);
 
-/// Lone islands (SegmentParams::island_min_width_px): of the islands n + 1 .. n + islands in
-/// ws.label, those the rim test joined to nothing, keeps each that meets no segment across
-/// continuous depth, lies behind every segment it meets, is island_min_width_px wide (2 x
-/// pixels / outline pairs) or more and holds min_points; unlabels the others. Returns the
-/// islands kept. Cost: a vectorized test per row, four neighbours of each island pixel, and
-/// a pass over the rows that hold islands.
-int keep_lone_islands(const Ctx& x, SegmentBuffers& ws, int n, int islands);
+/// The islands above label n that the rim test joined to nothing are unlabelled. Cost: a
+/// vectorized test per row, and a pass over the rows that hold islands.
+void drop_islands(const Ctx& x, SegmentBuffers& ws, int n);
 
 }  // namespace wul3d::detail

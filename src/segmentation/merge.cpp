@@ -1,8 +1,6 @@
 // The convexity merge (LCCP's): segments that meet along a depth-continuous boundary that
 // is mostly not concave are one object. Noise cuts an object along creases it does not have
-// (a box's front face from its top, a tin's rim); two objects meet at a concave fold. After
-// the colour cue the merge runs again between the parts of different segments that are one
-// material (color_rejoin), as the cue may have parted what kept them apart.
+// (a box's front face from its top, a tin's rim); two objects meet at a concave fold.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -100,49 +98,6 @@ int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
 
 void merge_segments(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
-}
-
-/// The convexity merge again after the colour cue (color_rejoin), between segments that
-/// came from different segments before it (ws.origin: what the cue parted stays parted)
-/// and are one material by the cue's measures: the chromaticities of their mean colours
-/// within color_min_distance and, with the brightness step on, their mean brightness within
-/// color_min_step. A box with another lying on it can come out of the crease cuts in two
-/// pieces, and the first merge kept them apart because the upper box's wall, a concave
-/// crease, ran along their boundary too; once the cue has made the upper box a segment of
-/// its own, the pieces' boundary is their own convex edge. Cost: one pass over the rows with
-/// labels for the segments' mean colours, then merge_convex's.
-void rejoin_materials(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    const SegmentParams& prm = x.prm;
-    if (stats.color_splits == 0 || !prm.color_rejoin) return;
-    ws.material.assign(static_cast<std::size_t>(n) + 1, {0, 0, 0, 0});
-    for (int v = 0; v < x.H; ++v) {
-        const int* const row = ws.label.data() + static_cast<std::ptrdiff_t>(v) * x.W;
-        if (!row_has_label(row, 0, x.W)) continue;
-        for (int u = 0; u < x.W; ++u) {
-            if (row[u] == 0) continue;
-            const std::size_t p = static_cast<std::size_t>(v) * x.W + u;
-            std::array<double, 4>& m = ws.material[static_cast<std::size_t>(row[u])];
-            m[0] += x.c.r[p], m[1] += x.c.g[p], m[2] += x.c.b[p], m[3] += 1;
-        }
-    }
-    // The mean colour's chromaticity and brightness.
-    auto material = [&](int l, double (&c)[3]) {
-        const std::array<double, 4>& m = ws.material[static_cast<std::size_t>(l)];
-        const double r = m[0] / m[3], g = m[1] / m[3], b = m[2] / m[3];
-        chromaticity(r, g, b, c);
-        return r + g + b + kDark;
-    };
-    stats.merges += merge_convex(x, ws, n, [&](int a, int b) {
-        if (ws.origin[static_cast<std::size_t>(a)] == ws.origin[static_cast<std::size_t>(b)]) return false;
-        double ca[3], cb[3];
-        const double ba = material(a, ca), bb = material(b, cb);
-        double d2 = 0;
-        for (int k = 0; k < 3; ++k) d2 += (ca[k] - cb[k]) * (ca[k] - cb[k]);
-        if (d2 >= static_cast<double>(prm.color_min_distance) * prm.color_min_distance) return false;
-        const bool brightness_step = prm.color_min_step > 1 &&
-                                     std::max(ba, bb) >= static_cast<double>(prm.color_min_step) * std::min(ba, bb);
-        return !brightness_step;
-    });
 }
 
 }  // namespace wul3d::detail

@@ -70,7 +70,6 @@ void SegmentParams::validate() const {
     require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
     require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
     require(rim_far_agree > 0, "rim_far_agree", rim_far_agree, "> 0");
-    require(island_min_width_px >= 0, "island_min_width_px", island_min_width_px, ">= 0, 0 = off");
     require(gap_max_px >= 0, "gap_max_px", gap_max_px, ">= 0");
     require(occluded_min_lines >= 0, "occluded_min_lines", occluded_min_lines, ">= 0");
     require(occluded_max_offset > 0, "occluded_max_offset", occluded_max_offset, "> 0");

@@ -68,7 +68,6 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     rule(geometric, ms.merge, merge_segments);
     rule(geometric, ms.containers, join_containers);
     rule(hybrid, ms.color, split_by_colour);
-    rule(hybrid, ms.color, rejoin_materials);
     rule(geometric && support, ms.stacks, split_stacks);
     rule(geometric, ms.gaps, fill_floor_gaps);
     rule(geometric, ms.occluded, join_occluded);

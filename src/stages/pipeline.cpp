@@ -53,7 +53,6 @@ PipelineParams PipelineParams::stage_params() const {
     g.gap_max_px = area(segmentation.gap_max_px);
     g.merge_min_boundary = length(segmentation.merge_min_boundary, 1);
     g.rim_min_boundary = length(segmentation.rim_min_boundary, 3);
-    g.island_min_width_px = length(segmentation.island_min_width_px, 1);
     s.objects.min_points = area(objects.min_points);
     return s;
 }

@@ -186,7 +186,7 @@ Segmented segment_at(const SegmentParams& params, const OrganizedCloud& cloud, c
     Segmented r;
     r.labels = out.labels;
     r.stats = {s.segments,    s.color_splits, s.texture_splits, s.stack_splits,
-               s.merges,      s.containers,   s.islands_kept,   s.occluded,
+               s.merges,      s.containers,   s.occluded,
                static_cast<long long>(s.gaps_filled), static_cast<long long>(s.reattached),
                s.support_scope, s.out_of_scope};
     return r;

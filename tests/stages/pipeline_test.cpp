@@ -370,28 +370,6 @@ TEST(GeneratedScene, NoisyActiveStereoDepth_TheMeasuredNoiseWidensTheNormalsAndF
     EXPECT_LT(static_cast<double>(in_object), 0.05 * static_cast<double>(table));
 }
 
-// A generated scene (eval/scenegen.py seed 2088, of the range 2000-2099 generated to check
-// the rule, rendered here): a box with a checked print and another box lying on it. The
-// crease along the upper box's wall cuts the lower box in two pieces, and the convexity
-// merge keeps them apart, since that wall runs along their boundary too; the colour cue
-// then parts the upper box from the piece it was joined to. Without color_rejoin the lower
-// box stays in two objects; with it the pieces, now meeting along their own convex edge,
-// are one.
-TEST(GeneratedScene, BoxUnderABox_PiecesRejoinedAfterTheColourCue) {
-    TempDir dir;
-    const GeneratedFrame g = render_generated(dir, 2088);
-    auto lower_box = [&](bool rejoin) {
-        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.color_rejoin = rejoin; });
-        // truth label 4: the lower box; its share in one object, and the merges
-        return std::pair{dominant_object(r.objects, g.truth, 4).second, r.segment_stats.merges};
-    };
-    const auto [without, merges_without] = lower_box(false);
-    ASSERT_LT(without, 0.75) << "the lower box should be in two pieces without the rule (test premise)";
-    const auto [with, merges_with] = lower_box(true);
-    EXPECT_GT(with, 0.9) << "the lower box's pieces were not rejoined";
-    EXPECT_EQ(merges_with, merges_without + 1);
-}
-
 // A generated scene (eval/scenegen.py tune seed 23): two plain boxes flush side by side, one
 // hue, a light one and a dark one (chromaticities 17 apart, brightness 344 against 223).
 // Their contact crosses their shared top and front planes, and the boundary runs along the
@@ -448,22 +426,4 @@ TEST(GeneratedScene, CylinderBehindABox_NotJoinedAsItsInside) {
     EXPECT_FALSE(one_object(SegmentParams{}.rim_far_agree)) << "the cylinder was joined to the box";
 }
 
-// A generated scene (eval/scenegen.py tune seed 30): a bowl whose inside, every pixel of it
-// on a crease at --decimate 2, seeds no segment, and whose rim fits no circle, so the rim
-// test joins that island to nothing. It meets no segment with continuous depth, lies behind
-// every segment it meets, and is 3.9 points wide: a lone island, kept as the bowl.
-TEST(GeneratedScene, BowlSeenOnlyAsAnIsland_KeptAsALoneIsland) {
-    TempDir dir;
-    const GeneratedFrame g = render_generated(dir, 30);
-    auto bowl = [&](int min_width) {
-        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.island_min_width_px = min_width; });
-        return std::pair{dominant_object(r.objects, g.truth, 13).second, r.segment_stats.islands_kept};  // truth 13: the bowl
-    };
-    const auto [without, kept_without] = bowl(0);
-    ASSERT_LT(without, 0.1) << "without lone islands the bowl should be missed (test premise)";
-    EXPECT_EQ(kept_without, 0);
-    const auto [with, kept] = bowl(SegmentParams{}.island_min_width_px);
-    EXPECT_GT(with, 0.85) << "the bowl's island was not kept";
-    EXPECT_GE(kept, 1);
-}
 #endif
