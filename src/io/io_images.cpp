@@ -169,6 +169,7 @@ constexpr std::size_t kMessageSize = 256;
 struct PixelFormat {
     int bits = 8;
     int channels = 1;
+    bool palette = false;  ///< a PNG of palette indices (channels: what the palette expands to)
 };
 
 std::string describe(PixelFormat f) {
@@ -180,10 +181,11 @@ enum class Layout {
     Gray8,   ///< 8-bit grey (files of 8 or fewer bits, 1 channel)
     Gray16,  ///< 16-bit grey in the host's byte order (16-bit files, 1 channel)
     Rgb8,    ///< 8-bit R, G, B (8-bit files, any channels: grey is copied, alpha dropped)
+    Index8,  ///< a palette PNG's indices, one byte each, the palette not applied
 };
 
 std::size_t bytes_per_pixel(Layout layout) {
-    return layout == Layout::Gray8 ? 1 : layout == Layout::Gray16 ? 2 : 3;
+    return layout == Layout::Gray8 || layout == Layout::Index8 ? 1 : layout == Layout::Gray16 ? 2 : 3;
 }
 
 /// Points s.rows at the rows of `out`, an image of `width` x `height` in `layout`.
@@ -264,6 +266,7 @@ public:
     PixelFormat format() const {
         PixelFormat f;
         f.bits = bit_depth_ == 16 ? 16 : 8;
+        f.palette = color_type_ == PNG_COLOR_TYPE_PALETTE;
         switch (color_type_) {
             case PNG_COLOR_TYPE_RGB:
             case PNG_COLOR_TYPE_PALETTE: f.channels = num_trans_ > 0 ? 4 : 3; break;
@@ -283,7 +286,11 @@ public:
         png_structp png = h_.png;
         png_infop info = h_.info;
         const bool ok = png_guarded(png, [&] {
-            if (color_type_ == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+            if (layout == Layout::Index8) {
+                if (bit_depth_ < 8) png_set_packing(png);  // 1, 2 or 4 bits: one byte each
+            } else if (color_type_ == PNG_COLOR_TYPE_PALETTE) {
+                png_set_palette_to_rgb(png);
+            }
             if (gray && bit_depth_ < 8) png_set_expand_gray_1_2_4_to_8(png);
             if (gray && layout == Layout::Rgb8) png_set_gray_to_rgb(png);
             png_set_strip_alpha(png);  // also the alpha that palette expansion makes of tRNS
@@ -704,8 +711,10 @@ void decode_color_image_into(const std::string& what, ImageScratch& s, ColorImag
 void read_label_png_into(const std::string& path, ImageScratch& s, LabelImage& out) {
     ImageFile file(path, s, false);
     const PixelFormat f = file.format();
-    // 8-bit labels are accepted too: ids, unlike depth, have no units to get wrong.
-    if ((f.bits != 16 && f.bits != 8) || f.channels != 1) {
+    // 8-bit labels are accepted too: ids, unlike depth, have no units to get wrong. So are a
+    // palette PNG's indices (PASCAL VOC's and many datasets' annotations): the index is the id,
+    // the palette only shows it.
+    if (!f.palette && ((f.bits != 16 && f.bits != 8) || f.channels != 1)) {
         throw InputError(path + ": labels must be 16-bit single-channel PNG, got " + describe(f));
     }
     out.labels.resize(file.pixels());
@@ -714,7 +723,7 @@ void read_label_png_into(const std::string& path, ImageScratch& s, LabelImage& o
             file.read(Layout::Gray16, reinterpret_cast<unsigned char*>(out.labels.data()));
         } else {
             s.pixels.resize(file.pixels());
-            file.read(Layout::Gray8, s.pixels.data());
+            file.read(f.palette ? Layout::Index8 : Layout::Gray8, s.pixels.data());
             std::copy(s.pixels.begin(), s.pixels.end(), out.labels.begin());
         }
     });

@@ -434,7 +434,9 @@ TEST(IoImages, WrittenPngs_HeaderAndExactRoundTrip) {
     EXPECT_EQ(header(tmp / "mask.png"), (std::pair<int, int>{8, 0}));
 }
 
-TEST(IoImages, PalettePngs_AreColourWithAlphaDropped) {
+// A palette PNG is colour for read_color_image, and its indices for read_label_png (the
+// annotations of PASCAL VOC and of many datasets: the index is the id, the palette shows it).
+TEST(IoImages, PalettePngs_AreColourWithAlphaDropped_AndTheirIndicesAreLabels) {
     TempDir tmp;
     // 2-bit palette, 4 pixels: entries 3, 0, 1, 2 packed into one byte.
     const std::string plte = png_chunk("PLTE", std::string("\x0a\x14\x1e\x28\x32\x3c\x46\x50\x5a\xc8\x64\x00", 12));
@@ -445,12 +447,22 @@ TEST(IoImages, PalettePngs_AreColourWithAlphaDropped) {
     const wul3d::ColorImage c = wul3d::read_color_image(opaque.string());
     EXPECT_EQ(c.width, 4);
     EXPECT_EQ(c.rgb, expect);
-    expect_input_error([&] { wul3d::read_label_png(opaque.string()); }, {opaque.string(), "got 8-bit 3-channel"});
+    const std::vector<std::uint16_t> indices = {3, 0, 1, 2};
+    const wul3d::LabelImage l = wul3d::read_label_png(opaque.string());
+    EXPECT_EQ(l.width, 4);
+    EXPECT_EQ(l.height, 1);
+    EXPECT_EQ(l.labels, indices);
+    // 8 bits an index, the same entries.
+    const fs::path wide = tmp / "palette8.png";
+    spit(wide, png_file(4, 1, 8, 3, zlib_stored(unfiltered({std::string("\x03\x00\x01\x02", 4)})), plte));
+    EXPECT_EQ(wul3d::read_label_png(wide.string()).labels, indices);
+    EXPECT_EQ(wul3d::read_color_image(wide.string()).rgb, expect);
 
     // With tRNS (alpha for the first two entries): four channels, the alpha is dropped.
     const fs::path transparent = tmp / "palette_trns.png";
     spit(transparent, png_file(4, 1, 2, 3, idat, plte + png_chunk("tRNS", std::string("\x00\x80", 2))));
     EXPECT_EQ(wul3d::read_color_image(transparent.string()).rgb, expect);
+    EXPECT_EQ(wul3d::read_label_png(transparent.string()).labels, indices);
     expect_input_error([&] { wul3d::read_depth_png(transparent.string(), 0.001f); },
                        {transparent.string(), "got 8-bit 4-channel"});
 }
