@@ -47,14 +47,16 @@ def write_bag(path: pathlib.Path, frames):
 
 @pytest.fixture(scope="module")
 def root(tmp_path_factory):
-    """ROOT: recs/a.bag (frames 0-1), recs/b.bag (frames 2-3), a hidden bag, a file that is
-    not a bag, and a folder of frames beside the bags."""
+    """ROOT: recs/a.bag (frames 0-1), recs/b.bag (frames 2-3), recs/broken.bag (not a bag: a
+    text file so named), a hidden bag, a file that is not a bag, and a folder of frames
+    beside the bags."""
     root = tmp_path_factory.mktemp("bags")
     frames = list(wul3d.read(str(SAMPLES / "uois_tabletop")))
     write_bag(root / "recs" / "a.bag", frames[:2])
     write_bag(root / "recs" / "b.bag", frames[2:])
     write_bag(root / "recs" / ".hidden.bag", frames[:1])
     (root / "recs" / "notes.txt").write_text("not a sequence\n")
+    (root / "recs" / "broken.bag").write_text("#ROSBAG V2.0\ncut short\n")
     for src in sorted(p for p in (SAMPLES / "uois_tabletop").iterdir() if p.is_dir())[:2]:
         (root / "recs" / "frames" / src.name).mkdir(parents=True)
         for p in src.iterdir():
@@ -63,7 +65,7 @@ def root(tmp_path_factory):
 
 
 def test_discover_finds_each_bag_beside_frames(root):
-    assert batch.discover(root) == ["recs/a.bag", "recs/b.bag", "recs/frames"]
+    assert batch.discover(root) == ["recs/a.bag", "recs/b.bag", "recs/broken.bag", "recs/frames"]
     assert batch.discover(root / "recs" / "a.bag") == ["."]  # ROOT may be one bag
 
 
@@ -73,7 +75,12 @@ def test_batch_of_bags_equals_wul3d_run_of_each(cli, root, tmp_path):
         report = batch.run_batch(root, tmp_path / "out", client=client, threads_per_worker=1,
                                  progress=False, timeout_s=300)
     by_name = {s["sequence"]: s for s in report["sequences"]}
-    assert sorted(by_name) == ["recs/a.bag", "recs/b.bag", "recs/frames"]
+    assert sorted(by_name) == ["recs/a.bag", "recs/b.bag", "recs/broken.bag", "recs/frames"]
+    # The file that is no bag fails alone, with the reader's one line; nothing of it is written.
+    broken = by_name.pop("recs/broken.bag")
+    assert broken["status"] == "failed" and "broken.bag" in broken["error"], broken
+    assert "\n" not in broken["error"]
+    assert not (tmp_path / "out" / "recs" / "broken.bag").exists()
     assert all(s["status"] == "ok" and s["error"] is None for s in by_name.values()), by_name
     assert by_name["recs/a.bag"]["frames"] == 2 and by_name["recs/b.bag"]["frames"] == 2
     for bag_name in ("a.bag", "b.bag"):
