@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Fuzzes wul3d.batch's discovery (batch.discover) over random folder trees: symbolic links
 back up the tree, to siblings, to themselves, to a tree outside ROOT, dangling and to files;
-FIFOs and files where folders or depth.png are expected; names with bytes that are not
+FIFOs and files where folders or depth.png are expected; ROS bags (*.bag files, links to
+them, FIFOs so named, hidden ones); names with bytes that are not
 UTF-8, newlines, spaces, 255 bytes, hidden names; folders that cannot be listed (when not
 run as root). Each tree is also kept as a model (a graph of its folders); the model says which
-folders are sequences and which of them a walk from ROOT reaches, and discovery must return
-each of those exactly once (by device and inode), end within 10 s, and raise nothing.
+folders are sequences, which bags lie in the folders a walk from ROOT lists, and which of
+them it reaches; discovery must return each of those exactly once (by device and inode), end
+within 10 s, and raise nothing.
 
     python3 fuzz/fuzz_batch_discovery.py [--seconds 20] [--seed 1] [--iteration I] [--keep DIR]
 
@@ -47,6 +49,7 @@ class Node:
         self.path, self.in_root = path, in_root
         self.children = {}  # name (bytes) -> Node (a folder, real or through a link)
         self.files = {}  # name (bytes) -> whether it is a regular file, links followed
+        self.bags = {}  # name (bytes, *.bag) -> (device, inode) of the regular file it is
         self.readable = True
 
     @property
@@ -151,6 +154,31 @@ def build_tree(rng: random.Random, base: bytes):
         elif kind < 0.45:  # a TUM sequence
             marker(node, b"rgb.txt")
             marker(node, b"depth.txt")
+    bag_files = []  # the regular *.bag files made, for links to them
+    for _ in range(rng.randint(0, 6)):  # ROS bags: files, links to them, FIFOs so named
+        parent = rng.choice(nodes)
+        name = new_name(parent)
+        name = (b"." if rng.random() < 0.15 else b"") + name[:200] + b".bag"
+        if name in taken[id(parent)] or name in parent.children:
+            continue
+        taken[id(parent)].add(name)
+        path = parent.path + b"/" + name
+        kind = rng.random()
+        try:
+            if kind < 0.5 or not bag_files:
+                with open(path, "wb") as f:
+                    f.write(b"#ROSBAG V2.0\n")
+                bag_files.append(path)
+                parent.bags[name] = key(path)
+            elif kind < 0.8:
+                target = rng.choice(bag_files)
+                os.symlink(target, path)
+                parent.bags[name] = key(target)
+            else:
+                os.mkfifo(path)
+        except OSError:
+            continue
+        parent.files[name] = name in parent.bags
     for _ in range(rng.randint(0, 10)):  # links, FIFOs and files among them
         parent = rng.choice(nodes)
         name = new_name(parent)
@@ -185,7 +213,8 @@ def build_tree(rng: random.Random, base: bytes):
 
 def expected(root: Node):
     """What discovery must return according to the model: the sequence folders a walk from
-    ROOT reaches (links followed, hidden names and frame folders not entered), and the
+    ROOT reaches (links followed, hidden names and frame folders not entered) and the bags
+    in the folders it lists but for sequence folders (by (device, inode), each once), and the
     folders it reaches but cannot list."""
     def is_frame(n):
         return n.readable and n.frame
@@ -194,8 +223,9 @@ def expected(root: Node):
         return n.readable and n.tum
 
     if is_tum(root) or is_frame(root):
-        return [root], []
+        return [root], [], set()
     sequences, unread, seen, todo = [], [], {id(root)}, [root]
+    bags = set()
     while todo:
         n = todo.pop()
         if not n.readable:
@@ -204,6 +234,7 @@ def expected(root: Node):
         if is_tum(n):
             sequences.append(n)
             continue
+        bags.update(k for name, k in n.bags.items() if not name.startswith(b"."))
         children = [c for name, c in n.children.items() if not name.startswith(b".")]
         if any(is_frame(c) for c in children):
             sequences.append(n)
@@ -211,7 +242,7 @@ def expected(root: Node):
             if not is_frame(c) and id(c) not in seen:
                 seen.add(id(c))
                 todo.append(c)
-    return sequences, unread
+    return sequences, unread, bags
 
 
 class Stuck(Exception):
@@ -236,7 +267,7 @@ def one(batch, seed, iteration, keep=None):
         os.makedirs(base)
     root, nodes = build_tree(rng, base)
     try:
-        want, want_unread = expected(root)
+        want, want_unread, want_bags = expected(root)
         signal.setitimer(signal.ITIMER_REAL, ITERATION_LIMIT_S)
         try:
             found = batch._discover(os.fsdecode(root.path))
@@ -245,7 +276,7 @@ def one(batch, seed, iteration, keep=None):
         got = [key(os.path.join(os.fsdecode(root.path), rel)) for rel in found.sequences]
         if len(set(got)) != len(got):
             return f"a sequence found twice: {found.sequences}"
-        if set(got) != {key(n.path) for n in want}:
+        if set(got) != {key(n.path) for n in want} | want_bags:
             return (f"found {found.sequences}; the model's sequences: "
                     f"{sorted(os.fsdecode(n.path[len(root.path) + 1:]) or '.' for n in want)}")
         def parts(rel):

@@ -183,6 +183,7 @@ def _discover(root) -> Discovery:
     # links lead to, so that a sequence is named by its real path where it has one.
     visited = {(st.st_dev, st.st_ino)}
     found, links, unread = [], [], []
+    bags = {}  # (device, inode) -> (reached through a link, relative path): each bag once
     walk = [()]  # relative paths as tuples of names, real folders
     deferred = []  # (relative path, key) of folders reached through a symbolic link
 
@@ -194,13 +195,20 @@ def _discover(root) -> Discovery:
         except OSError as e:
             unread.append((rel, e.strerror or type(e).__name__))
             return
-        subdirs, bags = [], []
+        subdirs, here_bags = [], []
         for e in entries:
             if e.name.startswith("."):
                 continue
             cst = _stat(e.path)
             if cst is not None and stat.S_ISREG(cst.st_mode) and e.name.endswith(".bag"):
-                bags.append(rel + (e.name,))
+                try:
+                    via_link = e.is_symlink()
+                except OSError:
+                    continue
+                bag_key = (cst.st_dev, cst.st_ino)
+                # A bag is named by its real path where it has one (as a folder is).
+                if bag_key not in bags or (bags[bag_key][0] and not via_link):
+                    here_bags.append((bag_key, (via_link, rel + (e.name,))))
                 continue
             if cst is None or not stat.S_ISDIR(cst.st_mode):
                 continue
@@ -212,7 +220,8 @@ def _discover(root) -> Discovery:
         if _is_tum(path) or _is_dataset_sequence(path):
             found.append(rel)
             return
-        found.extend(bags)  # each bag a sequence of its own
+        for bag_key, entry in here_bags:  # each bag a sequence of its own
+            bags[bag_key] = entry
         frames = {name for name, _, _ in subdirs if _is_frame(os.path.join(path, name))}
         if frames:
             found.append(rel)
@@ -242,6 +251,7 @@ def _discover(root) -> Discovery:
             continue
         links.append(os.path.realpath(os.path.join(root, *child)))
         walk.append(child)
+    found.extend(rel for _, rel in bags.values())
     found.sort()
     return Discovery(["/".join(rel) if rel else "." for rel in found], links,
                      [("/".join(rel) or ".", why) for rel, why in sorted(unread)])
@@ -252,8 +262,9 @@ def discover(root) -> list:
 
     A TUM sequence (rgb.txt and depth.txt), an OCID sequence, an OSD-0.2-depth tree or a
     BOP scene (docs/INPUTS.md, sections 5 and 6) is one sequence; so is each ROS 1 bag
-    (`*.bag`, section 4; its output folder keeps the name, OUT/<path>/rec.bag/), and root
-    itself may be one; a folder whose sub-folders are frames (depth.png) is one sequence of
+    (`*.bag`, section 4; its output folder keeps the name, OUT/<path>/rec.bag/; each bag
+    once, by device and inode, named by its real path where it has one), and root itself
+    may be one; a folder whose sub-folders are frames (depth.png) is one sequence of
     those frames, as `wul3d run FOLDER` reads it; root itself being one frame is a sequence
     of one. Other folders are searched further (a
     folder can hold frames and sequences of its own). Hidden folders are skipped.
