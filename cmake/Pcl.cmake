@@ -2,7 +2,8 @@
 #   bench/pcl_normals_peer.cpp  wul3d_bench_pcl: PCL's integral-image normals (docs/BENCH.md)
 #   eval/pcl_peers.cpp          wul3d_pcl_peers: PCL's plane RANSAC + Euclidean clustering and
 #                               organized multi-plane + connected components (docs/PEERS.md)
-# Sets WUL3D_PCL (ON/OFF) for both. PCL is not installed by scripts/install-deps.sh (Debian's
+# Sets WUL3D_PCL (ON/OFF) for both; with it, the target pcl_io serves the PCD reader's test
+# against PCL's own writer (tests/io/pcl/pcd_writer_test.cpp) where it is found. PCL is not installed by scripts/install-deps.sh (Debian's
 # libpcl-dev is some 312 packages): `apt-get install libpcl-dev`. Only the components the peers
 # need are asked for, and only the top ones: PCLConfig leaves a component named before one that
 # depends on it out of the dependant's link interface (asking for search before features
@@ -33,6 +34,12 @@ if(WUL3D_WITH_PCL)
     message(STATUS "PCL ${PCL_VERSION} found: building the PCL peers "
                    "(wul3d_bench_pcl with the benchmarks, wul3d_pcl_peers)")
     set(WUL3D_PCL ON)
+    # PCL's own PCD writer for the PCD reader's test (tests/io/pcl/), asked for apart.
+    set(CMAKE_DISABLE_FIND_PACKAGE_VTK TRUE)
+    set(CMAKE_MESSAGE_LOG_LEVEL NOTICE)
+    find_package(PCL 1.10 QUIET COMPONENTS io)
+    unset(CMAKE_MESSAGE_LOG_LEVEL)
+    unset(CMAKE_DISABLE_FIND_PACKAGE_VTK)
   endif()
 else()
   message(STATUS "WUL3D_WITH_PCL is OFF: the PCL peers are skipped")
