@@ -3,7 +3,8 @@
 // asked what the table holds. A segment is kept when it lies within the support's volume
 // (under the height limit, not running on past the support's hull or out of view beyond
 // its middle) and stands on the support, or hides its foot from the camera, or rests on a
-// segment that is kept (docs/DESIGN.md, "Scope").
+// segment that is kept, unless it is a low support: a board or tray on the floor that holds
+// other kept segments (docs/DESIGN.md, "Scope").
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -289,14 +290,6 @@ void count_upright(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     }
 }
 
-/// Whether the camera could see the support under segment l's middle: F, the foot of the
-/// segment's mean point on the support, is placed in the image by the local scale of the
-/// organized grid (the pitch of the points beside one of the segment's pixels), and the
-/// pixel there shows something nearer than F (the segment itself, or an object in front),
-/// shows nothing (no depth: the sensor's shadow beside an object) or lies out of the frame.
-/// A box seen from steeply above shows its top alone, its sides in shadow or edge-on, and
-/// its body hides its foot. A box hanging over the table, seen obliquely, shows the table
-/// under its middle. Cost: a few reads per segment.
 /// The organized grid's scale at pixel p: pixels per unit of x/z (fx) and of y/z (fy), from
 /// a neighbour with depth on either side; false where p has none. Cost: a few reads.
 bool grid_scale(const Ctx& x, int p, float& fx, float& fy) {
@@ -317,6 +310,14 @@ bool grid_scale(const Ctx& x, int p, float& fx, float& fy) {
     return fx > 0.0f && fy > 0.0f;
 }
 
+/// Whether the camera could see the support under segment l's middle: F, the foot of the
+/// segment's mean point on the support, is placed in the image by the local scale of the
+/// organized grid (the pitch of the points beside one of the segment's pixels), and the
+/// pixel there shows something nearer than F (the segment itself, or an object in front),
+/// shows nothing (no depth: the sensor's shadow beside an object) or lies out of the frame.
+/// A box seen from steeply above shows its top alone, its sides in shadow or edge-on, and
+/// its body hides its foot. A box hanging over the table, seen obliquely, shows the table
+/// under its middle. Cost: a few reads per segment.
 bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::size_t l) {
     const int p = ws.scope_any_px[l];
     if (p < 0 || ws.sizes[l] == 0) return false;

@@ -34,10 +34,10 @@ void NormalParams::validate() const {
 }
 
 float measure_depth_noise(const OrganizedCloud& cloud, float fx, std::vector<float>& scratch) {
-    constexpr int kStep = 3;        // every third pixel of every third row
-    constexpr int kSlope = 12;       // the surface's slope from the points this far either side
+    constexpr int kStep = 3;             // every third pixel of every third row
+    constexpr int kSlope = 12;           // the surface's slope from the points this far either side
     constexpr float kMaxSlope2 = 33.0f;  // tan^2 of 80 degrees: steeper is an edge, not a surface
-    constexpr double kKeep = 0.9;   // the largest tenth are edges
+    constexpr double kKeep = 0.9;        // the largest tenth are edges
     // E|x| over the smallest 90% of |N(0, 1)|, times sqrt(6) (the second difference of three
     // independent samples has 6 times their variance): 0.6573 * 2.4495.
     constexpr double kGaussian = 1.6100;
