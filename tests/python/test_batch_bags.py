@@ -74,6 +74,9 @@ def test_batch_of_bags_equals_wul3d_run_of_each(cli, root, tmp_path):
                       dashboard_address=":0") as cluster, Client(cluster) as client:
         report = batch.run_batch(root, tmp_path / "out", client=client, threads_per_worker=1,
                                  progress=False, timeout_s=300)
+        # ROOT one bag: OUT/<its name>/.
+        one = batch.run_batch(root / "recs" / "a.bag", tmp_path / "one", client=client,
+                              threads_per_worker=1, progress=False, timeout_s=300)
     by_name = {s["sequence"]: s for s in report["sequences"]}
     assert sorted(by_name) == ["recs/a.bag", "recs/b.bag", "recs/broken.bag", "recs/frames"]
     # The file that is no bag fails alone, with the reader's one line; nothing of it is written.
@@ -83,11 +86,14 @@ def test_batch_of_bags_equals_wul3d_run_of_each(cli, root, tmp_path):
     assert not (tmp_path / "out" / "recs" / "broken.bag").exists()
     assert all(s["status"] == "ok" and s["error"] is None for s in by_name.values()), by_name
     assert by_name["recs/a.bag"]["frames"] == 2 and by_name["recs/b.bag"]["frames"] == 2
-    for bag_name in ("a.bag", "b.bag"):
+    assert [(s["sequence"], s["status"], s["frames"]) for s in one["sequences"]] == [("a.bag", "ok", 2)]
+    for bag_name, out in (("a.bag", tmp_path / "out" / "recs" / "a.bag"),
+                          ("b.bag", tmp_path / "out" / "recs" / "b.bag"),
+                          ("a.bag", tmp_path / "one" / "a.bag")):
         ref = tmp_path / "ref" / bag_name
-        proc = run_cli(cli, "run", root / "recs" / bag_name, "--out", ref, "-q", "--threads", 1)
-        assert proc.returncode == 0, proc.stderr
-        out = tmp_path / "out" / "recs" / bag_name
+        if not ref.exists():
+            proc = run_cli(cli, "run", root / "recs" / bag_name, "--out", ref, "-q", "--threads", 1)
+            assert proc.returncode == 0, proc.stderr
         names = sorted(p.name for p in ref.iterdir() if p.is_dir())
         assert names and names == sorted(p.name for p in out.iterdir() if p.is_dir())
         for name in names:
