@@ -403,14 +403,15 @@ void drop_low_supports(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n)
     if (!(prm.low_support_max_m > 0)) return;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     auto& keep = ws.scope_keep;
-    auto low = [&](std::size_t l) { return keep[l] == 3 && ws.scope_hi[l] <= prm.low_support_max_m; };
     std::vector<int>& held = ws.scope_held;
     held.assign(L, 0);
     for (const std::uint64_t e : ws.edges) {
         const auto a = static_cast<std::size_t>(e >> 33), b = static_cast<std::size_t>((e >> 1) & 0xffffffffu);
         if (keep[a] != 3 || keep[b] != 3) continue;
-        if (low(a) && ws.scope_hi[b] > ws.scope_hi[a] + prm.scope_contact_m) ++held[a];
-        if (low(b) && ws.scope_hi[a] > ws.scope_hi[b] + prm.scope_contact_m) ++held[b];
+        // The lower of two kept segments holds the other when that one rises over it.
+        const auto [lo, hi] = ws.scope_hi[a] <= ws.scope_hi[b] ? std::pair{a, b} : std::pair{b, a};
+        if (ws.scope_hi[lo] <= prm.low_support_max_m && ws.scope_hi[hi] > ws.scope_hi[lo] + prm.scope_contact_m)
+            ++held[lo];
     }
     for (std::size_t l = 1; l < L; ++l)
         if (held[l] >= 2 && area_on_support(x, pl, ws, l) >= prm.low_support_min_area_m2) keep[l] = 0;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pcd_expect.hpp"
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
@@ -22,37 +23,9 @@ using wul3d::PcdData;
 using wul3d::RgbdFrame;
 using wul3d::test::TempDir;
 
-RgbdFrame sample_frame() {
-    const fs::path dir = wul3d::test::sample_dir() / "uois_tabletop/image_0000";
-    RgbdFrame f;
-    const wul3d::IntrinsicsFile K = wul3d::read_intrinsics_json((dir / "intrinsics.json").string());
-    f.intrinsics = K.intrinsics;
-    f.depth = wul3d::read_depth_png((dir / "depth.png").string(), K.depth_scale_m_per_unit);
-    f.color = wul3d::read_color_image((dir / "color.png").string());
-    return f;
-}
+RgbdFrame sample_frame() { return wul3d::test::read_sample_frame("image_0000"); }
 
-void expect_same(const RgbdFrame& want, const RgbdFrame& got, bool with_rgb) {
-    ASSERT_EQ(got.depth.width, want.depth.width);
-    ASSERT_EQ(got.depth.height, want.depth.height);
-    EXPECT_FLOAT_EQ(got.depth.scale_m_per_unit, 0.001f);
-    std::size_t off = 0;
-    for (std::size_t i = 0; i < want.depth.data.size(); ++i)
-        if (std::abs(int(got.depth.data[i]) - int(want.depth.data[i])) > 1) ++off;
-    EXPECT_EQ(off, 0u);
-    const wul3d::PinholeIntrinsics& a = want.intrinsics;
-    const wul3d::PinholeIntrinsics& b = got.intrinsics;
-    EXPECT_NEAR(b.fx, a.fx, 0.005 * a.fx);
-    EXPECT_NEAR(b.fy, a.fy, 0.005 * a.fy);
-    EXPECT_NEAR(b.cx, a.cx, 0.005 * a.cx);
-    EXPECT_NEAR(b.cy, a.cy, 0.005 * a.cy);
-    EXPECT_EQ(b.width, a.width);
-    EXPECT_EQ(b.height, a.height);
-    if (with_rgb)
-        EXPECT_EQ(got.color.rgb, want.color.rgb);
-    else
-        EXPECT_TRUE(got.color.empty());
-}
+using wul3d::test::expect_same_pcd_frame;
 
 struct Case {
     PcdData data;
@@ -66,7 +39,7 @@ TEST_P(PcdRoundTrip, ReadsBackTheDepthColourAndIntrinsics) {
     const RgbdFrame want = sample_frame();
     const std::string path = (tmp / "cloud.pcd").string();
     wul3d::write_pcd(path, want, GetParam().data, GetParam().rgb);
-    expect_same(want, wul3d::read_pcd_frame(path), GetParam().rgb);
+    expect_same_pcd_frame(want, wul3d::read_pcd_frame(path), GetParam().rgb);
 }
 
 INSTANTIATE_TEST_SUITE_P(Pcd, PcdRoundTrip,
@@ -172,7 +145,7 @@ TEST(Pcd, BinaryCompressedWithBackReferencesReadsBack) {
     bytes.append(reinterpret_cast<const char*>(sizes), sizeof sizes);
     bytes += packed;
     wul3d::test::write_text(path, bytes);
-    expect_same(want, wul3d::read_pcd_frame(path), true);
+    expect_same_pcd_frame(want, wul3d::read_pcd_frame(path), true);
     // A reference before the start of the data is refused.
     bytes[body + 8] = static_cast<char>((1 << 5) | 0x1f);
     wul3d::test::write_text(path, bytes);

@@ -4,13 +4,13 @@ own Python writer (Debian's python3-rosbag), from the shipped uois_tabletop fram
 
 import filecmp
 import json
-import os
 import pathlib
 
 import numpy as np
 import pytest
 
-from conftest import BUILD, SAMPLES, run_cli
+from conftest import SAMPLES, run_cli
+from test_batch import BUILD  # noqa: E402,F401  (sets PYTHONPATH for the workers)
 
 import genpy  # noqa: E402  (Debian's python3-genpy, with python3-rosbag)
 import rosbag  # noqa: E402
@@ -19,10 +19,6 @@ from sensor_msgs.msg import CameraInfo, Image  # noqa: E402
 
 import wul3d  # noqa: E402
 from wul3d import batch  # noqa: E402
-
-# Workers import the module just built.
-os.environ["PYTHONPATH"] = os.pathsep.join(
-    [str(BUILD / "python")] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
 
 
 def write_bag(path: pathlib.Path, frames):

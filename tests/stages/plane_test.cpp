@@ -204,9 +204,7 @@ TEST(RemoveSupportPlane, TiltedTable_RemovesTableKeepsBoxesAndTheirFeet) {
 // up in the image only by cos 80 = 0.17, which the support's facing test must still take,
 // while a wall facing any camera that looks down has -n_y <= 0.
 TEST(RemoveSupportPlane, CameraLookingAlmostStraightDown_TheTableIsTheSupport) {
-    Scene s;
-    s.width = 320;
-    s.height = 240;
+    Scene s = pitched_tabletop_scene();
     s.pitch_rad = 80.0f * 3.14159265f / 180.0f;
     s.table_y = 1.0f;
     s.table_near = -0.8f;

@@ -10,29 +10,19 @@
 #include <pcl/point_types.h>
 
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
 #include <limits>
 #include <string>
+#include <type_traits>
 
+#include "io/pcd_expect.hpp"
 #include "test_support.hpp"
 #include "wul3d/io.hpp"
 
 namespace {
 
-namespace fs = std::filesystem;
 using wul3d::RgbdFrame;
+using wul3d::test::expect_same_pcd_frame;
 using wul3d::test::TempDir;
-
-RgbdFrame sample_frame() {
-    const fs::path dir = wul3d::test::sample_dir() / "uois_tabletop/image_0002";
-    RgbdFrame f;
-    const wul3d::IntrinsicsFile K = wul3d::read_intrinsics_json((dir / "intrinsics.json").string());
-    f.intrinsics = K.intrinsics;
-    f.depth = wul3d::read_depth_png((dir / "depth.png").string(), K.depth_scale_m_per_unit);
-    f.color = wul3d::read_color_image((dir / "color.png").string());
-    return f;
-}
 
 /// The frame's pixels as an organized cloud of PointT, camera frame, metres.
 template <class PointT>
@@ -62,30 +52,11 @@ pcl::PointCloud<PointT> to_cloud(const RgbdFrame& f) {
     return cloud;
 }
 
-void expect_same(const RgbdFrame& want, const RgbdFrame& got, bool with_rgb) {
-    ASSERT_EQ(got.depth.width, want.depth.width);
-    ASSERT_EQ(got.depth.height, want.depth.height);
-    std::size_t off = 0;
-    for (std::size_t i = 0; i < want.depth.data.size(); ++i)
-        off += std::abs(int(got.depth.data[i]) - int(want.depth.data[i])) > 1;
-    EXPECT_EQ(off, 0u) << "pixels whose depth differs by over 1 mm";
-    const wul3d::PinholeIntrinsics& a = want.intrinsics;
-    const wul3d::PinholeIntrinsics& b = got.intrinsics;
-    EXPECT_NEAR(b.fx, a.fx, 0.005 * a.fx);
-    EXPECT_NEAR(b.fy, a.fy, 0.005 * a.fy);
-    EXPECT_NEAR(b.cx, a.cx, 0.005 * a.cx);
-    EXPECT_NEAR(b.cy, a.cy, 0.005 * a.cy);
-    if (with_rgb)
-        EXPECT_EQ(got.color.rgb, want.color.rgb);
-    else
-        EXPECT_TRUE(got.color.empty());
-}
-
 }  // namespace
 
 TEST(PcdFromPcl, EveryEncodingWithAndWithoutColourReadsBack) {
     TempDir tmp;
-    const RgbdFrame want = sample_frame();
+    const RgbdFrame want = wul3d::test::read_sample_frame("image_0002");
     const auto rgb = to_cloud<pcl::PointXYZRGB>(want);
     const auto xyz = to_cloud<pcl::PointXYZ>(want);
     const std::string ascii = (tmp / "ascii.pcd").string(), binary = (tmp / "binary.pcd").string(),
@@ -96,7 +67,7 @@ TEST(PcdFromPcl, EveryEncodingWithAndWithoutColourReadsBack) {
     ASSERT_EQ(pcl::io::savePCDFileBinaryCompressed(plain, xyz), 0);
     for (const std::string& path : {ascii, binary, compressed}) {
         SCOPED_TRACE(path);
-        expect_same(want, wul3d::read_pcd_frame(path), true);
+        expect_same_pcd_frame(want, wul3d::read_pcd_frame(path), true);
     }
-    expect_same(want, wul3d::read_pcd_frame(plain), false);
+    expect_same_pcd_frame(want, wul3d::read_pcd_frame(plain), false);
 }
