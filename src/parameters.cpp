@@ -113,8 +113,8 @@ std::vector<ParamSpec> make_table() {
         choice("scope", "segmentation", "support|scene",
                "Objects: support (what the support holds; the whole scene when no support is "
                "found) or scene (every segment)",
-               [](const P& p) { return V{std::string(scope_name(p.segmentation.scope))}; },
-               [](P& p, const V& v) { p.segmentation.scope = parse_scope(std::get<std::string>(v)); }),
+               [](const P& p) { return V{std::string(scope_name(p.segmentation.scope.mode))}; },
+               [](P& p, const V& v) { p.segmentation.scope.mode = parse_scope(std::get<std::string>(v)); }),
         [] {
             ParamSpec s = row("remove_plane", "plane", K::Switch, "", 0, 0,
                               "Remove the support plane (off: the paper's background step, "

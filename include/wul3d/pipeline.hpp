@@ -46,8 +46,8 @@ struct PipelineParams {
     static PipelineParams paper();
     void validate() const;
     /// The parameters the stages run with: with decimation N, the pixel counts of objects
-    /// (min_points of segments and tracks, gap_max_px) divided by N^2 and the plane's hull
-    /// margin and the merge and rim boundary lengths by N (rounded; 0 stays off). The
+    /// (min_points of segments and tracks, containers.gap_max_px) divided by N^2 and the
+    /// plane's hull margin and the merge and rim boundary lengths by N (rounded; 0 stays off). The
     /// neighbourhood sizes and the plane's grid step stay as given, in decimated pixels
     /// (pipeline.cpp says why).
     PipelineParams stage_params() const;

@@ -38,150 +38,177 @@ enum class Scope {
 Scope parse_scope(const std::string& name);  ///< support|scene, else ParamError
 const char* scope_name(Scope s);
 
-struct SegmentParams {
-    Segmenter segmenter = Segmenter::Hybrid;
-    int min_points = 300;           ///< objects with fewer pixels are dropped; >= 1 (--min-points)
-    float depth_jump_m = 0.004f;    ///< neighbours whose depths differ by more than
-    float depth_jump_rel = 0.012f;  ///< depth_jump_m + depth_jump_rel * z^2 are not connected;
-                                    ///< > 0 and >= 0 (Kinect depth noise grows with z^2)
-    int crease_step_px = 5;         ///< normals compared this many pixels apart; [1, 16]
-    int normal_smooth_px = 3;       ///< the crease tests use normals averaged over a window of
-                                    ///< this radius (sensor noise); [0, 16], 0 = raw normals
-    float concavity = 0.3f;         ///< (n_p - n_q) . (X_q - X_p) / |X_q - X_p| above this is a
-                                    ///< concave crease (LCCP's test, per pixel); > 0
-    int reattach_px = 8;            ///< cut pixels and feet join a segment up to this far; >= 0
-    int min_seed_points = 40;       ///< components smaller than this before re-attachment are
-                                    ///< cut pixels too; >= 1
-    // Merge (LCCP's merge on segments): two segments that meet, with continuous depth, along
-    // a boundary that is mostly not concave were split by noise or a thin convex edge (a
-    // bowl's rim, a box's front edge), not by a junction of two objects.
-    float merge_max_concave = 0.3f;  ///< largest share of concave pairs on such a boundary;
-                                     ///< [0, 1], 0 = never merge
-    int merge_min_boundary = 6;      ///< boundary pairs with a crease test at least; >= 1
-    // Colour cue (hybrid): a segment is split in two by the paper's distance (eq. 4, 6) with a
-    // colour-heavy alpha when the two parts differ in colour, are each large, meet along a
-    // short boundary, and that boundary crosses a smooth surface (no crease: shading on two
-    // faces of one box is not a second object).
-    float color_alpha = 0.02f;      ///< alpha of eq. (4) for the split; [0.002, 0.1]
-    float color_min_distance = 25;  ///< chromaticity distance (0-255 scale) between the
-                                    ///< parts' means; > 0
-    float color_min_share = 0.05f;  ///< each part holds at least this share (and min_points):
-                                    ///< a flat box lying on a larger one may show only its
-                                    ///< rim; (0, 0.5]
-    float color_max_boundary = 0.5f;  ///< boundary pairs / the smaller part's outline pairs
-                                      ///< at most: a contact is one side of it; (0, 1]
-    float color_max_compact = 6;      ///< ... or boundary pairs / sqrt(the smaller part's
-                                      ///< pixels) at most: a compact piece that the larger
-                                      ///< part encloses in view (a box lying on a box); a
-                                      ///< texture's parts run far longer; >= 0, 0 = off
-    float color_max_crease_deg = 15;  ///< 70 % of the boundary pairs have normals (a crease
-                                      ///< step away on either side) within this angle; > 0
-    float color_min_hue_deg = 10;     ///< ... or else (the boundary follows a fold) the parts'
-                                      ///< mean RGB vectors differ by this angle: shading
-                                      ///< scales a colour, only another material turns it;
-                                      ///< (0, 90)
-    float color_min_step = 1.15f;     ///< ... or, either way: of the boundary pairs that
-                                      ///< cross a smooth surface, half or more (6 at least)
-                                      ///< lie on one plane, and 70 % of those are this many
-                                      ///< times brighter (r + g + b) a crease step away on
-                                      ///< one part's side than on the other's: two materials
-                                      ///< of one hue; <= 1: off
-    float color_round_deg = 25;       ///< no split of a segment that stands round on the
-                                      ///< support (a can, a bottle, a cup: its colours are
-                                      ///< print): its walls, normals within this of the
-                                      ///< support plane, lie on one upright circle (the
-                                      ///< rim_ fit's residual and arc) and face within this
-                                      ///< of its radii; [0, 90), 0 = off
-    float color_round_max_radius_m = 0.15f;  ///< ... a circle of at most this radius; > 0
-    bool color_textures = true;  ///< where 2-means follows a texture (its boundary runs round
-                                 ///< many pieces), four colours, and two whose contact is
-                                 ///< longer than color_max_compact allows are one material
-                                 ///< (they interleave); the same tests judge the split
-                                 ///< between two materials: stripes beside a plain box
-    // Stacks (needs the support plane; not kmeans): a segment whose upward faces lie at two
-    // heights over the support, nothing facing up between them, is two objects, one resting
-    // on the other; it is cut just over the lower one's top.
-    float stack_min_step_m = 0.02f;  ///< the layers lie this far apart at least, and the lower
-                                     ///< this far above the support (a book's thickness);
-                                     ///< [0, 0.5], 0 = off
-    float stack_min_share = 0.04f;   ///< each layer holds this share of the segment's pixels
-                                     ///< (and min_points); (0, 0.5]
-    // Containers (needs the support plane): a bowl or a cup seen from above shows its outer
-    // wall and, over the front rim, its inside; the rim hides the inside's lower part, so
-    // the two meet only across a depth step, where no crease test or merge can join them.
-    // The rim gives it away: the nearer segment's edge along that step is a level circular
-    // arc, and the farther segment lies inside the circle and reaches up to the rim (its far
-    // side). Such a pair is joined.
-    int rim_min_boundary = 10;          ///< depth-step boundary pairs at least; >= 3, or 0 = off
-    float rim_max_residual_m = 0.0035f; ///< RMS distance of the edge from its fitted circle
-                                        ///< to 1 m, growing as z^2 beyond (the sensor's
-                                        ///< noise); the round test's at any depth; > 0
-    float rim_min_arc = 0.4f;           ///< widest chord of the edge / the circle's diameter at
-                                        ///< least (0.4: an arc of 47 degrees); (0, 1]
-    float rim_inside_share = 0.95f;     ///< share of the inside's feet within the circle
-                                        ///< (radius + 10 % + 1 cm); (0, 1]
-    float rim_height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
-    bool rim_islands = true;            ///< object regions no segment reached (a small cup's
-                                        ///< inside at --decimate 2, every pixel on a crease)
-                                        ///< are candidates too; those joined to nothing are
-                                        ///< dropped
-    bool rim_far = true;                ///< a second candidate circle per pair, fitted to the
-                                        ///< front's edge and the inside's far outline at the
-                                        ///< rim's height (its far rim), when the front spans
-                                        ///< a radius across the view and the far rim agrees
-    float rim_far_agree = 1.0f / 3;     ///< the far rim's own circle: radius and centre within
-                                        ///< this share of the radius of the circle through
-                                        ///< both edges (it is the same rim); > 0
-    /// Gaps in a container's floor: a patch of unlabelled points enclosed by one segment and
-    /// touching its inside (kPlaneInside: floor points whose patch was too noisy to pass the
-    /// plane's island test) joins that segment. A true hole (a mug's handle, the table seen
-    /// through it) touches no inside and stays. Patches up to this many pixels; 0 = off.
+/// The crease cuts and the components (cuts.cpp, components.cpp): a pixel seeds a component
+/// unless a concave crease or a depth jump runs through it; cut pixels and feet re-attach.
+struct CutParams {
+    int crease_step_px = 5;    ///< normals compared this many pixels apart; [1, 16]
+    int normal_smooth_px = 3;  ///< the crease tests use normals averaged over a window of
+                               ///< this radius (sensor noise); [0, 16], 0 = raw normals
+    float concavity = 0.3f;    ///< (n_p - n_q) . (X_q - X_p) / |X_q - X_p| above this is a
+                               ///< concave crease (LCCP's test, per pixel); > 0
+    int reattach_px = 8;       ///< cut pixels and feet join a segment up to this far; >= 0
+    int min_seed_points = 40;  ///< components smaller than this before re-attachment are
+                               ///< cut pixels too; >= 1
+};
+
+/// Merge (merge.cpp; LCCP's merge on segments): two segments that meet, with continuous
+/// depth, along a boundary that is mostly not concave were split by noise or a thin convex
+/// edge (a bowl's rim, a box's front edge), not by a junction of two objects.
+struct MergeParams {
+    float max_concave = 0.3f;  ///< largest share of concave pairs on such a boundary;
+                               ///< [0, 1], 0 = never merge
+    int min_boundary = 6;      ///< boundary pairs with a crease test at least; >= 1
+};
+
+/// Colour cue (colour_cue.cpp; hybrid): a segment is split in two by the paper's distance
+/// (eq. 4, 6) with a colour-heavy alpha when the two parts differ in colour, are each large,
+/// meet along a short boundary, and that boundary crosses a smooth surface (no crease:
+/// shading on two faces of one box is not a second object).
+struct ColourCueParams {
+    float alpha = 0.02f;       ///< alpha of eq. (4) for the split; [0.002, 0.1]
+    float min_distance = 25;   ///< chromaticity distance (0-255 scale) between the parts'
+                               ///< means; > 0
+    float min_share = 0.05f;   ///< each part holds at least this share (and min_points): a
+                               ///< flat box lying on a larger one may show only its rim;
+                               ///< (0, 0.5]
+    float max_boundary = 0.5f; ///< boundary pairs / the smaller part's outline pairs at
+                               ///< most: a contact is one side of it; (0, 1]
+    float max_compact = 6;     ///< ... or boundary pairs / sqrt(the smaller part's pixels)
+                               ///< at most: a compact piece that the larger part encloses
+                               ///< in view (a box lying on a box); a texture's parts run
+                               ///< far longer; >= 0, 0 = off
+    float max_crease_deg = 15; ///< 70 % of the boundary pairs have normals (a crease step
+                               ///< away on either side) within this angle; > 0
+    float min_hue_deg = 10;    ///< ... or else (the boundary follows a fold) the parts' mean
+                               ///< RGB vectors differ by this angle: shading scales a
+                               ///< colour, only another material turns it; (0, 90)
+    float min_step = 1.15f;    ///< ... or, either way: of the boundary pairs that cross a
+                               ///< smooth surface, half or more (6 at least) lie on one
+                               ///< plane, and 70 % of those are this many times brighter
+                               ///< (r + g + b) a crease step away on one part's side than on
+                               ///< the other's: two materials of one hue; <= 1: off
+    float round_deg = 25;      ///< no split of a segment that stands round on the support (a
+                               ///< can, a bottle, a cup: its colours are print): its walls,
+                               ///< normals within this of the support plane, lie on one
+                               ///< upright circle (the containers' fit's residual and arc)
+                               ///< and face within this of its radii; [0, 90), 0 = off
+    float round_max_radius_m = 0.15f;  ///< ... a circle of at most this radius; > 0
+    bool textures = true;      ///< where 2-means follows a texture (its boundary runs round
+                               ///< many pieces), four colours, and two whose contact is
+                               ///< longer than max_compact allows are one material (they
+                               ///< interleave); the same tests judge the split between two
+                               ///< materials: stripes beside a plain box
+};
+
+/// Stacks (stacks.cpp; needs the support plane; not kmeans): a segment whose upward faces
+/// lie at two heights over the support, nothing facing up between them, is two objects, one
+/// resting on the other; it is cut just over the lower one's top.
+struct StackParams {
+    float min_step_m = 0.02f;  ///< the layers lie this far apart at least, and the lower this
+                               ///< far above the support (a book's thickness); [0, 0.5],
+                               ///< 0 = off
+    float min_share = 0.04f;   ///< each layer holds this share of the segment's pixels (and
+                               ///< min_points); (0, 0.5]
+};
+
+/// Containers (containers.cpp, floor_gaps.cpp; need the support plane): a bowl or a cup
+/// seen from above shows its outer wall and, over the front rim, its inside; the rim hides
+/// the inside's lower part, so the two meet only across a depth step, where no crease test
+/// or merge can join them. The rim gives it away: the nearer segment's edge along that step
+/// is a level circular arc, and the farther segment lies inside the circle and reaches up
+/// to the rim (its far side). Such a pair is joined.
+struct ContainerParams {
+    int min_boundary = 10;          ///< depth-step boundary pairs at least; >= 3, or 0 = off
+    float max_residual_m = 0.0035f; ///< RMS distance of the edge from its fitted circle to
+                                    ///< 1 m, growing as z^2 beyond (the sensor's noise); the
+                                    ///< colour cue's round test's at any depth; > 0
+    float min_arc = 0.4f;           ///< widest chord of the edge / the circle's diameter at
+                                    ///< least (0.4: an arc of 47 degrees); (0, 1]
+    float inside_share = 0.95f;     ///< share of the inside's feet within the circle (radius
+                                    ///< + 10 % + 1 cm); (0, 1]
+    float height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
+    bool islands = true;            ///< object regions no segment reached (a small cup's
+                                    ///< inside at --decimate 2, every pixel on a crease) are
+                                    ///< candidates too; those joined to nothing are dropped
+    bool far_rim = true;            ///< a second candidate circle per pair, fitted to the
+                                    ///< front's edge and the inside's far outline at the
+                                    ///< rim's height (its far rim), when the front spans a
+                                    ///< radius across the view and the far rim agrees
+    float far_agree = 1.0f / 3;     ///< the far rim's own circle: radius and centre within
+                                    ///< this share of the radius of the circle through both
+                                    ///< edges (it is the same rim); > 0
+    /// Gaps in a container's floor (floor_gaps.cpp): a patch of unlabelled points enclosed by
+    /// one segment and touching its inside (kPlaneInside: floor points whose patch was too
+    /// noisy to pass the plane's island test) joins that segment. A true hole (a mug's
+    /// handle, the table seen through it) touches no inside and stays. Patches up to this
+    /// many pixels; 0 = off.
     int gap_max_px = 500;
-    // Occlusion: a nearer object that hides the middle of a surface (a box standing before a
-    // lying one) leaves two segments, one each side, where there is one object. The two
-    // parts lie on one plane and face the same way, and what lies between them in view
-    // stands in front of that plane. Lines of pixels that cross from one part, over the
-    // occluder, onto the other part's surface are the evidence; such a pair is joined.
-    int occluded_min_lines = 8;        ///< crossing lines to join two parts; >= 0, 0 = off
-    float occluded_max_offset = 1.0f;  ///< their mean height over the first part's plane, in
-                                       ///< sensor steps (depth_jump_m + depth_jump_rel z^2),
-                                       ///< at most; > 0
-    float occluded_max_gap_m = 0.3f;   ///< a line spans at most this much of the plane it
-                                       ///< starts on (each pixel where its ray meets the
-                                       ///< plane: the width hidden, not the occluder's
-                                       ///< height in front); > 0
-    float occluded_max_deg = 20;       ///< the normals at a line's two ends within this; (0, 90)
-    // Scope (needs the support plane; docs/DESIGN.md, "Scope"): with Scope::Support a segment
-    // is an object when it stands on the support, or rests on a segment that does, and stays
-    // within the support's volume: over its hull (PlaneParams::hull_margin_px) and up to a
-    // height limit. A segment that runs on, with continuous depth, into points the plane
-    // stage removed although they lie above the support (off its hull) is part of something
-    // bigger than the table holds: a wall, a chair, the next table.
-    Scope scope = Scope::Support;
-    float scope_contact_m = 0.03f;     ///< a segment whose lowest point is this close to the
-                                       ///< support stands on it (so does one whose foot the
-                                       ///< camera cannot see: its sides unseen); > 0
-    float scope_max_height_m = 0.5f;   ///< a segment with over 2 % of its points higher than
-                                       ///< this over the support is not held by it; > 0
-    float scope_max_outside = 0.1f;    ///< largest share of a segment's outline that continues
-                                       ///< into removed points above the support, or into
-                                       ///< the frame's edge beyond the support's middle; [0, 1]
-    float scope_upright_share = 0.7f;  ///< the frame's sides and bottom count for a segment
-                                       ///< only when this share of its pixels face sideways
-                                       ///< (within 25 degrees of the support plane): a wall;
-                                       ///< an object on the table the frame cuts shows its
-                                       ///< top (its top edge counts for all); [0, 1]
-    /// Low supports: a kept segment no higher than low_support_max_m over the support that
-    /// covers low_support_min_area_m2 of it and holds two kept segments or more (they touch
-    /// it and rise scope_contact_m above it) is a board or a tray lying on the floor, a
-    /// second support under the objects: background, not an object. 0.1 m: a 3 cm board on
-    /// a carpet, a tray's 4 cm rim, and the noise of the segment's highest point; [0, 0.5],
+};
+
+/// Occlusion (occlusion.cpp): a nearer object that hides the middle of a surface (a box
+/// standing before a lying one) leaves two segments, one each side, where there is one
+/// object. The two parts lie on one plane and face the same way, and what lies between them
+/// in view stands in front of that plane. Lines of pixels that cross from one part, over
+/// the occluder, onto the other part's surface are the evidence; such a pair is joined.
+struct OcclusionParams {
+    int min_lines = 8;         ///< crossing lines to join two parts; >= 0, 0 = off
+    float max_offset = 1.0f;   ///< their mean height over the first part's plane, in sensor
+                               ///< steps (depth_jump_m + depth_jump_rel z^2), at most; > 0
+    float max_gap_m = 0.3f;    ///< a line spans at most this much of the plane it starts on
+                               ///< (each pixel where its ray meets the plane: the width
+                               ///< hidden, not the occluder's height in front); > 0
+    float max_deg = 20;        ///< the normals at a line's two ends within this; (0, 90)
+};
+
+/// Scope (scope.cpp; needs the support plane; docs/DESIGN.md, "Scope"): with Scope::Support a
+/// segment is an object when it stands on the support, or rests on a segment that does, and
+/// stays within the support's volume: over its hull (PlaneParams::hull_margin_px) and up to
+/// a height limit. A segment that runs on, with continuous depth, into points the plane
+/// stage removed although they lie above the support (off its hull) is part of something
+/// bigger than the table holds: a wall, a chair, the next table.
+struct ScopeParams {
+    Scope mode = Scope::Support;
+    float contact_m = 0.03f;     ///< a segment whose lowest point is this close to the support
+                                 ///< stands on it (so does one whose foot the camera cannot
+                                 ///< see: its sides unseen); > 0
+    float max_height_m = 0.5f;   ///< a segment with over 2 % of its points higher than this
+                                 ///< over the support is not held by it; > 0
+    float max_outside = 0.1f;    ///< largest share of a segment's outline that continues into
+                                 ///< removed points above the support, or into the frame's
+                                 ///< edge beyond the support's middle; [0, 1]
+    float upright_share = 0.7f;  ///< the frame's sides and bottom count for a segment only
+                                 ///< when this share of its pixels face sideways (within 25
+                                 ///< degrees of the support plane): a wall; an object on the
+                                 ///< table the frame cuts shows its top (its top edge counts
+                                 ///< for all); [0, 1]
+    /// Low supports: a kept segment no higher than scope.low_support_max_m over the support that
+    /// covers scope.low_support_min_area_m2 of it and holds two kept segments or more (they touch
+    /// it and rise contact_m above it) is a board or a tray lying on the floor, a second
+    /// support under the objects: background, not an object. 0.1 m: a 3 cm board on a
+    /// carpet, a tray's 4 cm rim, and the noise of the segment's highest point; [0, 0.5],
     /// 0 = off.
     float low_support_max_m = 0.1f;
     float low_support_min_area_m2 = 0.07f;  ///< ... its area on the support at least (a book is
                                             ///< 0.06); > 0
+};
 
-    void validate() const;  ///< throws ParamError naming the field
+/// segment_objects' parameters: what every phase shares, then one struct per phase or rule,
+/// in the order the driver runs them (segmentation.cpp).
+struct SegmentParams {
+    Segmenter segmenter = Segmenter::Hybrid;
+    int min_points = 300;           ///< objects with fewer pixels are dropped; >= 1
+    float depth_jump_m = 0.004f;    ///< neighbours whose depths differ by more than
+    float depth_jump_rel = 0.012f;  ///< depth_jump_m + depth_jump_rel * z^2 are not connected;
+                                    ///< > 0 and >= 0 (Kinect depth noise grows with z^2)
+    CutParams cuts;
+    MergeParams merge;
+    ContainerParams containers;
+    ColourCueParams colour;
+    StackParams stacks;
+    OcclusionParams occlusion;
+    ScopeParams scope;
+
+    void validate() const;  ///< throws ParamError naming the field (`colour.alpha`)
 };
 
 /// segment_objects' buffers, sized once per resolution and reused from frame to frame
@@ -200,20 +227,33 @@ private:
     std::unique_ptr<Buffers> b_;
 };
 
-/// What segmentation did, as data.
+/// What segmentation did, as data: the counts of each rule in a struct of its own.
 struct SegmentStats {
-    int segments = 0;      ///< objects written to `out`
-    int color_splits = 0;  ///< splits the colour cue made, both rounds (each adds a segment)
-    int texture_splits = 0;  ///< of color_splits, those between a texture and another
-                             ///< material (color_textures)
-    int stack_splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
-    int merges = 0;        ///< segment pairs joined across a non-concave boundary
-    int containers = 0;    ///< insides joined to their container across the rim
-    int occluded = 0;      ///< parts of one surface joined across the object before them
-    std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (gap_max_px)
-    std::size_t reattached = 0;  ///< cut pixels and feet re-attached
-    bool support_scope = false;  ///< Scope::Support was applied (a support was found)
-    int out_of_scope = 0;        ///< segments of min_points or more the scope left out
+    int segments = 0;             ///< objects written to `out`
+    std::size_t reattached = 0;   ///< cut pixels and feet re-attached (CutParams)
+    struct MergeCounts {
+        int joins = 0;  ///< segment pairs joined across a non-concave boundary
+    } merge;
+    struct ContainerCounts {
+        int joins = 0;                ///< insides joined to their container across the rim
+        std::size_t gaps_filled = 0;  ///< points of containers' floors filled in (containers.gap_max_px)
+    } containers;
+    struct ColourCueCounts {
+        int splits = 0;          ///< splits the colour cue made, both rounds (each adds a
+                                 ///< segment)
+        int texture_splits = 0;  ///< of splits, those between a texture and another material
+                                 ///< (ColourCueParams::textures)
+    } colour;
+    struct StackCounts {
+        int splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
+    } stacks;
+    struct OcclusionCounts {
+        int joins = 0;  ///< parts of one surface joined across the object before them
+    } occlusion;
+    struct ScopeCounts {
+        bool applied = false;  ///< Scope::Support was applied (a support was found)
+        int out_of_scope = 0;  ///< segments of min_points or more the scope left out
+    } scope;
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
     /// components, re-attachment, convexity merge, container rule, colour cue, stack rule,
     /// floor gaps, occlusion, the scope, and the renumbering passes with the output. For the

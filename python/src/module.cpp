@@ -175,13 +175,13 @@ py::dict stats_dict(const Result& r) {
     out["depth_noise_px"] = r.depth_noise_px;
     out["normal_radius_px"] = r.normal_radius_px;
     out["segments"] = r.segment_stats.segments;
-    out["merges"] = r.segment_stats.merges;
-    out["containers"] = r.segment_stats.containers;
-    out["occluded_joins"] = r.segment_stats.occluded;
-    out["gaps_filled"] = r.segment_stats.gaps_filled;
-    out["color_splits"] = r.segment_stats.color_splits;
-    out["texture_splits"] = r.segment_stats.texture_splits;
-    out["stack_splits"] = r.segment_stats.stack_splits;
+    out["merges"] = r.segment_stats.merge.joins;
+    out["containers"] = r.segment_stats.containers.joins;
+    out["occluded_joins"] = r.segment_stats.occlusion.joins;
+    out["gaps_filled"] = r.segment_stats.containers.gaps_filled;
+    out["color_splits"] = r.segment_stats.colour.splits;
+    out["texture_splits"] = r.segment_stats.colour.texture_splits;
+    out["stack_splits"] = r.segment_stats.stacks.splits;
     return out;
 }
 

@@ -247,7 +247,7 @@ std::string objects_json(const FrameResult& r, int selected_id) {
         objs.push_back(std::move(o));
     }
     nlohmann::json j = {{"objects", objs},
-                        {"scope", r.segment_stats.support_scope ? "support" : "scene"},
+                        {"scope", r.segment_stats.scope.applied ? "support" : "scene"},
                         {"support_plane", nullptr}};
     if (r.plane.found) {
         const Plane& pl = r.plane.support;

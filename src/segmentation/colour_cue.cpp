@@ -252,10 +252,10 @@ void two_means(const float* const* planes, int m, const double (&total)[6], std:
 struct SplitBoundary {
     int boundary = 0;       ///< 4-neighbour pairs inside the segment with different parts
     int with_normals = 0;   ///< ... with normals a crease step away on either side
-    int smooth = 0;         ///< ... whose normals lie within color_max_crease_deg
+    int smooth = 0;         ///< ... whose normals lie within colour.max_crease_deg
     int on_plane = 0;       ///< ... of those, on one plane (kStepPlaneDeg)
     int steps[2] = {0, 0};  ///< ... of those, where part 0's side (steps[0]) or part 1's
-                            ///< is color_min_step times brighter a crease step away
+                            ///< is colour.min_step times brighter a crease step away
     int small_outline = 0;  ///< 4-neighbour pairs from the smaller part to anything else
 };
 
@@ -275,9 +275,9 @@ void for_part_boundary_pairs(const Ctx& x, const SegmentBuffers& ws, int l, int 
 /// segment's pixels and their neighbours.
 SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m,
                              std::uint8_t small_part, float cos_crease) {
-    const int W = x.W, s = x.prm.crease_step_px;
+    const int W = x.W, s = x.prm.cuts.crease_step_px;
     const std::uint8_t* const part = ws.part.data();
-    // One plane: within kStepPlaneDeg, and smooth whatever color_max_crease_deg says.
+    // One plane: within kStepPlaneDeg, and smooth whatever colour.max_crease_deg says.
     const float cos_plane = std::max(std::cos(kStepPlaneDeg * kDegToRad), cos_crease);
     auto brightness = [&](int p) { return static_cast<float>(x.c.r[p] + x.c.g[p] + x.c.b[p]) + kDark; };
     SplitBoundary sb;
@@ -304,23 +304,23 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, cons
             if (cos_ab < cos_plane) return;
             ++sb.on_plane;
             const float ia = brightness(a), ib = brightness(b);
-            sb.steps[part[p]] += ia >= x.prm.color_min_step * ib;
-            sb.steps[part[q]] += ib >= x.prm.color_min_step * ia;
+            sb.steps[part[p]] += ia >= x.prm.colour.min_step * ib;
+            sb.steps[part[q]] += ib >= x.prm.colour.min_step * ia;
         });
     }
     return sb;
 }
 
 /// Whether the pixels px[0, m) of one segment stand round on the support pl: a quarter of
-/// them or more are walls (normals within color_round_deg of the plane), the walls lie on
+/// them or more are walls (normals within colour.round_deg of the plane), the walls lie on
 /// one upright circle (fit_circle on the plane, as the containers' rims: RMS within
-/// rim_max_residual_m at any depth, spanning rim_min_arc of the diameter, radius up to
-/// color_round_max_radius_m) and three quarters of them face within color_round_deg of its
-/// radii. A can, a bottle or a cup is one solid of revolution; two objects flush in view
+/// containers.max_residual_m at any depth, spanning containers.min_arc of the diameter,
+/// radius up to colour.round_max_radius_m) and three quarters of them face within
+/// colour.round_deg of its radii. A can, a bottle or a cup is one solid of revolution; two objects flush in view
 /// show flat faces. Cost: two passes and fit_circle's six over the m pixels.
 bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, const int* px, int m) {
     const SegmentParams& prm = x.prm;
-    const float sin_wall = std::sin(prm.color_round_deg * kDegToRad);
+    const float sin_wall = std::sin(prm.colour.round_deg * kDegToRad);
     auto for_walls = [&](auto&& visit) {
         for (int i = 0; i < m; ++i) {
             const auto p = static_cast<std::size_t>(px[i]);
@@ -338,8 +338,8 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_walls));
     const Eigen::Vector2d centre = fit.centre;
     const double R = fit.radius;
-    if (!std::isfinite(R) || R > prm.color_round_max_radius_m) return false;
-    const double cos_radial = std::cos(prm.color_round_deg * kDegToRad);
+    if (!std::isfinite(R) || R > prm.colour.round_max_radius_m) return false;
+    const double cos_radial = std::cos(prm.colour.round_deg * kDegToRad);
     // Residual, the walls' extent (the diagonal of their box on the plane) and how many
     // face along a radius (either way: a cup's inside faces in).
     double res = 0, radial = 0;
@@ -354,7 +354,7 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
         lo = lo.cwiseMin(d);
         hi = hi.cwiseMax(d);
     });
-    return std::sqrt(res / walls) <= prm.rim_max_residual_m && (hi - lo).norm() >= prm.rim_min_arc * 2 * R &&
+    return std::sqrt(res / walls) <= prm.containers.max_residual_m && (hi - lo).norm() >= prm.containers.min_arc * 2 * R &&
            4 * radial >= 3 * walls;
 }
 
@@ -378,12 +378,12 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
                     const float (&cen)[2][6]) {
     const SegmentParams& prm = x.prm;
     const int small = std::min(count[0], count[1]);
-    if (small < prm.min_points || static_cast<float>(small) < prm.color_min_share * static_cast<float>(m))
+    if (small < prm.min_points || static_cast<float>(small) < prm.colour.min_share * static_cast<float>(m))
         return Verdict::kRejected;
     const float dr = (cen[0][3] - cen[1][3]) / cp.alpha, dg = (cen[0][4] - cen[1][4]) / cp.alpha,
                 db = (cen[0][5] - cen[1][5]) / cp.alpha;
-    const bool far_in_colour = std::sqrt(dr * dr + dg * dg + db * db) >= prm.color_min_distance;
-    if (!far_in_colour && !(prm.color_min_step > 1)) return Verdict::kRejected;
+    const bool far_in_colour = std::sqrt(dr * dr + dg * dg + db * db) >= prm.colour.min_distance;
+    if (!far_in_colour && !(prm.colour.min_step > 1)) return Verdict::kRejected;
     // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
     // crease step away on either side tell a smooth surface from a fold.
     const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
@@ -393,21 +393,21 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
     // outline of a compact piece: 4 sqrt(pixels) for a square, 6 for a 6:1 rectangle. A
     // split along a texture (stripes, checks, print) runs round most of each of its many
     // pieces, far longer than either.
-    const bool one_side = static_cast<float>(sb.boundary) <= prm.color_max_boundary * static_cast<float>(sb.small_outline);
-    const bool compact = static_cast<double>(sb.boundary) <= prm.color_max_compact * std::sqrt(static_cast<double>(small));
+    const bool one_side = static_cast<float>(sb.boundary) <= prm.colour.max_boundary * static_cast<float>(sb.small_outline);
+    const bool compact = static_cast<double>(sb.boundary) <= prm.colour.max_compact * std::sqrt(static_cast<double>(small));
     if (!one_side && !compact) return Verdict::kTexture;
     // Most of the boundary must cross a smooth surface (a few pairs near a box's corner
     // straddle its edge), or the parts must differ in chromaticity: light falling on two
     // faces of one box at other angles scales their colour, it does not turn it, so
     // across a fold (a flat box on another, flush boxes of two heights) only a change of
-    // material turns the mean colour by color_min_hue_deg. Or, either way, a step in
+    // material turns the mean colour by colour.min_hue_deg. Or, either way, a step in
     // brightness along the boundary where it crosses one plane: light falls alike on both
     // sides there, so only a change of material (two flush boxes of one hue, a light and a
     // dark one, which the chromaticity cannot tell apart) makes one side brighter, along
     // most of the crossing, in one direction. Most: half the smooth crossing or more lies on
     // one plane (a curved surface's does not: a white bowl's shaded floor, 6 of 52), and 70 %
     // of that steps (DESIGN.md, "The brightness step").
-    const bool brightness_step = prm.color_min_step > 1 && sb.on_plane >= kMinStepPairs &&
+    const bool brightness_step = prm.colour.min_step > 1 && sb.on_plane >= kMinStepPairs &&
                                  2 * sb.on_plane >= sb.smooth &&
                                  10 * std::max(sb.steps[0], sb.steps[1]) >= 7 * sb.on_plane;
     if (!far_in_colour && !brightness_step) return Verdict::kRejected;
@@ -417,10 +417,10 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
         const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
         const float dot = r0 * r1 + g0 * g1 + b0c * b1c;
         const float norms = std::sqrt((r0 * r0 + g0 * g0 + b0c * b0c) * (r1 * r1 + g1 * g1 + b1c * b1c));
-        if (!(norms > 0) || dot >= std::cos(prm.color_min_hue_deg * kDegToRad) * norms) return Verdict::kRejected;
+        if (!(norms > 0) || dot >= std::cos(prm.colour.min_hue_deg * kDegToRad) * norms) return Verdict::kRejected;
     }
     // Last, as it is the rarest to fail: a round thing's colours are print.
-    if (support && prm.color_round_deg > 0 && stands_round(x, *plane_xy, *support, px, m)) return Verdict::kRejected;
+    if (support && prm.colour.round_deg > 0 && stands_round(x, *plane_xy, *support, px, m)) return Verdict::kRejected;
     return Verdict::kKept;
 }
 
@@ -528,8 +528,8 @@ void texture_colours(const float* const* f, int m, const float (&two)[2][6], std
 
 /// The materials of segment l's colours (ws.part at its pixels px[0, m), sizes `count`):
 /// per pair of colours their contact, the 4-neighbour pairs between them, over the square
-/// root of the smaller's size. Above color_max_compact (longer than the outline of any
-/// compact piece) they interleave: one material. At most color_max_boundary x that (one side
+/// root of the smaller's size. Above colour.max_compact (longer than the outline of any
+/// compact piece) they interleave: one material. At most colour.max_boundary x that (one side
 /// of a compact piece) they lie apart. Between the two the pair is neither: no split. True,
 /// with `material` (0 or 1 per colour), when the colours make exactly two materials. Cost:
 /// one pass over the segment's pixels.
@@ -569,9 +569,9 @@ bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int*
             if (tiny(a) || tiny(b)) continue;
             const double c = contact[a][b];
             const double unit = std::sqrt(static_cast<double>(std::min(count[a], count[b])));
-            if (c > prm.color_max_compact * unit) {
+            if (c > prm.colour.max_compact * unit) {
                 join(a, b);
-            } else if (c > prm.color_max_boundary * prm.color_max_compact * unit) {
+            } else if (c > prm.colour.max_boundary * prm.colour.max_compact * unit) {
                 return false;
             }
         }
@@ -634,7 +634,7 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
     for (int q = 0; q < 6; ++q) f[q] = ft.f[q] + (o - ft.first);
     float cen[2][6];
     double total[6];
-    if (!seed_centres(f, m, prm.color_min_distance * cp.alpha, cen, total)) return kNotSplit;
+    if (!seed_centres(f, m, prm.colour.min_distance * cp.alpha, cen, total)) return kNotSplit;
     std::uint8_t* const side = ws.part_in_order.data() + o;
     int count[2] = {0, 0};
     two_means(f, m, total, side, cen, count);
@@ -643,7 +643,7 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
     const Verdict verdict = judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen);
     if (verdict == Verdict::kKept) return kSplitByColour;
     // kTexture: both parts passed the share test, so both hold pixels.
-    if (verdict != Verdict::kTexture || !prm.color_textures || !split_by_materials(x, ws, l, px, f, m, side, cen, count))
+    if (verdict != Verdict::kTexture || !prm.colour.textures || !split_by_materials(x, ws, l, px, f, m, side, cen, count))
         return kNotSplit;
     return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen) == Verdict::kKept
                ? kSplitByMaterial
@@ -683,10 +683,10 @@ int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, i
     ws.part_in_order.resize(static_cast<std::size_t>(ws.offsets[static_cast<std::size_t>(n) + 1]));
     ws.split.assign(static_cast<std::size_t>(n) + 1, kNotSplit);
     ClusterParams cp;
-    cp.alpha = prm.color_alpha;
-    cp.delta = 1.0f - prm.color_alpha;
+    cp.alpha = prm.colour.alpha;
+    cp.delta = 1.0f - prm.colour.alpha;
     const ColourFeatures features = gather_features(x, cp, ws, n);
-    const float cos_crease = std::cos(prm.color_max_crease_deg * kDegToRad);
+    const float cos_crease = std::cos(prm.colour.max_crease_deg * kDegToRad);
     std::optional<PlaneAxes> plane_xy;
     if (support) plane_xy.emplace(*support);
     // Each segment is tried on its own; split ids are given out in segment order afterwards
@@ -728,8 +728,8 @@ int color_splits(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, 
 }  // namespace
 
 void split_by_colour(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    stats.color_splits = color_splits(x, support, ws, n, stats.texture_splits);
-    n += stats.color_splits;
+    stats.colour.splits = color_splits(x, support, ws, n, stats.colour.texture_splits);
+    n += stats.colour.splits;
 }
 
 }  // namespace wul3d::detail

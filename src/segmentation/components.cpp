@@ -268,7 +268,7 @@ std::size_t reattach(const Ctx& x, SegmentBuffers& ws, int max_steps, bool insid
     return added;
 }
 
-/// Fragments too small to seed an object (min_seed_points) go back to the unassigned pool:
+/// Fragments too small to seed an object (cuts.min_seed_points) go back to the unassigned pool:
 /// their labels in ws.label become 0. In: ws.sizes from components. Cost: one parallel pass
 /// over the pixels.
 void drop_small_components(SegmentBuffers& ws, int min_seed) {
@@ -305,13 +305,13 @@ int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentBuffers&
 int seed_components(const Ctx& x, SegmentBuffers& ws) {
     // A strip per thread; one thread searches.
     const int n = label_components(x, ws.cut.data(), ws, row_strips(x.H));
-    drop_small_components(ws, x.prm.min_seed_points);
+    drop_small_components(ws, x.prm.cuts.min_seed_points);
     return n;
 }
 
 std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
     // Cut pixels, feet and dropped fragments, then containers' insides, join what they touch.
-    const std::size_t near = reattach(x, ws, x.prm.reattach_px);
+    const std::size_t near = reattach(x, ws, x.prm.cuts.reattach_px);
     return near + reattach(x, ws, x.W + x.H, true);
 }
 

@@ -91,14 +91,14 @@ void collect_boundary_steps(const Ctx& x, SegmentBuffers& ws, int n) {
 }
 
 /// The RMS distance from a fitted circle that still counts as on it, for points at mean
-/// depth z: rim_max_residual_m to 1 m (it was set on `osd_mosd`, whose objects lie 0.57-0.82
+/// depth z: containers.max_residual_m to 1 m (it was set on `osd_mosd`, whose objects lie 0.57-0.82
 /// m away), then growing as z^2, as the sensor's depth noise does (a structured-light
 /// sensor's depth step is z^2 / (f b)), which scatters the points along the rays. Only the
-/// rims use it: the round test keeps rim_max_residual_m, since a looser bound there let more
+/// rims use it: the round test keeps containers.max_residual_m, since a looser bound there let more
 /// segments pass as round, which the colour cue then leaves unsplit (docs/ABLATION.md,
 /// "Containers").
 double circle_tolerance(const SegmentParams& prm, double z) {
-    return prm.rim_max_residual_m * std::max(1.0, z * z);
+    return prm.containers.max_residual_m * std::max(1.0, z * z);
 }
 
 /// The front's extent across the line of sight, in radii of a circle fitted with the far
@@ -131,7 +131,7 @@ struct RimCircle {
 
 /// A circle fitted to the rim points `for_rim` visits (it calls its argument with each
 /// pixel), on the plane (fit_circle), when the points lie on it (circle_tolerance at their
-/// depth) and span enough of it (rim_min_arc); nothing otherwise. Cost: three passes and
+/// depth) and span enough of it (containers.min_arc); nothing otherwise. Cost: three passes and
 /// fit_circle's six over the points.
 template <class ForRim>
 std::optional<RimCircle> rim_circle(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, ForRim&& for_rim) {
@@ -165,11 +165,11 @@ std::optional<RimCircle> rim_circle(const Ctx& x, const Plane& pl, const PlaneAx
         }
     });
     for_rim([&](std::size_t p) { chord = std::max(chord, (plane_xy(x.c, p) - mean - far).norm()); });
-    if (std::sqrt(res / m) > circle_tolerance(x.prm, z) || chord < x.prm.rim_min_arc * 2 * R) return std::nullopt;
+    if (std::sqrt(res / m) > circle_tolerance(x.prm, z) || chord < x.prm.containers.min_arc * 2 * R) return std::nullopt;
     return RimCircle{centre + mean, R, height};
 }
 
-/// The back segment's pixels on its far rim, into ws.rim_far_px: within rim_height_tol_m of
+/// The back segment's pixels on its far rim, into ws.rim_far_px: within containers.height_tol_m of
 /// `rim_height` over the plane, and nearer across a depth step than a 4-neighbour that
 /// belongs to neither segment (or has no depth). A container's inside, seen over its front
 /// wall, ends there at the far half of the rim. Cost: one pass over the back's rows.
@@ -187,21 +187,21 @@ void collect_far_rim(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int fron
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if (label[p] != back) continue;
-            if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) - rim_height) > x.prm.rim_height_tol_m) continue;
+            if (std::fabs(pl.height(x.c.x[p], x.c.y[p], x.c.z[p]) - rim_height) > x.prm.containers.height_tol_m) continue;
             const bool on_outline = (u > 0 && steps_to_farther(p, p - 1)) || (u + 1 < W && steps_to_farther(p, p + 1)) ||
                                     (v > 0 && steps_to_farther(p, p - W)) || (v + 1 < H && steps_to_farther(p, p + W));
             if (on_outline) ws.rim_far_px.push_back(static_cast<int>(p));
         }
 }
 
-/// The far rim's candidate (rim_far) for the pair (front, back), whose front edge
+/// The far rim's candidate (containers.far_rim) for the pair (front, back), whose front edge
 /// `for_edge` visits: a circle fitted to that edge and to the back's far rim
 /// (collect_far_rim, at the edge's mean height). A small cup's front edge at --decimate 2
 /// can be 6 pairs long, too short an arc to fit alone, or it fits a circle too small for the
 /// inside; with the far half of the rim the circle spans the whole rim. Kept when
 ///  - the front spans a radius of it across the line of sight (kFarRimMinWidth): a
 ///    container's outer wall spans its diameter;
-///  - the far rim alone fits a circle that agrees with it (rim_far_agree): it is the same
+///  - the far rim alone fits a circle that agrees with it (containers.far_agree): it is the same
 ///    rim. This is what keeps an object behind a box out: its outline at the box's height
 ///    reaches "the rim" by how the far rim is chosen, but traces its own shape, not the
 ///    circle through the box's straight edge.
@@ -228,7 +228,7 @@ std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const Pla
     if (!both || front_width(x, plane_xy, ws, front, both->centre) < kFarRimMinWidth * both->radius)
         return std::nullopt;
     const auto far = rim_circle(x, pl, plane_xy, for_far);
-    const double agree = x.prm.rim_far_agree * both->radius;
+    const double agree = x.prm.containers.far_agree * both->radius;
     if (!far || std::fabs(far->radius - both->radius) > agree || (far->centre - both->centre).norm() > agree)
         return std::nullopt;
     return both;
@@ -236,7 +236,7 @@ std::optional<RimCircle> far_rim_circle(const Ctx& x, const Plane& pl, const Pla
 
 /// The rim of the pair (front, back) along the steps ws.steps[i0, i1): a circle fitted to
 /// the front segment's edge there (the nearer pixels of the depth steps that lie in
-/// `front`), and with rim_far a second one through the back's far rim too
+/// `front`), and with containers.far_rim a second one through the back's far rim too
 /// (far_rim_circle). Appends each that passes to ws.rim_fits as {front, back, centre (2),
 /// radius, rim height}; the inside test then judges each. Cost: rim_circle's passes over
 /// the pair's boundary pairs, and far_rim_circle's; no allocation but the appends.
@@ -251,7 +251,7 @@ void fit_rim(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, SegmentBu
                                c.radius, c.height});
     };
     if (const auto edge = rim_circle(x, pl, plane_xy, for_edge)) keep(*edge);
-    if (!x.prm.rim_far) return;
+    if (!x.prm.containers.far_rim) return;
     if (const auto both = far_rim_circle(x, pl, plane_xy, ws, for_edge, front, back)) keep(*both);
 }
 
@@ -272,7 +272,7 @@ void find_rims(const Ctx& x, const Plane& pl, const PlaneAxes& plane_xy, Segment
             lo_nearer += static_cast<int>(ws.steps[i].key & 1);
         }
         const int pairs = static_cast<int>(i - i0);
-        if (steps < prm.rim_min_boundary || 5 * steps < 4 * pairs) continue;
+        if (steps < prm.containers.min_boundary || 5 * steps < 4 * pairs) continue;
         const int lo = static_cast<int>(k >> 34), hi = static_cast<int>((k >> 4) & ((1u << 30) - 1));
         if (2 * lo_nearer == steps) continue;  // neither is in front
         const int front = 2 * lo_nearer > steps ? lo : hi, back = front == lo ? hi : lo;
@@ -326,7 +326,7 @@ int join_insides(const Ctx& x, SegmentBuffers& ws, int n) {
     for (std::size_t c = 0; c < ws.rim_fits.size(); ++c) {
         const auto& fit = ws.rim_fits[c];
         const auto& b = ws.rim_back[c];
-        if (b[1] < prm.rim_inside_share * b[0] || std::fabs(b[2] - fit[5]) > prm.rim_height_tol_m) continue;
+        if (b[1] < prm.containers.inside_share * b[0] || std::fabs(b[2] - fit[5]) > prm.containers.height_tol_m) continue;
         joins += join_sets(ws.parent, static_cast<int>(fit[0]), static_cast<int>(fit[1]));
     }
     if (joins > 0) relabel_to_roots(ws);
@@ -349,7 +349,7 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 
 /// The container rule (SegmentParams, "Containers"), on a support: a segment seen over
 /// another's circular, level edge across a depth step, lying inside that circle and reaching
-/// up to it, is the other's inside (a bowl's or a cup's) and joins it. With rim_islands the
+/// up to it, is the other's inside (a bowl's or a cup's) and joins it. With containers.islands the
 /// regions no segment reached take part as segments n + 1, ... (add_islands), and after the
 /// joins those that joined no segment are unlabelled again (drop_islands): the root of a
 /// joined set is its smallest label, so what is left above n joined only islands. In:
@@ -358,9 +358,9 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 /// boundary, and one over the rows of the candidates' insides; with islands, add_islands and
 /// drop_islands.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    if (!support || x.prm.rim_min_boundary <= 0 || n < 1) return;
-    const int islands = x.prm.rim_islands ? add_islands(x, ws, n) : 0;
-    stats.containers = join_rims(x, *support, ws, n + islands);
+    if (!support || x.prm.containers.min_boundary <= 0 || n < 1) return;
+    const int islands = x.prm.containers.islands ? add_islands(x, ws, n) : 0;
+    stats.containers.joins = join_rims(x, *support, ws, n + islands);
     if (islands > 0) drop_islands(x, ws, n);
 }
 

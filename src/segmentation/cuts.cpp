@@ -14,14 +14,14 @@
 
 namespace wul3d::detail {
 
-/// The normals of the crease tests: `normals` smoothed over normal_smooth_px into ws.smooth,
-/// or `normals` themselves when normal_smooth_px is 0. Smoothed normals are read at segment
+/// The normals of the crease tests: `normals` smoothed over cuts.normal_smooth_px into ws.smooth,
+/// or `normals` themselves when cuts.normal_smooth_px is 0. Smoothed normals are read at segment
 /// pixels (never removed ones) and a crease step away from them: only those rows are
 /// smoothed. Cost: a scan of the classes for the rows with objects, then running sums over
 /// those rows (smooth_normals); no allocation once ws.smooth has the frame's size.
 const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& normals,
                                 const std::vector<std::uint8_t>& classes, int W, int H, SegmentBuffers& ws) {
-    if (params.normal_smooth_px <= 0) return normals;
+    if (params.cuts.normal_smooth_px <= 0) return normals;
     int first = H, last = -1;
     for (int v = 0; v < H; ++v) {
         const auto row = classes.begin() + static_cast<std::ptrdiff_t>(v) * W;
@@ -30,8 +30,8 @@ const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& no
             last = v;
         }
     }
-    const int margin = params.crease_step_px + 1;
-    smooth_normals(normals, params.normal_smooth_px, ws.smooth_scratch, ws.smooth, std::max(0, first - margin),
+    const int margin = params.cuts.crease_step_px + 1;
+    smooth_normals(normals, params.cuts.normal_smooth_px, ws.smooth_scratch, ws.smooth, std::max(0, first - margin),
                    std::min(H, last + 1 + margin));
     return ws.smooth;
 }
@@ -64,7 +64,7 @@ void seeds_in_clusters(const Ctx& x, const LabelImage& clusters, SegmentBuffers&
 /// SegmentParams::concavity), bit 1 for (p, p + s W) along v. `has_normal`: the raw normals'
 /// validity. Cost: one parallel pass over the pixels, two tests each.
 void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentBuffers& ws) {
-    const int W = x.W, H = x.H, s = x.prm.crease_step_px;
+    const int W = x.W, H = x.H, s = x.prm.cuts.crease_step_px;
     // Raw pointers and plain values: the byte stores would otherwise make the compiler
     // reload every container's data pointer and every parameter on each pixel.
     const std::uint8_t* const cls = x.cls.data();
@@ -73,7 +73,7 @@ void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentBuf
     ws.crease.resize(static_cast<std::size_t>(W) * H);
     std::uint8_t* const crease = ws.crease.data();
     const float jump_m = x.prm.depth_jump_m, jump_rel = x.prm.depth_jump_rel;
-    const float concavity = x.prm.concavity, steps = static_cast<float>(s);
+    const float concavity = x.prm.cuts.concavity, steps = static_cast<float>(s);
 #pragma omp parallel for schedule(static)
     for (int v = 0; v < H; ++v) {
         // Only the columns from the row's first object pixel (memchr) to its last can hold
@@ -118,7 +118,7 @@ void find_concave_pairs(const Ctx& x, const std::uint8_t* has_normal, SegmentBuf
 /// threads write one byte). Cost: one parallel pass over the pixels, up to 2 (s + 1) reads
 /// each; no allocation.
 void seeds_off_creases(const Ctx& x, const std::uint8_t* has_normal, SegmentBuffers& ws) {
-    const int W = x.W, H = x.H, s = x.prm.crease_step_px;
+    const int W = x.W, H = x.H, s = x.prm.cuts.crease_step_px;
     const std::uint8_t* const cls = x.cls.data();
     const std::uint8_t* const crease = ws.crease.data();
     std::uint8_t* const seedable_out = ws.cut.data();

@@ -11,13 +11,13 @@
 namespace wul3d::detail {
 namespace {
 
-/// Gaps in a container's floor (SegmentParams::gap_max_px): each patch of unlabelled pixels
+/// Gaps in a container's floor (ContainerParams::gap_max_px): each patch of unlabelled pixels
 /// beside a labelled kPlaneInside pixel is explored breadth-first; when it is enclosed by one
 /// segment (no image border, no other segment) and small, its points join that segment.
 /// Only the inside pixels are visited to find the patches, and the marks are cleared behind
 /// each search: the cost follows the insides, not the image. Returns the points filled.
 std::size_t fill_container_gaps(const Ctx& x, SegmentBuffers& ws) {
-    const int max_px = x.prm.gap_max_px;
+    const int max_px = x.prm.containers.gap_max_px;
     if (max_px <= 0) return 0;
     const int W = x.W, H = x.H;
     const std::size_t N = static_cast<std::size_t>(W) * H;
@@ -85,7 +85,7 @@ std::size_t fill_container_gaps(const Ctx& x, SegmentBuffers& ws) {
 }  // namespace
 
 void fill_floor_gaps(const Ctx& x, const Plane*, SegmentBuffers& ws, int&, SegmentStats& stats) {
-    stats.gaps_filled = fill_container_gaps(x, ws);
+    stats.containers.gaps_filled = fill_container_gaps(x, ws);
 }
 
 }  // namespace wul3d::detail

@@ -30,7 +30,7 @@ struct BoundaryStep {
 
 /// segment_objects' buffers (SegmentWorkspace, opaque to its callers).
 struct SegmentWorkspace::Buffers {
-    NormalMap smooth;                  ///< smoothed normals (normal_smooth_px)
+    NormalMap smooth;                  ///< smoothed normals (cuts.normal_smooth_px)
     std::vector<float> smooth_scratch;
     std::vector<std::uint8_t> cut;     ///< 1 = may seed a component; once the seeds are
                                        ///< spent, the container rule's open pixels (islands)
@@ -177,7 +177,7 @@ inline void chromaticity(const OrganizedCloud& c, std::size_t p, float (&out)[3]
 constexpr float kUprightDeg = 25.0f;
 
 /// What every phase reads: the parameters, the frame and the normals of the crease tests
-/// (smoothed when normal_smooth_px > 0), the plane's classes per pixel.
+/// (smoothed when cuts.normal_smooth_px > 0), the plane's classes per pixel.
 struct Ctx {
     const SegmentParams& prm;
     const OrganizedCloud& c;
@@ -296,8 +296,8 @@ int row_strips(int rows);
 
 // ---- the phases before the rules ---------------------------------------------------------
 
-/// The normals of the crease tests (cuts.cpp): `normals` smoothed over normal_smooth_px into
-/// ws.smooth, or `normals` themselves when normal_smooth_px is 0.
+/// The normals of the crease tests (cuts.cpp): `normals` smoothed over cuts.normal_smooth_px into
+/// ws.smooth, or `normals` themselves when cuts.normal_smooth_px is 0.
 const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& normals,
                                 const std::vector<std::uint8_t>& classes, int W, int H, SegmentBuffers& ws);
 
@@ -308,7 +308,7 @@ const NormalMap& crease_normals(const SegmentParams& params, const NormalMap& no
 void find_seeds(const Ctx& x, const std::uint8_t* has_normal, const LabelImage& clusters, SegmentBuffers& ws);
 
 /// The segments (components.cpp): connected components of the seeds into ws.label, 1..n,
-/// fragments under min_seed_points unlabelled again. Returns n.
+/// fragments under cuts.min_seed_points unlabelled again. Returns n.
 int seed_components(const Ctx& x, SegmentBuffers& ws);
 
 /// Connected components of the pixels with seedable[p] = 1 (else 0) into ws.label, 1..n, and
@@ -322,7 +322,7 @@ int seed_components(const Ctx& x, SegmentBuffers& ws);
 int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentBuffers& ws, int strips);
 
 /// Cut pixels, feet, pixels without a normal and dropped fragments join the segment they
-/// touch (up to reattach_px, where depth is continuous), then containers' insides, however
+/// touch (up to cuts.reattach_px, where depth is continuous), then containers' insides, however
 /// wide (components.cpp). Returns the pixels added.
 std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws);
 
@@ -342,20 +342,20 @@ using Rule = void (*)(const Ctx& x, const Plane* support, SegmentBuffers& ws, in
 void merge_segments(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Containers (containers.cpp; SegmentParams, "Containers"): joins a container's inside,
-/// seen over its rim, to the container; with rim_islands, the regions no segment reached
+/// seen over its rim, to the container; with containers.islands, the regions no segment reached
 /// take part (islands.cpp). Nothing without a support. stats.containers.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// The colour cue (colour_cue.cpp; hybrid): splits segments in two by colour.
 /// stats.color_splits, texture_splits (those
-/// between a texture and another material, SegmentParams::color_textures).
+/// between a texture and another material, ColourCueParams::textures).
 void split_by_colour(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Stacks (stacks.cpp; SegmentParams, "Stacks"; `support` not null): cuts a segment whose
 /// upward faces lie at two heights in two. stats.stack_splits.
 void split_stacks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
-/// Floor gaps (floor_gaps.cpp; SegmentParams::gap_max_px): small unlabelled patches beside a
+/// Floor gaps (floor_gaps.cpp; ContainerParams::gap_max_px): small unlabelled patches beside a
 /// container's inside, enclosed by one segment, join it. stats.gaps_filled.
 void fill_floor_gaps(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
@@ -370,7 +370,7 @@ void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws,
 // ---- islands (islands.cpp), for the container rule -----------------------------------------
 
 /// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
-/// segment reached, of min_seed_points or more, become segments n + 1, ... for the rim
+/// segment reached, of cuts.min_seed_points or more, become segments n + 1, ... for the rim
 /// test. Returns the islands added.
 int add_islands(const Ctx& x, SegmentBuffers& ws, int n);
 

@@ -2,8 +2,8 @@
 // a small cup's inside can lie within a crease step of a crease, and the rim's depth step
 // keeps reattachment out). They take part in the container rule's rim test as segments
 // (containers.cpp), and those it joins to nothing are dropped: mixed pixels along occluding
-// edges, broken pieces of one surface. (Keeping the lone ones as objects added under 0.2
-// Overlap F on every set: docs/ABLATION.md, "Every rule, switched off".)
+// edges, broken pieces of one surface. (Keeping the lone ones as objects was a rule once:
+// docs/ABLATION.md, "Every rule, switched off", says why it went.)
 #include <algorithm>
 #include <cstring>
 
@@ -13,7 +13,7 @@
 namespace wul3d::detail {
 
 /// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
-/// segment reached, of min_seed_points or more, become segments n + 1, ... for the rim
+/// segment reached, of cuts.min_seed_points or more, become segments n + 1, ... for the rim
 /// test. At `--decimate 2` every pixel of a small cup's inside, or of a bowl's outer wall
 /// seen at a steep angle, can lie within a crease step of a crease, so the region seeds no
 /// segment, and the rim's depth step keeps reattachment out of it. ws.cut (the seeds, spent
@@ -37,7 +37,7 @@ int add_islands(const Ctx& x, SegmentBuffers& ws, int n) {
         const int size = flood_region(
             x, ws.queue, static_cast<int>(seed), [&](std::size_t q) { return open[q] != 0; },
             [&](std::size_t q) { open[q] = 0; });
-        if (size < x.prm.min_seed_points) continue;
+        if (size < x.prm.cuts.min_seed_points) continue;
         const int id = n + (++added);
         for (int i = 0; i < size; ++i) ws.label[static_cast<std::size_t>(ws.queue[i])] = id;
     }

@@ -16,7 +16,7 @@ namespace {
 /// segments, were tested for a crease and found concave. Reads only: strips run in parallel.
 void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, std::vector<std::uint64_t>& edges) {
     const SegmentParams& prm = x.prm;
-    const int W = x.W, H = x.H, s = prm.crease_step_px;
+    const int W = x.W, H = x.H, s = prm.cuts.crease_step_px;
     // The pair (p, q = p + d) of segments a and b, q right of or below p.
     auto boundary_pair = [&](int u, int v, int a, int b, const int (&d)[2]) {
         const int p = v * W + u, q = p + d[0] + d[1] * W;
@@ -29,7 +29,7 @@ void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, std::vector<
             const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
             if (label[pp] == a && label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
                 tested = 1;
-                concave = x.concavity(pp, qq) > prm.concavity;
+                concave = x.concavity(pp, qq) > prm.cuts.concavity;
             }
         }
         const auto lo = static_cast<std::uint64_t>(std::min(a, b));
@@ -58,7 +58,7 @@ void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, std::vector<
 template <class MayJoin>
 int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
     const SegmentParams& prm = x.prm;
-    if (prm.merge_max_concave <= 0 || n < 2) return 0;
+    if (prm.merge.max_concave <= 0 || n < 2) return 0;
     const int strips = row_strips(x.H);
     const int* const label = ws.label.data();
     ws.edges.clear();
@@ -85,8 +85,8 @@ int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
             concave += static_cast<int>(ws.edges[i] & 1);
         }
         const int a = static_cast<int>(key >> 30), b = static_cast<int>(key & ((1u << 30) - 1));
-        if (tested < prm.merge_min_boundary ||
-            static_cast<float>(concave) > prm.merge_max_concave * static_cast<float>(tested) || !may_join(a, b))
+        if (tested < prm.merge.min_boundary ||
+            static_cast<float>(concave) > prm.merge.max_concave * static_cast<float>(tested) || !may_join(a, b))
             continue;
         merges += join_sets(ws.parent, a, b);
     }
@@ -97,7 +97,7 @@ int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
 }  // namespace
 
 void merge_segments(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    stats.merges = merge_convex(x, ws, n, [](int, int) { return true; });
+    stats.merge.joins = merge_convex(x, ws, n, [](int, int) { return true; });
 }
 
 }  // namespace wul3d::detail

@@ -17,15 +17,15 @@ namespace {
 /// The plane is a's tangent plane a crease step inside its outline, where the smoothed
 /// normals are not bent by the occluder's. Returns that pixel's segment b when it lies on
 /// the plane (within two sensor steps, and 5 % of the distance for the surface's curvature
-/// and the normals' noise), faces the same way (normals within occluded_max_deg) and is
+/// and the normals' noise), faces the same way (normals within occlusion.max_deg) and is
 /// not the occluder's own far edge; `offset` gets its height over the plane in sensor
 /// steps. Returns 0 otherwise. Cost: the pixels crossed; a line ends after
-/// occluded_max_gap_m of a's plane (each pixel measured where its viewing ray meets it) or
+/// occlusion.max_gap_m of a's plane (each pixel measured where its viewing ray meets it) or
 /// after 4 crease steps without a point.
 int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, int dv, float cos_max,
                    float& offset) {
     const OrganizedCloud& c = x.c;
-    const int s = x.prm.crease_step_px;
+    const int s = x.prm.cuts.crease_step_px;
     const int au = u - s * du, av = v - s * dv;
     if (au < 0 || av < 0) return 0;
     const std::size_t p = static_cast<std::size_t>(av) * x.W + au;  // the plane's anchor
@@ -62,7 +62,7 @@ int cross_occluder(const Ctx& x, const int* label, int a, int u, int v, int du, 
         const float t = anchor_side / toward;
         const float gx = t * c.x[r] - c.x[p], gy = t * c.y[r] - c.y[p], gz = t * c.z[r] - c.z[p];
         const float dist = std::sqrt(gx * gx + gy * gy + gz * gz);
-        if (dist > x.prm.occluded_max_gap_m) return 0;
+        if (dist > x.prm.occlusion.max_gap_m) return 0;
         const float tol = 2.0f * step + 0.05f * dist;
         if (h > tol) {
             if (b == 0) return 0;  // in front of a but the support's: no occluder
@@ -127,15 +127,15 @@ void collect_lines(const Ctx& x, SegmentBuffers& ws, float cos_max) {
 
 /// The occlusion rule (SegmentParams, "Occlusion"). Each line of evidence (collect_lines,
 /// cross_occluder) that lands on another segment b lying on a's plane says that a and b are
-/// one surface with the occluder before its middle. A pair joins with occluded_min_lines
-/// lines or more whose mean offset from a's plane is at most occluded_max_offset sensor
+/// one surface with the occluder before its middle. A pair joins with occlusion.min_lines
+/// lines or more whose mean offset from a's plane is at most occlusion.max_offset sensor
 /// steps: one line's tolerance takes the sensor's noise, the mean takes two faces a little
 /// apart. In: ws.label (1..n with gaps). Out: ws.label with the pairs joined. Cost:
 /// collect_lines; a sort of the lines; a relabel pass when anything joined.
 int join_across_occluders(const Ctx& x, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
-    if (prm.occluded_min_lines <= 0 || n < 2) return 0;
-    collect_lines(x, ws, std::cos(prm.occluded_max_deg * kDegToRad));
+    if (prm.occlusion.min_lines <= 0 || n < 2) return 0;
+    collect_lines(x, ws, std::cos(prm.occlusion.max_deg * kDegToRad));
     auto& lines = ws.occluded_lines;
     if (lines.empty()) return 0;
     std::sort(lines.begin(), lines.end());
@@ -147,7 +147,7 @@ int join_across_occluders(const Ctx& x, SegmentBuffers& ws, int n) {
         std::size_t j = i;
         for (; j < lines.size() && lines[j].first == key; ++j) sum += lines[j].second;
         const auto count = static_cast<double>(j - i);
-        if (count >= prm.occluded_min_lines && std::fabs(sum / count) <= prm.occluded_max_offset)
+        if (count >= prm.occlusion.min_lines && std::fabs(sum / count) <= prm.occlusion.max_offset)
             joins += join_sets(ws.parent, static_cast<int>(key >> 32), static_cast<int>(key & 0xffffffffu));
         i = j;
     }
@@ -158,7 +158,7 @@ int join_across_occluders(const Ctx& x, SegmentBuffers& ws, int n) {
 }  // namespace
 
 void join_occluded(const Ctx& x, const Plane*, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    stats.occluded = join_across_occluders(x, ws, n);
+    stats.occlusion.joins = join_across_occluders(x, ws, n);
 }
 
 }  // namespace wul3d::detail

@@ -43,45 +43,45 @@ void SegmentParams::validate() const {
     require(min_points >= 1, "min_points", min_points, ">= 1");
     require(depth_jump_m > 0, "depth_jump_m", depth_jump_m, "> 0");
     require(depth_jump_rel >= 0, "depth_jump_rel", depth_jump_rel, ">= 0");
-    require(normal_smooth_px >= 0 && normal_smooth_px <= 16, "normal_smooth_px", normal_smooth_px, "in [0, 16]");
-    require(crease_step_px >= 1 && crease_step_px <= 16, "crease_step_px", crease_step_px, "in [1, 16]");
-    require(concavity > 0, "concavity", concavity, "> 0");
-    require(reattach_px >= 0, "reattach_px", reattach_px, ">= 0");
-    require(min_seed_points >= 1, "min_seed_points", min_seed_points, ">= 1");
-    require(merge_max_concave >= 0 && merge_max_concave <= 1, "merge_max_concave", merge_max_concave, "in [0, 1]");
-    require(merge_min_boundary >= 1, "merge_min_boundary", merge_min_boundary, ">= 1");
-    require(color_alpha >= 0.002f && color_alpha <= 0.1f, "color_alpha", color_alpha,
+    require(cuts.normal_smooth_px >= 0 && cuts.normal_smooth_px <= 16, "cuts.normal_smooth_px", cuts.normal_smooth_px, "in [0, 16]");
+    require(cuts.crease_step_px >= 1 && cuts.crease_step_px <= 16, "cuts.crease_step_px", cuts.crease_step_px, "in [1, 16]");
+    require(cuts.concavity > 0, "cuts.concavity", cuts.concavity, "> 0");
+    require(cuts.reattach_px >= 0, "cuts.reattach_px", cuts.reattach_px, ">= 0");
+    require(cuts.min_seed_points >= 1, "cuts.min_seed_points", cuts.min_seed_points, ">= 1");
+    require(merge.max_concave >= 0 && merge.max_concave <= 1, "merge.max_concave", merge.max_concave, "in [0, 1]");
+    require(merge.min_boundary >= 1, "merge.min_boundary", merge.min_boundary, ">= 1");
+    require(colour.alpha >= 0.002f && colour.alpha <= 0.1f, "colour.alpha", colour.alpha,
             "in [0.002, 0.1] (the paper's range of alpha)");
-    require(color_min_distance > 0, "color_min_distance", color_min_distance, "> 0");
-    require(color_min_share > 0 && color_min_share <= 0.5f, "color_min_share", color_min_share, "in (0, 0.5]");
-    require(color_max_boundary > 0 && color_max_boundary <= 1, "color_max_boundary", color_max_boundary, "in (0, 1]");
-    require(color_max_compact >= 0, "color_max_compact", color_max_compact, ">= 0");
-    require(color_max_crease_deg > 0, "color_max_crease_deg", color_max_crease_deg, "> 0");
-    require(color_min_hue_deg > 0 && color_min_hue_deg < 90, "color_min_hue_deg", color_min_hue_deg, "in (0, 90)");
-    require(color_min_step >= 0 && color_min_step < 100, "color_min_step", color_min_step, "in [0, 100), <= 1 = off");
-    require(color_round_deg >= 0 && color_round_deg < 90, "color_round_deg", color_round_deg, "in [0, 90)");
-    require(color_round_max_radius_m > 0, "color_round_max_radius_m", color_round_max_radius_m, "> 0");
-    require(stack_min_step_m >= 0 && stack_min_step_m <= 0.5f, "stack_min_step_m", stack_min_step_m,
+    require(colour.min_distance > 0, "colour.min_distance", colour.min_distance, "> 0");
+    require(colour.min_share > 0 && colour.min_share <= 0.5f, "colour.min_share", colour.min_share, "in (0, 0.5]");
+    require(colour.max_boundary > 0 && colour.max_boundary <= 1, "colour.max_boundary", colour.max_boundary, "in (0, 1]");
+    require(colour.max_compact >= 0, "colour.max_compact", colour.max_compact, ">= 0");
+    require(colour.max_crease_deg > 0, "colour.max_crease_deg", colour.max_crease_deg, "> 0");
+    require(colour.min_hue_deg > 0 && colour.min_hue_deg < 90, "colour.min_hue_deg", colour.min_hue_deg, "in (0, 90)");
+    require(colour.min_step >= 0 && colour.min_step < 100, "colour.min_step", colour.min_step, "in [0, 100), <= 1 = off");
+    require(colour.round_deg >= 0 && colour.round_deg < 90, "colour.round_deg", colour.round_deg, "in [0, 90)");
+    require(colour.round_max_radius_m > 0, "colour.round_max_radius_m", colour.round_max_radius_m, "> 0");
+    require(stacks.min_step_m >= 0 && stacks.min_step_m <= 0.5f, "stacks.min_step_m", stacks.min_step_m,
             "in [0, 0.5], 0 = off");
-    require(stack_min_share > 0 && stack_min_share <= 0.5f, "stack_min_share", stack_min_share, "in (0, 0.5]");
-    require(rim_min_boundary == 0 || rim_min_boundary >= 3, "rim_min_boundary", rim_min_boundary, ">= 3, or 0 = off");
-    require(rim_max_residual_m > 0, "rim_max_residual_m", rim_max_residual_m, "> 0");
-    require(rim_min_arc > 0 && rim_min_arc <= 1, "rim_min_arc", rim_min_arc, "in (0, 1]");
-    require(rim_inside_share > 0 && rim_inside_share <= 1, "rim_inside_share", rim_inside_share, "in (0, 1]");
-    require(rim_height_tol_m > 0, "rim_height_tol_m", rim_height_tol_m, "> 0");
-    require(rim_far_agree > 0, "rim_far_agree", rim_far_agree, "> 0");
-    require(gap_max_px >= 0, "gap_max_px", gap_max_px, ">= 0");
-    require(occluded_min_lines >= 0, "occluded_min_lines", occluded_min_lines, ">= 0");
-    require(occluded_max_offset > 0, "occluded_max_offset", occluded_max_offset, "> 0");
-    require(occluded_max_gap_m > 0, "occluded_max_gap_m", occluded_max_gap_m, "> 0");
-    require(occluded_max_deg > 0 && occluded_max_deg < 90, "occluded_max_deg", occluded_max_deg, "in (0, 90)");
-    require(scope_contact_m > 0, "scope_contact_m", scope_contact_m, "> 0");
-    require(scope_max_height_m > 0, "scope_max_height_m", scope_max_height_m, "> 0");
-    require(low_support_max_m >= 0 && low_support_max_m <= 0.5f, "low_support_max_m", low_support_max_m,
+    require(stacks.min_share > 0 && stacks.min_share <= 0.5f, "stacks.min_share", stacks.min_share, "in (0, 0.5]");
+    require(containers.min_boundary == 0 || containers.min_boundary >= 3, "containers.min_boundary", containers.min_boundary, ">= 3, or 0 = off");
+    require(containers.max_residual_m > 0, "containers.max_residual_m", containers.max_residual_m, "> 0");
+    require(containers.min_arc > 0 && containers.min_arc <= 1, "containers.min_arc", containers.min_arc, "in (0, 1]");
+    require(containers.inside_share > 0 && containers.inside_share <= 1, "containers.inside_share", containers.inside_share, "in (0, 1]");
+    require(containers.height_tol_m > 0, "containers.height_tol_m", containers.height_tol_m, "> 0");
+    require(containers.far_agree > 0, "containers.far_agree", containers.far_agree, "> 0");
+    require(containers.gap_max_px >= 0, "containers.gap_max_px", containers.gap_max_px, ">= 0");
+    require(occlusion.min_lines >= 0, "occlusion.min_lines", occlusion.min_lines, ">= 0");
+    require(occlusion.max_offset > 0, "occlusion.max_offset", occlusion.max_offset, "> 0");
+    require(occlusion.max_gap_m > 0, "occlusion.max_gap_m", occlusion.max_gap_m, "> 0");
+    require(occlusion.max_deg > 0 && occlusion.max_deg < 90, "occlusion.max_deg", occlusion.max_deg, "in (0, 90)");
+    require(scope.contact_m > 0, "scope.contact_m", scope.contact_m, "> 0");
+    require(scope.max_height_m > 0, "scope.max_height_m", scope.max_height_m, "> 0");
+    require(scope.low_support_max_m >= 0 && scope.low_support_max_m <= 0.5f, "scope.low_support_max_m", scope.low_support_max_m,
             "in [0, 0.5]");
-    require(low_support_min_area_m2 > 0, "low_support_min_area_m2", low_support_min_area_m2, "> 0");
-    require(scope_max_outside >= 0 && scope_max_outside <= 1, "scope_max_outside", scope_max_outside, "in [0, 1]");
-    require(scope_upright_share >= 0 && scope_upright_share <= 1, "scope_upright_share", scope_upright_share, "in [0, 1]");
+    require(scope.low_support_min_area_m2 > 0, "scope.low_support_min_area_m2", scope.low_support_min_area_m2, "> 0");
+    require(scope.max_outside >= 0 && scope.max_outside <= 1, "scope.max_outside", scope.max_outside, "in [0, 1]");
+    require(scope.upright_share >= 0 && scope.upright_share <= 1, "scope.upright_share", scope.upright_share, "in [0, 1]");
 }
 
 }  // namespace wul3d

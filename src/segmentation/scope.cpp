@@ -171,7 +171,7 @@ void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 c.any_px = static_cast<int>(p);
                 if (sums) sums[0][l] += x.c.x[p], sums[1][l] += x.c.y[p], sums[2][l] += x.c.z[p];
                 c.hi = std::max(c.hi, h);
-                c.high += h > prm.scope_max_height_m;
+                c.high += h > prm.scope.max_height_m;
                 ++c.size;
                 // On the frame's edge, beyond the support's middle.
                 const int on_edge = x.c.z[p] > far_z ? (v == fe.edge_top) + (u == fe.edge_left) +
@@ -358,12 +358,12 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
         // The frame's sides and bottom cut walls and the sides of furniture, and objects on
         // the table too; only an upright segment (a wall) leaves the volume there.
         const bool upright =
-            static_cast<float>(ws.scope_upright[l]) >= prm.scope_upright_share * static_cast<float>(ws.sizes[l]);
+            static_cast<float>(ws.scope_upright[l]) >= prm.scope.upright_share * static_cast<float>(ws.sizes[l]);
         const int outside = ws.scope_outside[l] + (upright ? ws.scope_frame[l] : 0);
         const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
                             static_cast<float>(outside) <=
-                                prm.scope_max_outside * static_cast<float>(ws.scope_outline[l]);
-        const bool stands = ws.scope_lo[l] <= prm.scope_contact_m ||
+                                prm.scope.max_outside * static_cast<float>(ws.scope_outline[l]);
+        const bool stands = ws.scope_lo[l] <= prm.scope.contact_m ||
                             foot_hidden(x, pl, ws, l);
         keep[l] = static_cast<std::uint8_t>(inside ? (stands ? 3 : 1) : 0);
     }
@@ -394,13 +394,13 @@ double area_on_support(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, 
     return m * (cz / fx) * (cz / fy) / cos_view;
 }
 
-/// Low supports (SegmentParams::low_support_max_m): kept segments that lie low, cover
-/// low_support_min_area_m2 of the support and hold two kept segments or more (that touch
-/// them and rise scope_contact_m higher) are left out, keep 0: a board or a tray on the
+/// Low supports (ScopeParams::low_support_max_m): kept segments that lie low, cover
+/// scope.low_support_min_area_m2 of the support and hold two kept segments or more (that touch
+/// them and rise scope.contact_m higher) are left out, keep 0: a board or a tray on the
 /// floor. What they hold stays kept. Cost: O(n) and one pass over ws.edges.
 void drop_low_supports(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const SegmentParams& prm = x.prm;
-    if (!(prm.low_support_max_m > 0)) return;
+    if (!(prm.scope.low_support_max_m > 0)) return;
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     auto& keep = ws.scope_keep;
     std::vector<int>& held = ws.scope_held;
@@ -410,11 +410,11 @@ void drop_low_supports(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n)
         if (keep[a] != 3 || keep[b] != 3) continue;
         // The lower of two kept segments holds the other when that one rises over it.
         const auto [lo, hi] = ws.scope_hi[a] <= ws.scope_hi[b] ? std::pair{a, b} : std::pair{b, a};
-        if (ws.scope_hi[lo] <= prm.low_support_max_m && ws.scope_hi[hi] > ws.scope_hi[lo] + prm.scope_contact_m)
+        if (ws.scope_hi[lo] <= prm.scope.low_support_max_m && ws.scope_hi[hi] > ws.scope_hi[lo] + prm.scope.contact_m)
             ++held[lo];
     }
     for (std::size_t l = 1; l < L; ++l)
-        if (held[l] >= 2 && area_on_support(x, pl, ws, l) >= prm.low_support_min_area_m2) keep[l] = 0;
+        if (held[l] >= 2 && area_on_support(x, pl, ws, l) >= prm.scope.low_support_min_area_m2) keep[l] = 0;
 }
 
 /// Clears the labels of the segments not kept. Returns those of min_points or more (within
@@ -452,8 +452,8 @@ int keep_held(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 }  // namespace
 
 void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    stats.support_scope = true;
-    stats.out_of_scope = keep_held(x, *support, ws, n);
+    stats.scope.applied = true;
+    stats.scope.out_of_scope = keep_held(x, *support, ws, n);
 }
 
 }  // namespace wul3d::detail

@@ -71,7 +71,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     rule(geometric && support, ms.stacks, split_stacks);
     rule(geometric, ms.gaps, fill_floor_gaps);
     rule(geometric, ms.occluded, join_occluded);
-    rule(support && params.scope == Scope::Support, ms.scope, restrict_to_support);
+    rule(support && params.scope.mode == Scope::Support, ms.scope, restrict_to_support);
     out.width = W;
     out.height = H;
     out.labels.resize(cloud.size());

@@ -64,9 +64,9 @@ void count_layers(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n, int 
 
 /// The height that cuts one segment between two layers of its upward faces (hist: its
 /// bins, size: its pixels), or a negative value when it has no two. A layer is a local peak
-/// of the counts over three bins that holds stack_min_share of the segment and min_points;
-/// the lower stands stack_min_step_m or more above the support (a box's top, not the table
-/// or a bowl's floor); the two lie stack_min_step_m or more apart, with a valley between
+/// of the counts over three bins that holds stacks.min_share of the segment and min_points;
+/// the lower stands stacks.min_step_m or more above the support (a box's top, not the table
+/// or a bowl's floor); the two lie stacks.min_step_m or more apart, with a valley between
 /// them (kValleyDivisor). Of several pairs, the one whose smaller layer is largest; the cut
 /// lies kCutOverLowerM over its lower layer. Cost: O(bins^2), a hundred bins.
 float cut_height(const int* hist, int bins, int size, const SegmentParams& prm) {
@@ -75,8 +75,8 @@ float cut_height(const int* hist, int bins, int size, const SegmentParams& prm) 
         const int c = window(b);
         return c >= window(b - 1) && (b + 1 >= bins || c >= window(b + 1));
     };
-    const int min_layer = std::max(prm.min_points, static_cast<int>(prm.stack_min_share * static_cast<float>(size)));
-    const int step = static_cast<int>(std::ceil(prm.stack_min_step_m / kLayerBinM));
+    const int min_layer = std::max(prm.min_points, static_cast<int>(prm.stacks.min_share * static_cast<float>(size)));
+    const int step = static_cast<int>(std::ceil(prm.stacks.min_step_m / kLayerBinM));
     auto middle = [](int b) { return (static_cast<float>(b) + 0.5f) * kLayerBinM; };
     float cut = -1.0f;
     int best_count = 0;
@@ -215,7 +215,7 @@ double colour_distance(const std::array<double, 4>& a, const std::array<double, 
 /// cut halves the taller one: its walls run on below the cut, under its walls above it.
 /// Their colour decides, as geometry cannot tell them from a box resting flush on the edge
 /// of a larger one (whose walls below the cut are the lower box's): they go up only when
-/// their mean chromaticity lies color_min_distance or more from the rest of the lower piece
+/// their mean chromaticity lies colour.min_distance or more from the rest of the lower piece
 /// (another material) and nearer the upper object's walls. Same-coloured pairs stay cut by
 /// height. Clears the map of every segment whose walls stay. Cost: one pass over the rows
 /// with objects.
@@ -228,7 +228,7 @@ void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, 
         // Chromaticity, 255 rgb / (r + g + b + 30): light falling at other angles on two faces
         // of one object scales their colour and leaves it. The colour cue's adds 10 to each
         // channel first, pulling dark pixels towards grey; this rule was measured without
-        // that (with it, report scene 01051's printed pair falls under color_min_distance:
+        // that (with it, report scene 01051's printed pair falls under colour.min_distance:
         // docs/ABLATION.md).
         const double r = x.c.r[p], g = x.c.g[p], b = x.c.b[p], scale = 255.0 / (r + g + b + 30.0);
         std::array<double, 4>& sum = ws.wall_colour[3 * static_cast<std::size_t>(l) + static_cast<std::size_t>(k)];
@@ -242,7 +242,7 @@ void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, 
         bool up = sums[kUpperWall][3] > 0 && sums[kUnderUpperWalls][3] > 0 && sums[kLower][3] > 0;
         if (up) {
             const double to_lower = colour_distance(sums[kUnderUpperWalls], sums[kLower]);
-            up = to_lower >= x.prm.color_min_distance && colour_distance(sums[kUnderUpperWalls], sums[kUpperWall]) < to_lower;
+            up = to_lower >= x.prm.colour.min_distance && colour_distance(sums[kUnderUpperWalls], sums[kUpperWall]) < to_lower;
         }
         if (!up) ws.wall_maps[static_cast<std::size_t>(l)].cols = 0;  // no map: the walls stay
     }
@@ -266,8 +266,8 @@ int cut_layers(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_w
 /// where to cut, which walls go up with the upper object (hybrid), then the cuts. Returns
 /// the cuts.
 int split_by_height(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
-    if (x.prm.stack_min_step_m <= 0) return 0;
-    const int bins = static_cast<int>(std::ceil(x.prm.scope_max_height_m / kLayerBinM));
+    if (x.prm.stacks.min_step_m <= 0) return 0;
+    const int bins = static_cast<int>(std::ceil(x.prm.scope.max_height_m / kLayerBinM));
     count_layers(x, pl, ws, n, bins);
     if (find_cuts(x, ws, n, bins) == 0) return 0;
     // Which walls below the cut stand under the upper object's walls, and whether their
@@ -287,8 +287,8 @@ int split_by_height(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 }  // namespace
 
 void split_stacks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
-    stats.stack_splits = split_by_height(x, *support, ws, n);
-    n += stats.stack_splits;
+    stats.stacks.splits = split_by_height(x, *support, ws, n);
+    n += stats.stacks.splits;
 }
 
 }  // namespace wul3d::detail

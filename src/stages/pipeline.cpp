@@ -50,9 +50,9 @@ PipelineParams PipelineParams::stage_params() const {
     s.plane.hull_margin_px = length(plane.hull_margin_px, 0);
     SegmentParams& g = s.segmentation;
     g.min_points = area(segmentation.min_points);
-    g.gap_max_px = area(segmentation.gap_max_px);
-    g.merge_min_boundary = length(segmentation.merge_min_boundary, 1);
-    g.rim_min_boundary = length(segmentation.rim_min_boundary, 3);
+    g.containers.gap_max_px = area(segmentation.containers.gap_max_px);
+    g.merge.min_boundary = length(segmentation.merge.min_boundary, 1);
+    g.containers.min_boundary = length(segmentation.containers.min_boundary, 3);
     s.objects.min_points = area(objects.min_points);
     return s;
 }

@@ -38,7 +38,7 @@ TEST(SegmentObjects, FlushBoxesOfDifferentColours_SeparatedByTheColourCue) {
     EXPECT_GT(dominant_share(hyb.labels, truth, kTruthBox0 + 1, &b), 0.9);
     EXPECT_NE(a, 0);
     EXPECT_NE(a, b) << "the colour cue did not split the flush boxes";
-    EXPECT_EQ(stats.color_splits, 1);
+    EXPECT_EQ(stats.colour.splits, 1);
 }
 
 // Two flush boxes of one hue, a light one and a dark one: their chromaticities lie closer
@@ -53,7 +53,7 @@ TEST(SegmentObjects, FlushBoxesOfOneHue_SeparatedByTheBrightnessStep) {
     std::vector<int> truth;
     int a = 0, b = 0;
     SegmentParams no_step;
-    no_step.color_min_step = 0;
+    no_step.colour.min_step = 0;
     const LabelImage without = segment(s, no_step, truth);
     dominant_share(without.labels, truth, kTruthBox0, &a);
     dominant_share(without.labels, truth, kTruthBox0 + 1, &b);
@@ -65,7 +65,7 @@ TEST(SegmentObjects, FlushBoxesOfOneHue_SeparatedByTheBrightnessStep) {
     EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + 1, &b), 0.9);
     EXPECT_NE(a, 0);
     EXPECT_NE(a, b) << "the brightness step did not split the flush boxes";
-    EXPECT_EQ(stats.color_splits, 1);
+    EXPECT_EQ(stats.colour.splits, 1);
 }
 
 // The colour cue leaves a box alone whose faces differ in shade: the colour boundary runs
@@ -79,7 +79,7 @@ TEST(SegmentObjects, ColourCue_DoesNotSplitOneBox) {
     SegmentStats stats;
     const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
     EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0), 0.95);
-    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.colour.splits, 0);
     EXPECT_EQ(stats.segments, 1);
 }
 
@@ -112,7 +112,7 @@ TEST(SegmentObjects, FlushBoxesOfTwoHeights_SeparatedAcrossTheFold) {
 // A flat box lying on a larger box of another colour, seen from above: the larger box's top
 // encloses the flat one in view, so their colour boundary is the flat box's whole outline,
 // not one side of it. It is short for the piece's area (a compact piece, not a texture),
-// and the colour cue splits them (color_max_compact).
+// and the colour cue splits them (colour.max_compact).
 TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
     Scene s = pitched_tabletop_scene();
     // The base near the table's colour, as its feet are; the flat box lying on its top.
@@ -123,7 +123,7 @@ TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
     const PlaneStage in = up_to_the_plane(s);
     int a = 0, b = 0;
     SegmentParams without;
-    without.color_max_compact = 0;
+    without.colour.max_compact = 0;
     const LabelImage one = segment(in, without);
     dominant_share(one.labels, in.truth, kTruthBox0, &a);
     dominant_share(one.labels, in.truth, kTruthBox0 + 1, &b);
@@ -132,28 +132,28 @@ TEST(SegmentObjects, FlatBoxLyingOnABox_SeparatedAsACompactPiece) {
     SegmentStats stats;
     const LabelImage two = segment(in, SegmentParams{}, &stats);
     expect_separate(two, in.truth, kTruthBox0, kTruthBox0 + 1, 0.8, "the flat box was not split from the box it lies on");
-    EXPECT_EQ(stats.color_splits, 1);
+    EXPECT_EQ(stats.colour.splits, 1);
 }
 
 // A cup with a printed band round its outer wall: two colours on one solid of revolution,
 // as a can's or a bottle's label. The band is a compact piece the colour cue would cut off;
 // the cup's walls lie on one upright circle and face along its radii, so it stays one
-// object (color_round_deg).
+// object (colour.round_deg).
 TEST(SegmentObjects, CupWithAPrintedBand_StaysOneObject) {
     Scene s = pitched_tabletop_scene();
     s.noise_seed = 5;
     s.cups = {SceneCup{.z = 0.9f, .radius = 0.045f, .h = 0.13f, .band_lo = 0.03f, .band_hi = 0.1f}};
     const PlaneStage in = up_to_the_plane(s);
     SegmentParams without;
-    without.color_round_deg = 0;
+    without.colour.round_deg = 0;
     SegmentStats split_stats;
     const LabelImage split = segment(in, without, &split_stats);
-    ASSERT_GE(split_stats.color_splits, 1) << "without the round test the band should be cut off (test premise)";
+    ASSERT_GE(split_stats.colour.splits, 1) << "without the round test the band should be cut off (test premise)";
     ASSERT_LT(dominant_share(split.labels, in.truth, kTruthCup0), 0.9) << "(test premise)";
 
     SegmentStats stats;
     const LabelImage one = segment(in, SegmentParams{}, &stats);
-    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.colour.splits, 0);
     EXPECT_GE(dominant_share(one.labels, in.truth, kTruthCup0), 0.95) << "the printed cup was split";
 }
 
@@ -176,7 +176,7 @@ TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
     EXPECT_NE(id[0], id[1]);
     EXPECT_NE(id[1], id[2]);
     EXPECT_NE(id[0], id[2]);
-    EXPECT_EQ(stats.color_splits, 2);
+    EXPECT_EQ(stats.colour.splits, 2);
 }
 
 // Two flush boxes of different colours, one with a small sticker of a third colour (under
@@ -209,7 +209,7 @@ TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
     SegmentStats stats;
     const LabelImage out = segment(in, SegmentParams{}, &stats);
     expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the sticker hid the contact between the boxes");
-    EXPECT_EQ(stats.color_splits, 1);
+    EXPECT_EQ(stats.colour.splits, 1);
 }
 
 namespace {
@@ -242,19 +242,19 @@ PlaneStage plain_and_striped_boxes() {
 TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
     const PlaneStage in = plain_and_striped_boxes();
     SegmentParams without;
-    without.color_textures = false;
+    without.colour.textures = false;
     SegmentStats stats;
     const LabelImage one = segment(in, without, &stats);
     int a = 0, b = 0;
     dominant_share(one.labels, in.truth, kTruthBox0, &a);
     dominant_share(one.labels, in.truth, kTruthBox0 + 1, &b);
     ASSERT_EQ(a, b) << "2-means alone should not part the boxes (test premise)";
-    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.colour.splits, 0);
 
     const LabelImage out = segment(in, SegmentParams{}, &stats);
     expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the materials were not parted");
-    EXPECT_EQ(stats.color_splits, 1);
-    EXPECT_EQ(stats.texture_splits, 1);
+    EXPECT_EQ(stats.colour.splits, 1);
+    EXPECT_EQ(stats.colour.texture_splits, 1);
 }
 
 // One striped box on its own: its stripes are one material, whatever four colours k-means
@@ -268,6 +268,6 @@ TEST(SegmentObjects, StripedBox_StaysOneObject) {
     SegmentStats stats;
     const LabelImage out = segment(in, SegmentParams{}, &stats);
     EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0), 0.95);
-    EXPECT_EQ(stats.color_splits, 0);
+    EXPECT_EQ(stats.colour.splits, 0);
     EXPECT_EQ(stats.segments, 1);
 }

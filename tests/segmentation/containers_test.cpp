@@ -22,7 +22,7 @@ TEST(SegmentObjects, Cup_InsideJoinedToTheOuterWallAcrossTheRim) {
     s.cups = {cup};
     std::vector<int> truth;
     SegmentParams off;
-    off.rim_min_boundary = 0;
+    off.containers.min_boundary = 0;
     SegmentStats stats;
     const LabelImage split = segment(s, off, truth, &stats);
     EXPECT_GE(stats.segments, 2) << "the cup was one segment without the rule (test premise)";
@@ -32,7 +32,7 @@ TEST(SegmentObjects, Cup_InsideJoinedToTheOuterWallAcrossTheRim) {
     int label = 0;
     EXPECT_GT(dominant_share(out.labels, truth, kTruthCup0, &label), 0.95);
     EXPECT_NE(label, 0);
-    EXPECT_GE(stats.containers, 1);
+    EXPECT_GE(stats.containers.joins, 1);
     EXPECT_EQ(stats.segments, 1);
 }
 
@@ -122,5 +122,5 @@ TEST(CircleFit, ExactCircleAndALine) {
     };
     const double extent = std::hypot(0.11, 0.22);
     const detail::Circle l = detail::fit_circle(on_line);
-    EXPECT_FALSE(extent >= SegmentParams{}.rim_min_arc * 2 * l.radius) << "a line fitted a circle of radius " << l.radius;
+    EXPECT_FALSE(extent >= SegmentParams{}.containers.min_arc * 2 * l.radius) << "a line fitted a circle of radius " << l.radius;
 }

@@ -49,7 +49,7 @@ TEST(SegmentObjects, Cup_FloorGapsFilledWallHoleKept) {
 
     for (const int max_px : {0, 500}) {
         SegmentParams params;
-        params.gap_max_px = max_px;
+        params.containers.gap_max_px = max_px;
         SegmentStats st;
         const LabelImage out = segment(in, params, &st);
         int cup_label = 0;
@@ -58,6 +58,6 @@ TEST(SegmentObjects, Cup_FloorGapsFilledWallHoleKept) {
         for (std::size_t p : wall_hole) EXPECT_EQ(out.labels[p], 0) << "max " << max_px;
         for (std::size_t p : floor_gap)
             EXPECT_EQ(out.labels[p], max_px ? cup_label : 0) << "max " << max_px;
-        EXPECT_EQ(st.gaps_filled, max_px ? floor_gap.size() : 0u);
+        EXPECT_EQ(st.containers.gaps_filled, max_px ? floor_gap.size() : 0u);
     }
 }

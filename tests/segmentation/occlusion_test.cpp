@@ -32,7 +32,7 @@ Scene box_behind_an_occluder(bool two_boxes, float occluder_z = 0.88f, float occ
 void expect_joined_behind_the_occluder(const Scene& scene) {
     const PlaneStage st = up_to_the_plane(scene);
     SegmentParams off;
-    off.occluded_min_lines = 0;
+    off.occlusion.min_lines = 0;
     const LabelImage apart = segment(st, off);
     ASSERT_LT(dominant_share(apart.labels, st.truth, kTruthBox0), 0.7)
         << "the standing box should divide the lying one (test premise)";
@@ -40,7 +40,7 @@ void expect_joined_behind_the_occluder(const Scene& scene) {
     SegmentStats stats;
     const LabelImage out = segment(st, SegmentParams{}, &stats);
     expect_separate(out, st.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the lying box was joined to the standing one");
-    EXPECT_GE(stats.occluded, 1);
+    EXPECT_GE(stats.occlusion.joins, 1);
 }
 }  // namespace
 
@@ -52,7 +52,7 @@ TEST(SegmentObjects, BoxSeenBothSidesOfAnOccluder_IsOneObject) {
 }
 
 // The same with the standing box 0.4 m nearer the camera than the lying one (and taller, to
-// hide its middle still): its points lie farther from the lying box than occluded_max_gap_m,
+// hide its middle still): its points lie farther from the lying box than occlusion.max_gap_m,
 // but that bounds the width a line spans on the lying box's plane, which is what the
 // occluder hides, not its height in front of it.
 TEST(SegmentObjects, BoxBehindAnOccluderNearTheCamera_IsOneObject) {
@@ -61,12 +61,12 @@ TEST(SegmentObjects, BoxBehindAnOccluderNearTheCamera_IsOneObject) {
 
 // The same view with two boxes behind the standing one, their faces parallel and 2.5 cm
 // apart: each line lands within the sensor's tolerance, and only the lines' mean offset
-// (occluded_max_offset) tells two surfaces from one; the rule leaves them apart.
+// (occlusion.max_offset) tells two surfaces from one; the rule leaves them apart.
 TEST(SegmentObjects, TwoBoxesBehindAnOccluder_StayApart) {
     const PlaneStage st = up_to_the_plane(box_behind_an_occluder(true));
     SegmentStats stats;
     const LabelImage out = segment(st, SegmentParams{}, &stats);
     expect_separate(out, st.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "two boxes behind the occluder were joined");
     EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 2), 0.9);
-    EXPECT_EQ(stats.occluded, 0);
+    EXPECT_EQ(stats.occlusion.joins, 0);
 }

@@ -185,10 +185,10 @@ Segmented segment_at(const SegmentParams& params, const OrganizedCloud& cloud, c
     const SegmentStats s = segment_objects(params, cloud, normals, classes, support, clusters, ws, out);
     Segmented r;
     r.labels = out.labels;
-    r.stats = {s.segments,    s.color_splits, s.texture_splits, s.stack_splits,
-               s.merges,      s.containers,   s.occluded,
-               static_cast<long long>(s.gaps_filled), static_cast<long long>(s.reattached),
-               s.support_scope, s.out_of_scope};
+    r.stats = {s.segments,    s.colour.splits, s.colour.texture_splits, s.stacks.splits,
+               s.merge.joins,      s.containers.joins,   s.occlusion.joins,
+               static_cast<long long>(s.containers.gaps_filled), static_cast<long long>(s.reattached),
+               s.scope.applied, s.scope.out_of_scope};
     return r;
 }
 

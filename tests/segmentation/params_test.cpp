@@ -24,9 +24,9 @@ TEST(SegmentParams, Validate_NamesTheField) {
             << e.what();
     }
     SegmentParams stacks;
-    stacks.stack_min_step_m = std::nanf("");
+    stacks.stacks.min_step_m = std::nanf("");
     EXPECT_THROW(stacks.validate(), ParamError);
-    stacks.stack_min_step_m = 0;  // off
+    stacks.stacks.min_step_m = 0;  // off
     EXPECT_NO_THROW(stacks.validate());
     EXPECT_THROW(parse_segmenter("watershed"), ParamError);
     EXPECT_EQ(parse_segmenter("kmeans"), Segmenter::Kmeans);
@@ -38,5 +38,5 @@ TEST(SegmentParams, Scope_ParsedAndNamed) {
     EXPECT_EQ(parse_scope("scene"), Scope::Scene);
     EXPECT_THROW(parse_scope("table"), ParamError);
     EXPECT_STREQ(scope_name(Scope::Scene), "scene");
-    EXPECT_EQ(SegmentParams{}.scope, Scope::Support);
+    EXPECT_EQ(SegmentParams{}.scope.mode, Scope::Support);
 }

@@ -46,21 +46,21 @@ TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
     for (const Scope scope : {Scope::Support, Scope::Scene}) {
         SCOPED_TRACE(scope_name(scope));
         SegmentParams params;
-        params.scope = scope;
+        params.scope.mode = scope;
         SegmentStats stats;
         const LabelImage out = segment(st, params, &stats);
         int ia = 0, ib = 0;
         EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &ia), 0.9);
         EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib), 0.9);
         EXPECT_NE(ia, 0);
-        EXPECT_EQ(stats.support_scope, scope == Scope::Support);
+        EXPECT_EQ(stats.scope.applied, scope == Scope::Support);
         if (scope == Scope::Support) {
             EXPECT_EQ(ib, 0) << "the hanging box is an object";
-            EXPECT_EQ(stats.out_of_scope, 1);
+            EXPECT_EQ(stats.scope.out_of_scope, 1);
             EXPECT_EQ(stats.segments, 1);
         } else {
             EXPECT_NE(ib, 0);
-            EXPECT_EQ(stats.out_of_scope, 0);
+            EXPECT_EQ(stats.scope.out_of_scope, 0);
             EXPECT_EQ(stats.segments, 2);
         }
     }
@@ -68,7 +68,7 @@ TEST(SegmentObjects, Scope_HangingBoxIsNotHeldByTheSupport) {
 
 // A box whose sides the sensor does not see (seen from steeply above, or in the shadow of a
 // structured-light sensor): its segment is its top alone, 15 cm over the table, standing on
-// nothing within scope_contact_m and touching nothing. Its foot is hidden, not seen: the
+// nothing within scope.contact_m and touching nothing. Its foot is hidden, not seen: the
 // pixel of the support point under its middle shows no depth, so the support holds it.
 // (The hanging box above shows the table under its middle and stays out.)
 TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
@@ -96,14 +96,14 @@ TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
     EXPECT_NE(ia, 0);
     dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib);
     EXPECT_NE(ib, 0) << "the box seen without its sides was left out";
-    EXPECT_EQ(stats.out_of_scope, 0);
+    EXPECT_EQ(stats.scope.out_of_scope, 0);
     EXPECT_EQ(stats.segments, 2);
 }
 
 // On the far half of the table, the frame's right edge cuts a box and its left edge a board
 // standing upright (a wall's stand-in). The box shows its top: an object the frame cuts,
 // which stays. The board faces sideways: like a wall, it leaves the support's volume through
-// the frame's edge (scope_upright_share). With every segment counted at the frame's sides
+// the frame's edge (scope.upright_share). With every segment counted at the frame's sides
 // (share 0, as before) the box leaves too.
 TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
     Scene s = pitched_tabletop_scene();
@@ -119,13 +119,13 @@ TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
     }
     ASSERT_TRUE(box_at_edge && board_at_edge) << "the frame should cut both (test premise)";
     SegmentParams every;
-    every.scope_upright_share = 0;
+    every.scope.upright_share = 0;
     int box = 0, board = 0;
     const LabelImage before = segment(st, every);
     dominant_share(before.labels, st.truth, kTruthBox0, &box);
     ASSERT_EQ(box, 0) << "counting the frame's sides for every segment should leave the box out (test premise)";
     SegmentParams no_edges;  // nothing leaves through its outline: the board is held
-    no_edges.scope_max_outside = 1;
+    no_edges.scope.max_outside = 1;
     const LabelImage held = segment(st, no_edges);
     dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
     ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
@@ -136,7 +136,7 @@ TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
     EXPECT_NE(box, 0) << "the box the frame cuts was left out";
     dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
     EXPECT_EQ(board, 0) << "the upright board the frame cuts is an object";
-    EXPECT_EQ(stats.out_of_scope, 1);
+    EXPECT_EQ(stats.scope.out_of_scope, 1);
 }
 
 // The same lift on a box that touches another in the image (a small box in front of a tall
@@ -167,7 +167,7 @@ TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
     EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 1, &ib), 0.9);
     EXPECT_NE(ia, 0) << "the box resting on a held one was left out";
     EXPECT_NE(ib, 0);
-    EXPECT_EQ(stats.out_of_scope, 0);
+    EXPECT_EQ(stats.scope.out_of_scope, 0);
 }
 
 // A board 2 cm thick lying on the table, 60 x 40 cm, with two boxes standing on it, and a
@@ -203,7 +203,7 @@ TEST(SegmentObjects, Scope_BoardHoldingObjectsIsASupportNotAnObject) {
     const PlaneStage st = up_to_the_plane(s);
     auto run = [&](float low_support_max_m) {
         SegmentParams params;
-        params.low_support_max_m = low_support_max_m;
+        params.scope.low_support_max_m = low_support_max_m;
         return segment(st, params);
     };
     int board_id = 0;
@@ -211,7 +211,7 @@ TEST(SegmentObjects, Scope_BoardHoldingObjectsIsASupportNotAnObject) {
     ASSERT_GT(dominant_share(off.labels, st.truth, kTruthBox0, &board_id), 0.8);
     ASSERT_NE(board_id, 0) << "without the rule the board should be an object (test premise)";
 
-    const LabelImage out = run(SegmentParams{}.low_support_max_m);
+    const LabelImage out = run(SegmentParams{}.scope.low_support_max_m);
     dominant_share(out.labels, st.truth, kTruthBox0, &board_id);
     EXPECT_EQ(board_id, 0) << "the board is an object";
     for (int i = 1; i <= 3; ++i) {

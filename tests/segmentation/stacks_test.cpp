@@ -17,9 +17,9 @@ namespace {
 void expect_split_by_height(const PlaneStage& in, int ta, int tb, double share, const char* what,
                             const SegmentParams& params = {}) {
     SegmentParams no_creases = params;
-    no_creases.concavity = 100;  // above any (n_p - n_q) . direction: no pixel is a crease
+    no_creases.cuts.concavity = 100;  // above any (n_p - n_q) . direction: no pixel is a crease
     SegmentParams without = no_creases;
-    without.stack_min_step_m = 0;
+    without.stacks.min_step_m = 0;
     const LabelImage one = segment(in, without);
     int a = 0, b = 0;
     dominant_share(one.labels, in.truth, ta, &a);
@@ -29,15 +29,15 @@ void expect_split_by_height(const PlaneStage& in, int ta, int tb, double share, 
     SegmentStats stats;
     const LabelImage two = segment(in, no_creases, &stats);
     expect_separate(two, in.truth, ta, tb, share, what);
-    EXPECT_EQ(stats.stack_splits, 1);
+    EXPECT_EQ(stats.stacks.splits, 1);
 }
 
 /// The colour cue splits nothing, as where 2-means follows a print: no boundary is short
 /// enough.
 SegmentParams without_colour_splits() {
     SegmentParams p;
-    p.color_max_boundary = 1e-6f;
-    p.color_max_compact = 0;
+    p.colour.max_boundary = 1e-6f;
+    p.colour.max_compact = 0;
     return p;
 }
 
@@ -90,11 +90,11 @@ TEST(SegmentObjects, TallAndShortBoxesOfTwoColoursSideBySide_TheTallerKeepsItsWa
     s.boxes = {tall, low};
     const PlaneStage in = up_to_the_plane(s);
     SegmentParams geometric = without_colour_splits();
-    geometric.concavity = 100;
+    geometric.cuts.concavity = 100;
     geometric.segmenter = Segmenter::Geometric;  // the walls' colour is not read: a cut by height
     SegmentStats cut_stats;
     const LabelImage cut = segment(in, geometric, &cut_stats);
-    ASSERT_EQ(cut_stats.stack_splits, 1) << "(test premise)";
+    ASSERT_EQ(cut_stats.stacks.splits, 1) << "(test premise)";
     ASSERT_LT(dominant_share(cut.labels, in.truth, kTruthBox0), 0.8) << "the cut should halve the tall box (test premise)";
     expect_split_by_height(in, kTruthBox0, kTruthBox0 + 1, 0.9, "the boxes side by side are one object",
                            without_colour_splits());

@@ -289,18 +289,18 @@ TEST(PipelineParams, DecimationScalesObjectSizesNotNeighbourhoods) {
     p.decimation = 2;
     const PipelineParams s = p.stage_params();
     EXPECT_EQ(s.segmentation.min_points, 75);
-    EXPECT_EQ(s.segmentation.gap_max_px, 125);
-    EXPECT_EQ(s.segmentation.merge_min_boundary, 3);
-    EXPECT_EQ(s.segmentation.rim_min_boundary, 5);
+    EXPECT_EQ(s.segmentation.containers.gap_max_px, 125);
+    EXPECT_EQ(s.segmentation.merge.min_boundary, 3);
+    EXPECT_EQ(s.segmentation.containers.min_boundary, 5);
     EXPECT_EQ(s.objects.min_points, 25);
     EXPECT_EQ(s.plane.grid_stride_px, p.plane.grid_stride_px);
     EXPECT_EQ(s.plane.hull_margin_px, 6);
     EXPECT_EQ(s.normals.radius_px, p.normals.radius_px);
-    EXPECT_EQ(s.segmentation.crease_step_px, p.segmentation.crease_step_px);
-    EXPECT_EQ(s.segmentation.reattach_px, p.segmentation.reattach_px);
-    EXPECT_EQ(s.segmentation.min_seed_points, p.segmentation.min_seed_points);
-    p.segmentation.gap_max_px = 0;  // off stays off
-    EXPECT_EQ(p.stage_params().segmentation.gap_max_px, 0);
+    EXPECT_EQ(s.segmentation.cuts.crease_step_px, p.segmentation.cuts.crease_step_px);
+    EXPECT_EQ(s.segmentation.cuts.reattach_px, p.segmentation.cuts.reattach_px);
+    EXPECT_EQ(s.segmentation.cuts.min_seed_points, p.segmentation.cuts.min_seed_points);
+    p.segmentation.containers.gap_max_px = 0;  // off stays off
+    EXPECT_EQ(p.stage_params().segmentation.containers.gap_max_px, 0);
     p.decimation = 1;
     EXPECT_EQ(p.stage_params().segmentation.min_points, p.segmentation.min_points);
     p.decimation = 9;

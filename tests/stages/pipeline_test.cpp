@@ -381,12 +381,12 @@ TEST(GeneratedScene, FlushBoxesOfOneHue_PartedByTheStepOnTheirSharedPlanes) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 23);
     auto objects = [&](float min_step) {
-        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.color_min_step = min_step; });
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.colour.min_step = min_step; });
         return std::pair{dominant_object(r.objects, g.truth, 1), dominant_object(r.objects, g.truth, 2)};
     };
     const auto [light_off, dark_off] = objects(0);
     ASSERT_EQ(light_off.first, dark_off.first) << "without the step the boxes should be one object (test premise)";
-    const auto [light, dark] = objects(SegmentParams{}.color_min_step);
+    const auto [light, dark] = objects(SegmentParams{}.colour.min_step);
     EXPECT_NE(light.first, dark.first) << "the flush boxes were not parted";
     EXPECT_GT(light.second, 0.9);
     EXPECT_GT(dark.second, 0.9);
@@ -401,7 +401,7 @@ TEST(GeneratedScene, SmallCup_JoinedAcrossItsFarRim) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 2001);
     auto cup_share = [&](bool far_rim) {
-        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.rim_far = far_rim; });
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.containers.far_rim = far_rim; });
         return dominant_object(r.objects, g.truth, 1).second;  // truth 1: the cup
     };
     ASSERT_LT(cup_share(false), 0.6) << "without the far rim the cup should be in two objects (test premise)";
@@ -418,12 +418,12 @@ TEST(GeneratedScene, CylinderBehindABox_NotJoinedAsItsInside) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 1028);
     auto one_object = [&](float agree) {
-        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.rim_far_agree = agree; });
+        const FrameResult r = process_with(g, [&](SegmentParams& s) { s.containers.far_agree = agree; });
         // truth 2: the cylinder; 3: the box in front of it
         return dominant_object(r.objects, g.truth, 2).first == dominant_object(r.objects, g.truth, 3).first;
     };
     ASSERT_TRUE(one_object(1e9f)) << "with any far rim agreeing, the cylinder should join the box (test premise)";
-    EXPECT_FALSE(one_object(SegmentParams{}.rim_far_agree)) << "the cylinder was joined to the box";
+    EXPECT_FALSE(one_object(SegmentParams{}.containers.far_agree)) << "the cylinder was joined to the box";
 }
 
 #endif
