@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Fuzzes wul3d.batch's discovery (batch.discover) over random folder trees: symbolic links
+"""Fuzzes wul3d.batch's discovery (wul3d/discovery.py, discover_all) over random folder trees: symbolic links
 back up the tree, to siblings, to themselves, to a tree outside ROOT, dangling and to files;
 FIFOs and files where folders or depth.png are expected; ROS bags (*.bag files, links to
 them, FIFOs so named, hidden ones); names with bytes that are not
@@ -14,7 +14,7 @@ within 10 s, and raise nothing.
 Deterministic: tree I of seed S is the same on every machine (random.Random(f"{S}:{I}")).
 A finding prints the seed and the iteration and the command that rebuilds that tree and
 runs discovery on it again; --keep DIR leaves the tree there to look at. Needs no build: it
-loads python/wul3d/batch.py by path (its discovery uses the standard library only).
+loads python/wul3d/discovery.py by path (it uses the standard library only).
 Exit 0 with "no finding", 1 on a finding (docs/FUZZING.md).
 """
 
@@ -31,12 +31,12 @@ import time
 import traceback
 
 HERE = pathlib.Path(__file__).resolve().parent
-BATCH_PY = HERE.parent / "python" / "wul3d" / "batch.py"
+DISCOVERY_PY = HERE.parent / "python" / "wul3d" / "discovery.py"
 ITERATION_LIMIT_S = 10
 
 
-def load_batch():
-    spec = importlib.util.spec_from_file_location("wul3d_batch_under_fuzz", BATCH_PY)
+def load_discovery():
+    spec = importlib.util.spec_from_file_location("wul3d_discovery_under_fuzz", DISCOVERY_PY)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -258,7 +258,7 @@ def key(path) -> tuple:
     return (st.st_dev, st.st_ino)
 
 
-def one(batch, seed, iteration, keep=None):
+def one(discovery, seed, iteration, keep=None):
     """Builds tree `iteration` of `seed`, runs discovery; returns None or what went wrong."""
     rng = random.Random(f"{seed}:{iteration}")
     base = (keep.encode() if keep else os.fsencode(tempfile.mkdtemp(prefix="wul3d-fuzz-")))
@@ -270,7 +270,7 @@ def one(batch, seed, iteration, keep=None):
         want, want_unread, want_bags = expected(root)
         signal.setitimer(signal.ITIMER_REAL, ITERATION_LIMIT_S)
         try:
-            found = batch._discover(os.fsdecode(root.path))
+            found = discovery.discover_all(os.fsdecode(root.path))
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
         got = [key(os.path.join(os.fsdecode(root.path), rel)) for rel in found.sequences]
@@ -308,7 +308,7 @@ def main(argv=None) -> int:
     p.add_argument("--keep", help="build the tree here and leave it (with --iteration)")
     args = p.parse_args(argv)
     seed = args.seed if args.seed != 0 else random.SystemRandom().randrange(1, 2**31)
-    batch = load_batch()
+    discovery = load_discovery()
     signal.signal(signal.SIGALRM, _alarm)
     iterations = [args.iteration] if args.iteration is not None else None
     start = time.monotonic()
@@ -320,7 +320,7 @@ def main(argv=None) -> int:
             i = iterations.pop()
         elif time.monotonic() - start >= args.seconds:
             break
-        problem = one(batch, seed, i, args.keep)
+        problem = one(discovery, seed, i, args.keep)
         done += 1
         if problem is not None:
             print(f"fuzz_batch_discovery: FINDING with seed {seed}, iteration {i}: {problem}")

@@ -34,25 +34,20 @@ import os
 import pathlib
 import signal
 import socket
-import stat
 import sys
 import threading
 import time
 import uuid
 
-STAGING_PREFIX = ".wul3d.staging-"  # OUT/.wul3d.staging-<pid>-<id>/: one batch's tries
-LIVE_MARKER = ".wul3d.live"  # in a staging folder while its batch runs
-OWN_PREFIX = ".wul3d."  # names wul3d keeps for itself in OUT (check_frame_name refuses them)
+# discover, output_dir, foreign_entry and the names of what the batch writes are wul3d.batch's
+# API too (docs/SCALE.md), defined in discovery.py and staging.py.
+from .discovery import MAX_DEPTH, discover, discover_all, text  # noqa: F401
+from .staging import (DONE_MARKER, FRAME_OUTPUT_FILES, LIVE_MARKER, OWN_PREFIX,  # noqa: F401
+                      STAGING_PREFIX, Refused, check_write_target, foreign_entry, is_finished,
+                      lstat_or_none, make_staging, no_link_on_the_way, output_dir, publish,
+                      remove_run_output, remove_staging)
+
 BATCH_JSON = "batch.json"
-DONE_MARKER = "summary.json"  # written last by the run loop
-FRAMES_FILE = "frames.jsonl"
-# The files wul3d writes in a frame folder: the library's frame_output_files()
-# (src/run/output.cpp), copied: batch.py imports without the compiled module (the discovery
-# fuzzer); tests/python/test_batch_hostile.py checks the copy against _frame_output_files().
-FRAME_OUTPUT_FILES = frozenset({
-    "labels.png", "colors.png", "selected.png", "objects.png", "objects.json",
-    "selected_object.png", "cloud.ply", "overlay.png"})
-MAX_DEPTH = 64  # folders below ROOT that discovery descends (a path stays under PATH_MAX)
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 EXIT_SIGNAL_BASE = 128  # 130 after SIGINT, 143 after SIGTERM, as a shell reports them
 RUN_FLAGS = {"no_plane", "ply", "overlay"}
@@ -61,9 +56,7 @@ RUN_FLAGS = {"no_plane", "ply", "overlay"}
 def run_options():
     """The options of `wul3d run` that pass through, keyword -> (type, help): the pipeline's
     parameters from the library's table (wul3d.parameters(); its switch, remove_plane, is the
-    command's --no-plane flag, in RUN_FLAGS), then the run's own options. Imported when
-    called: the discovery above needs the standard library only (fuzz_batch_discovery.py
-    loads this file alone)."""
+    command's --no-plane flag, in RUN_FLAGS), then the run's own options."""
     from . import _wul3d
     types = {"int": int, "float": float, "str": str}
     options = {"preset": (str, 'as `wul3d run --preset`: "default" or "paper"')}
@@ -91,399 +84,12 @@ class Interrupted(KeyboardInterrupt):
         self.signum, self.report, self.line = signum, report, line
 
 
-def text(name) -> str:
-    """`name` as valid Unicode: bytes that are not UTF-8 (a str from os.fsdecode carries them
-    as lone surrogates) become \\xNN escapes, so that JSON and terminals take it."""
-    if isinstance(name, bytes):
-        return name.decode("utf-8", "backslashreplace")
-    try:
-        name.encode("utf-8")
-        return name
-    except UnicodeEncodeError:
-        return os.fsencode(name).decode("utf-8", "backslashreplace")
-
-
 def _one_line(e: BaseException) -> str:
     msg = str(e).splitlines()[0] if str(e).strip() else type(e).__name__
     return text(msg)
 
 
-# ---- discovery ----------------------------------------------------------------------------
-
-def _stat(path):
-    """os.stat (links followed), or None where it fails (gone, a dangling link, a loop)."""
-    try:
-        return os.stat(path)
-    except (OSError, ValueError):
-        return None
-
-
-def _is_file(path) -> bool:
-    st = _stat(path)
-    return st is not None and stat.S_ISREG(st.st_mode)
-
-
-def _is_frame(d) -> bool:
-    return _is_file(os.path.join(d, "depth.png"))
-
-
-def _is_tum(d) -> bool:
-    return _is_file(os.path.join(d, "rgb.txt")) and _is_file(os.path.join(d, "depth.txt"))
-
-
-def _is_dir(path) -> bool:
-    st = _stat(path)
-    return st is not None and stat.S_ISDIR(st.st_mode)
-
-
-def _is_bag(path) -> bool:
-    """A ROS 1 bag file as the batch finds one: a plain file (links followed) named *.bag,
-    not hidden. `wul3d run` checks its first bytes (`#ROSBAG V2.0`) when it reads it."""
-    name = os.path.basename(os.fsdecode(path))
-    return name.endswith(".bag") and not name.startswith(".") and _is_file(path)
-
-
-def _is_dataset_sequence(d) -> bool:
-    """A dataset as downloaded that `wul3d run` takes whole: an OCID sequence (rgb/ and
-    depth/ holding result_*.png), an OSD-0.2-depth tree (image_color/) or a BOP scene
-    (scene_camera.json)."""
-    if _is_dir(os.path.join(d, "image_color")) or _is_file(os.path.join(d, "scene_camera.json")):
-        return True
-    depth = os.path.join(d, "depth")
-    if not (_is_dir(os.path.join(d, "rgb")) and _is_dir(depth)):
-        return False
-    try:
-        with os.scandir(depth) as it:
-            return any(e.name.startswith("result_") and e.name.endswith(".png") for e in it)
-    except OSError:
-        return False
-
-
-class Discovery:
-    """What discover found under a root: `sequences` (paths relative to the root, "/"
-    separated, "." for the root itself; str as os.fsdecode gives them), `links` (the folders
-    outside the walk that symbolic links led to: inputs too, which OUT must stay apart from)
-    and `unread` ((path, reason) of folders that could not be listed or were too deep)."""
-
-    def __init__(self, sequences, links, unread):
-        self.sequences, self.links, self.unread = sequences, links, unread
-
-
-def _discover(root) -> Discovery:
-    root = os.fsdecode(root)
-    if _is_bag(root):
-        return Discovery(["."], [], [])
-    st = _stat(root)
-    if st is None or not stat.S_ISDIR(st.st_mode):
-        raise FileNotFoundError(f"{text(root)}: no such folder")
-    if _is_tum(root) or _is_frame(root) or _is_dataset_sequence(root):
-        return Discovery(["."], [], [])
-    # Every folder is listed once, by (device, inode): a link back into the tree (a loop)
-    # or a second link to one folder adds nothing. Real folders first, then the folders
-    # links lead to, so that a sequence is named by its real path where it has one.
-    visited = {(st.st_dev, st.st_ino)}
-    found, links, unread = [], [], []
-    bags = {}  # (device, inode) -> (reached through a link, relative path): each bag once
-    walk = [()]  # relative paths as tuples of names, real folders
-    deferred = []  # (relative path, key) of folders reached through a symbolic link
-
-    def listing(rel):
-        path = os.path.join(root, *rel)
-        try:
-            with os.scandir(path) as it:
-                entries = sorted(it, key=lambda e: e.name)
-        except OSError as e:
-            unread.append((rel, e.strerror or type(e).__name__))
-            return
-        subdirs, here_bags = [], []
-        for e in entries:
-            if e.name.startswith("."):
-                continue
-            cst = _stat(e.path)
-            if cst is not None and stat.S_ISREG(cst.st_mode) and e.name.endswith(".bag"):
-                try:
-                    via_link = e.is_symlink()
-                except OSError:
-                    continue
-                bag_key = (cst.st_dev, cst.st_ino)
-                # A bag is named by its real path where it has one (as a folder is).
-                if bag_key not in bags or (bags[bag_key][0] and not via_link):
-                    here_bags.append((bag_key, (via_link, rel + (e.name,))))
-                continue
-            if cst is None or not stat.S_ISDIR(cst.st_mode):
-                continue
-            try:
-                is_link = e.is_symlink()
-            except OSError:
-                continue
-            subdirs.append((e.name, (cst.st_dev, cst.st_ino), is_link))
-        if _is_tum(path) or _is_dataset_sequence(path):
-            found.append(rel)
-            return
-        for bag_key, entry in here_bags:  # each bag a sequence of its own
-            bags[bag_key] = entry
-        frames = {name for name, _, _ in subdirs if _is_frame(os.path.join(path, name))}
-        if frames:
-            found.append(rel)
-        for name, key, is_link in subdirs:
-            if name in frames:
-                continue
-            child = rel + (name,)
-            if is_link:
-                deferred.append((child, key))
-            elif key not in visited:
-                visited.add(key)
-                if len(child) > MAX_DEPTH:
-                    unread.append((child, f"deeper than {MAX_DEPTH} folders"))
-                else:
-                    walk.append(child)
-
-    while walk or deferred:
-        if walk:
-            listing(walk.pop())
-            continue
-        child, key = deferred.pop(0)
-        if key in visited:
-            continue
-        visited.add(key)
-        if len(child) > MAX_DEPTH:
-            unread.append((child, f"deeper than {MAX_DEPTH} folders"))
-            continue
-        links.append(os.path.realpath(os.path.join(root, *child)))
-        walk.append(child)
-    found.extend(rel for _, rel in bags.values())
-    found.sort()
-    return Discovery(["/".join(rel) if rel else "." for rel in found], links,
-                     [("/".join(rel) or ".", why) for rel, why in sorted(unread)])
-
-
-def discover(root) -> list:
-    """The sequences under `root`, as paths relative to it ("." for root itself), sorted.
-
-    A TUM sequence (rgb.txt and depth.txt), an OCID sequence, an OSD-0.2-depth tree or a
-    BOP scene (docs/INPUTS.md, sections 5 and 6) is one sequence; so is each ROS 1 bag
-    (`*.bag`, section 4; its output folder keeps the name, OUT/<path>/rec.bag/; each bag
-    once, by device and inode, named by its real path where it has one), and root itself
-    may be one; a folder whose sub-folders are frames (depth.png) is one sequence of
-    those frames, as `wul3d run FOLDER` reads it; root itself being one frame is a sequence
-    of one. Other folders are searched further (a
-    folder can hold frames and sequences of its own). Hidden folders are skipped.
-    Symbolic links to folders are followed, each folder once (by device and inode): a loop
-    back into the tree, or two links to one folder, find nothing twice; a sequence reached
-    both by its real path and through a link is named by its real path. Folders more than
-    MAX_DEPTH (64) below root, and folders that cannot be listed, are not searched (the
-    batch reports them). Names that are not UTF-8 come back as os.fsdecode gives them.
-    """
-    return _discover(root).sequences
-
-
-def output_dir(out, root, rel) -> pathlib.Path:
-    """OUT/<rel>, or OUT/<root's name> for root itself."""
-    return pathlib.Path(out) / (pathlib.Path(root).resolve().name if rel == "." else rel)
-
-
-def is_finished(out_dir: pathlib.Path) -> bool:
-    """Whether summary.json, the run loop's last write, is there (a plain file)."""
-    try:
-        st = os.lstat(pathlib.Path(out_dir) / DONE_MARKER)
-    except OSError:
-        return False
-    return stat.S_ISREG(st.st_mode)
-
-
-# ---- what wul3d wrote -----------------------------------------------------------------------
-
-def _lstat(path):
-    try:
-        return os.lstat(path)
-    except OSError:
-        return None
-
-
-def _own_listing(d):
-    """(the entries of folder `d` by name, but for `.wul3d.*` temporaries, None), or
-    ([], why it cannot be listed)."""
-    try:
-        entries = sorted(os.scandir(d), key=lambda e: e.name)
-    except OSError as e:
-        return [], f"{text(str(d))} ({e.strerror})"
-    return [e for e in entries if not e.name.startswith(OWN_PREFIX)], None
-
-
-def _foreign_in_frame_folder(d: pathlib.Path):
-    """The first entry of frame folder `d` that write_frame does not write, or None."""
-    entries, why = _own_listing(d)
-    for e in entries:
-        if e.name not in FRAME_OUTPUT_FILES or not e.is_file(follow_symlinks=False):
-            return text(e.path)
-    return why
-
-
-def foreign_entry(out_dir, nested=()):
-    """The first thing in the sequence output `out_dir` that wul3d did not write, or None:
-    the library's rule for an existing OUT (prepare_out_dir): summary.json and frames.jsonl
-    as plain files, `.wul3d.*` temporaries, frame folders holding only frame outputs; and
-    `nested`, the names of folders that hold other sequences' outputs of this batch."""
-    entries, why = _own_listing(out_dir)
-    for e in entries:
-        if e.name in (DONE_MARKER, FRAMES_FILE):
-            if not e.is_file(follow_symlinks=False):
-                return text(e.path)
-            continue
-        if not e.is_dir(follow_symlinks=False):
-            return text(e.path)
-        if e.name in nested:
-            continue
-        what = _foreign_in_frame_folder(pathlib.Path(e.path))
-        if what is not None:
-            return what
-    return why
-
-
-def _is_run_output(d: pathlib.Path) -> bool:
-    """Whether `d` holds only what a run into it writes (a task's staging folder)."""
-    return _lstat(d) is not None and stat.S_ISDIR(_lstat(d).st_mode) and \
-        foreign_entry(d) is None
-
-
-def _remove_run_output(d: pathlib.Path) -> bool:
-    """Removes the folder `d` if it holds only what wul3d writes (foreign_entry's rule):
-    its files of those names, its frame folders, then itself. Anything else stays (and so
-    does `d`). Returns whether `d` is gone."""
-    if not _is_run_output(d):
-        return False
-    for e in list(os.scandir(d)):
-        try:
-            if e.is_dir(follow_symlinks=False):
-                for f in list(os.scandir(e.path)):
-                    if f.is_dir(follow_symlinks=False):  # a .wul3d.partial-* of a killed run
-                        _remove_run_output(pathlib.Path(f.path))
-                    elif f.name in FRAME_OUTPUT_FILES or f.name.startswith(OWN_PREFIX):
-                        os.unlink(f.path)
-                os.rmdir(e.path)
-            elif e.name in (DONE_MARKER, FRAMES_FILE) or e.name.startswith(OWN_PREFIX):
-                os.unlink(e.path)
-        except OSError:
-            pass
-    try:
-        os.rmdir(d)
-        return True
-    except OSError:
-        return False
-
-
-def _make_staging(staging: pathlib.Path):
-    """A batch's staging folder, with the marker that tells its tasks it is live."""
-    staging.mkdir()
-    fd = os.open(staging / LIVE_MARKER, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW
-                 | os.O_CLOEXEC, 0o644)
-    os.close(fd)
-
-
-def _remove_staging(staging: pathlib.Path) -> bool:
-    """Removes a batch's staging folder: each task folder in it that holds only run outputs,
-    then the folder if that emptied it. Returns whether it is gone."""
-    try:
-        entries = list(os.scandir(staging))
-    except FileNotFoundError:
-        return True
-    except OSError:
-        return False
-    for e in entries:
-        if e.is_dir(follow_symlinks=False):
-            _remove_run_output(pathlib.Path(e.path))
-        elif e.name == LIVE_MARKER and e.is_file(follow_symlinks=False):
-            os.unlink(e.path)
-    try:
-        os.rmdir(staging)
-        return True
-    except OSError:
-        return False
-
-
 # ---- one task -----------------------------------------------------------------------------
-
-class Refused(ValueError):
-    """A sequence's output would replace what wul3d did not write."""
-
-
-def _check_write_target(target, kind, inputs, flag):
-    from . import _wul3d
-
-    _wul3d._check_write_target(os.fsencode(target), kind, [os.fsencode(i) for i in inputs],
-                               flag)
-
-
-def _replace_file(entry: pathlib.Path, target: pathlib.Path):
-    """Moves `entry` to `target`, replacing a plain file there; a link, hard link, FIFO or
-    folder under the name is refused (the library's guard), not replaced."""
-    _check_write_target(target, "file", [], text(str(target)))
-    os.replace(entry, target)
-
-
-def _no_link_on_the_way(top: pathlib.Path, final: pathlib.Path):
-    """Refuses a symbolic link among the folders between OUT and `final` (OUT/a -> elsewhere
-    for the sequence a/b): outputs are never written through a link out of OUT."""
-    path = top
-    for part in final.relative_to(top).parts[:-1]:
-        path = path / part
-        st = _lstat(path)
-        if st is not None and stat.S_ISLNK(st.st_mode):
-            raise Refused(f"{text(str(path))}: is a symbolic link; the batch writes no output "
-                          "through one: move it away")
-
-
-def _publish(staging: pathlib.Path, final: pathlib.Path, nested=(), overwrite=False):
-    """Moves a complete staging folder to `final`: one rename when `final` does not exist;
-    else (it holds a nested sequence's output, or an unfinished earlier try) entry by entry
-    with the marker last, and in a frame folder file by file, only the files of
-    FRAME_OUTPUT_FILES: nothing wul3d did not write is removed or replaced. An existing
-    `final` holding anything else is Refused, unless `overwrite` (then what is foreign stays
-    where it is, beside the new outputs)."""
-    final.parent.mkdir(parents=True, exist_ok=True)
-    if _lstat(final) is None:
-        try:
-            os.rename(staging, final)
-            return
-        except OSError:
-            if _lstat(final) is None:
-                raise
-    st = _lstat(final)
-    if not stat.S_ISDIR(st.st_mode):  # a link (never followed) or a file
-        raise Refused(f"{text(str(final))}: exists and is not a folder wul3d wrote; "
-                      "move it away")
-    if not overwrite:
-        what = foreign_entry(final, nested)
-        if what is not None:
-            raise Refused(f"{text(str(final))}: holds what wul3d did not write ({what}); "
-                          "choose another --out, or --overwrite to replace only wul3d's "
-                          "own files there")
-    marker = final / DONE_MARKER
-    m = _lstat(marker)
-    if m is not None and stat.S_ISREG(m.st_mode):
-        marker.unlink()  # unfinished until the new marker is in place
-    entries = sorted(staging.iterdir(), key=lambda p: (p.name == DONE_MARKER, p.name))
-    for entry in entries:
-        target = final / entry.name
-        if not entry.is_dir() or entry.is_symlink():
-            _replace_file(entry, target)
-            continue
-        t = _lstat(target)
-        if t is None:
-            os.rename(entry, target)
-            continue
-        if not stat.S_ISDIR(t.st_mode):
-            raise Refused(f"{text(str(target))}: exists and is not a frame folder; move it away")
-        new = {f.name for f in entry.iterdir()}
-        for name in sorted(new):
-            _replace_file(entry / name, target / name)
-        for name in sorted(FRAME_OUTPUT_FILES - new):  # what an earlier run wrote, not this
-            old = _lstat(target / name)
-            if old is not None and stat.S_ISREG(old.st_mode):
-                (target / name).unlink()
-        entry.rmdir()
-    staging.rmdir()
-
 
 def _frame_scores(input_dir: pathlib.Path, out_dir: pathlib.Path, names):
     """Per frame with INPUT/<frame>/label.png: the UOIS scores of objects.png against it."""
@@ -545,7 +151,7 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
 
             wul3d.set_num_threads(threads)
         if own_root:
-            _make_staging(staging_root)
+            make_staging(staging_root)
         # The batch renames its folder when it ends or is interrupted: then this try is not
         # wanted (a task on a cluster's worker may outlive its batch). The folder is held
         # open (its inode cannot be reused) and must hold the batch's marker (a folder the
@@ -561,13 +167,13 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
         summary = _run(input_dir, str(staging), options)
         names = sorted(p.name for p in staging.iterdir() if p.is_dir())
         record["scores"] = _frame_scores(pathlib.Path(input_dir), staging, names) if score else []
-        now = _lstat(staging_root)
+        now = lstat_or_none(staging_root)
         if now is None or (now.st_dev, now.st_ino) != (batch_folder.st_dev, batch_folder.st_ino):
             ended = True
             raise Refused("the batch ended before this sequence was done; not published")
-        _check_write_target(final, "folder", [input_dir], "output folder")
-        _no_link_on_the_way(pathlib.Path(out_root), final)
-        _publish(staging, final, nested, overwrite)
+        check_write_target(final, "folder", [input_dir], "output folder")
+        no_link_on_the_way(pathlib.Path(out_root), final)
+        publish(staging, final, nested, overwrite)
         record.update(status="ok", frames=summary["frames"], fps=summary["fps"])
     except (ValueError, OSError, RuntimeError, TypeError) as e:
         # wul3d.InputError is a ValueError; UnicodeError too
@@ -575,10 +181,10 @@ def run_sequence_task(input_dir, out_root, rel_out, options: dict, threads: int,
     finally:
         if batch_fd is not None:
             os.close(batch_fd)
-        if _lstat(staging) is not None:
-            _remove_run_output(staging)
+        if lstat_or_none(staging) is not None:
+            remove_run_output(staging)
         if own_root or ended:
-            _remove_staging(staging_root)  # an ended batch's folder, made again by the run
+            remove_staging(staging_root)  # an ended batch's folder, made again by the run
         record["wall_s"] = time.monotonic() - start
     return record
 
@@ -734,7 +340,7 @@ def _write_batch_json(out: pathlib.Path, report: dict, inputs):
     and a new temporary (O_EXCL, never a link followed) renamed over it. Every string is
     valid Unicode: names that are not UTF-8 are escaped (text)."""
     target = out / BATCH_JSON
-    _check_write_target(target, "file", inputs, BATCH_JSON)
+    check_write_target(target, "file", inputs, BATCH_JSON)
     tmp = out / f"{OWN_PREFIX}tmp-batch-{os.getpid()}-{uuid.uuid4().hex[:8]}"
     data = (json.dumps(report, indent=2, ensure_ascii=False) + "\n").encode("utf-8")
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
@@ -800,12 +406,12 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
     root = pathlib.Path(os.path.realpath(root))
     try:
         # Before anything is read or written: OUT apart from ROOT (however spelt).
-        _check_write_target(out_given, "folder", [root], "--out")
-        found = _discover(root)
+        check_write_target(out_given, "folder", [root], "--out")
+        found = discover_all(root)
         inputs = [str(root)] + found.links  # the folders links lead to are inputs too
-        _check_write_target(out_given, "folder", inputs, "--out")
-        if _lstat(pathlib.Path(out_given) / BATCH_JSON) is not None:
-            _check_write_target(pathlib.Path(out_given) / BATCH_JSON, "file", inputs,
+        check_write_target(out_given, "folder", inputs, "--out")
+        if lstat_or_none(pathlib.Path(out_given) / BATCH_JSON) is not None:
+            check_write_target(pathlib.Path(out_given) / BATCH_JSON, "file", inputs,
                                 BATCH_JSON)
     except _wul3d.InputError as e:
         raise BatchError(_one_line(e)) from None
@@ -833,9 +439,9 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
     _wul3d._remove_stale_temporaries(os.fsencode(out))  # of a run killed mid-write
     for e in sorted(os.scandir(out), key=lambda e: e.name):  # of a batch killed mid-way
         if e.name.startswith(STAGING_PREFIX) and e.is_dir(follow_symlinks=False):
-            _remove_staging(pathlib.Path(e.path))
+            remove_staging(pathlib.Path(e.path))
     staging = out / f"{STAGING_PREFIX}{os.getpid()}-{uuid.uuid4().hex[:12]}"
-    _make_staging(staging)
+    make_staging(staging)
 
     sequences = found.sequences
     rel_outs = {rel: str(output_dir(out, root, rel).relative_to(out)) for rel in sequences}
@@ -874,7 +480,7 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
             if is_finished(final):
                 records[rel_out] = _finished_record(root / rel, final, rel_out, score)
                 continue
-            what = None if overwrite or _lstat(final) is None else foreign_entry(
+            what = None if overwrite or lstat_or_none(final) is None else foreign_entry(
                 final, nested_names(rel_out))
             if what is not None:
                 records[rel_out] = _failed_record(
@@ -963,7 +569,7 @@ def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_p
         except OSError:
             ended = staging
         for _ in range(3):
-            if _remove_staging(ended):
+            if remove_staging(ended):
                 break
             time.sleep(0.1)
     if interrupted is not None:  # finished, but the result was not collected: OUT says so

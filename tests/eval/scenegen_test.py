@@ -16,6 +16,8 @@ from PIL import Image
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "eval"))
 import scenegen  # noqa: E402
+import scene_sensors  # noqa: E402
+import scene_shapes  # noqa: E402
 import kinds as kinds_module  # noqa: E402
 
 W, H = 320, 240
@@ -70,11 +72,11 @@ class Scenegen(unittest.TestCase):
         self.assertGreater(valid.mean(), 0.5)
         fb = self.truth["fb"]
         # Disparity noise (5 sigma) and its 1/8-pixel step, as depth: both grow with z^2.
-        bound = z * z / fb * (5 * self.truth["sigma_px"] + 1 / scenegen.SUBPIXEL) + 0.001
+        bound = z * z / fb * (5 * self.truth["sigma_px"] + 1 / scene_sensors.SUBPIXEL) + 0.001
         err = np.abs(depth[valid] * intr["depth_scale_m_per_unit"] - z[valid])
         self.assertTrue((err <= bound[valid]).all(), f"worst {err.max():.4f} m")
         # Missing depth where the ray hit something: shadows, edges.
-        self.assertGreater(((z > 0) & (z < scenegen.ZMAX) & ~valid).sum(), 0)
+        self.assertGreater(((z > 0) & (z < scene_sensors.ZMAX) & ~valid).sum(), 0)
 
     def test_written_as_a_frame_folder(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -98,11 +100,11 @@ class Scenegen(unittest.TestCase):
             labelled += [(prim, mat) for prim, lab, mat in parts if lab > 0 and mat["kind"] == "label"]
         self.assertGreater(len(labelled), 5)
         for prim, mat in labelled:
-            self.assertTrue(isinstance(prim, scenegen.Cone) and prim.r0 == prim.r1)
+            self.assertTrue(isinstance(prim, scene_shapes.Cone) and prim.r0 == prim.r1)
             self.assertTrue(prim.z0 < mat["z0"] < mat["z1"] < prim.z1)
             mid, below = np.array([[0.0, 0.0, (mat["z0"] + mat["z1"]) / 2]]), np.array([[0.0, 0.0, mat["z0"] / 2]])
-            np.testing.assert_array_equal(scenegen.shade(mat, mid)[0], mat["b"])
-            self.assertGreaterEqual(np.linalg.norm(scenegen.shade(mat, below)[0] - mat["b"]), 1)
+            np.testing.assert_array_equal(scene_shapes.shade(mat, mid)[0], mat["b"])
+            self.assertGreaterEqual(np.linalg.norm(scene_shapes.shade(mat, below)[0] - mat["b"]), 1)
 
     def test_each_object_has_the_kind_it_was_drawn_as(self):
         label = self.frame[2]
@@ -116,7 +118,7 @@ class Scenegen(unittest.TestCase):
             for prim, lab, _ in parts:
                 if lab > 0:
                     round_kind = kind_of[lab] in ("cylinder", "cup", "bowl")
-                    self.assertEqual(isinstance(prim, scenegen.Cone), round_kind, kind_of[lab])
+                    self.assertEqual(isinstance(prim, scene_shapes.Cone), round_kind, kind_of[lab])
 
     def test_kinds_scores_a_perfect_run_good_and_an_empty_one_missed_and_compares_them(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -247,16 +249,16 @@ class FamiliesAndSensors(unittest.TestCase):
                 near = np.full(z.shape, np.inf)
                 for dy in (-1, 0, 1):
                     for dx in (-1, 0, 1):
-                        near = np.minimum(near, scenegen.shift(np.where(depth > 0, d, np.inf), dy, dx, np.inf))
+                        near = np.minimum(near, scene_sensors.shift(np.where(depth > 0, d, np.inf), dy, dx, np.inf))
                 # The band: no depth, and a nearer surface a little to its right.
                 band = truth["band"] & (z > 0)
                 self.assertGreater(band.sum(), 0)
                 self.assertFalse((depth[band] > 0).any())
                 reach = int(np.ceil(self.W / 640 * scenegen.SENSORS["active_stereo"]["focal"] *
-                                    scenegen.AS_BASELINE / scenegen.AS_ZMIN)) + 2
+                                    scene_sensors.AS_BASELINE / scene_sensors.AS_ZMIN)) + 2
                 right = np.full(z.shape, np.inf)
                 for dx in range(1, reach + 1):
-                    right = np.minimum(right, scenegen.shift(np.where(z > 0, z, np.inf), 0, dx, np.inf))
+                    right = np.minimum(right, scene_sensors.shift(np.where(z > 0, z, np.inf), 0, dx, np.inf))
                 self.assertTrue((right[band] < z[band] - 0.005).mean() > 0.95)
 
     def test_tof_flying_pixels_multipath_and_dark_dropouts(self):
@@ -273,7 +275,7 @@ class FamiliesAndSensors(unittest.TestCase):
                 self.assertGreaterEqual(mp.min(), 0.0)
                 self.assertGreater(mp.max(), 0.002)   # a corner somewhere pushes depth back
                 amp, dropped = truth["amplitude"], truth["dropped"]
-                lo, hi = scenegen.TOF_AMP_DROP
+                lo, hi = scene_sensors.TOF_AMP_DROP
                 self.assertTrue(dropped[amp <= lo].all())
                 self.assertFalse(dropped[amp >= hi].any())
                 self.assertFalse((depth[dropped] > 0).any())

@@ -209,12 +209,6 @@ def test_a_second_writer_of_one_out_is_refused(tmp_path):
     # While the batch runs, `wul3d run` into the same OUT is refused (the batch holds it).
 
 
-def test_frame_output_files_agree_with_the_library():
-    # batch.py keeps its own copy: it is imported without the compiled module (the fuzzer).
-    from wul3d import _wul3d
-    assert set(_wul3d._frame_output_files()) == batch.FRAME_OUTPUT_FILES
-
-
 # ---- item 8: links and loops under ROOT ------------------------------------------------------
 
 def fake_frame(d: pathlib.Path):
@@ -247,7 +241,7 @@ def test_discovery_over_link_loops_finds_each_sequence_once_and_fast(tmp_path):
     subprocess.run([sys.executable, "-c", "import sys; from wul3d import batch; "
                     "batch.discover(sys.argv[1])", str(root)], check=True, timeout=60,
                    env=dict(os.environ, PYTHONPATH=str(BUILD / "python")))
-    found = batch._discover(root)
+    found = batch.discover_all(root)
     assert found.sequences == ["deep/seqB", "deep/seqB/nested", "ext1/seqC", "seqA"]
     assert found.links == [os.path.realpath(outside)]
     assert found.unread == []
@@ -259,7 +253,7 @@ def test_discovery_stops_at_the_depth_bound(tmp_path):
     deep = root.joinpath(*["d"] * (batch.MAX_DEPTH + 2))
     fake_frame(deep / "f0")
     fake_frame(root / "near" / "f0")
-    found = batch._discover(root)
+    found = batch.discover_all(root)
     assert found.sequences == ["near"]
     assert [why for _, why in found.unread] == [f"deeper than {batch.MAX_DEPTH} folders"]
 
