@@ -2,6 +2,8 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_support.hpp"
+#include "wul3d/clustering.hpp"
+#include "wul3d/objects.hpp"
 #include "wul3d/visualization.hpp"
 
 using namespace wul3d;

@@ -8,11 +8,13 @@
 #include <vector>
 
 #include "wul3d/camera.hpp"
-#include "wul3d/clustering.hpp"
 #include "wul3d/frame.hpp"
-#include "wul3d/objects.hpp"
+#include "wul3d/image.hpp"
 
 namespace wul3d {
+
+class ClusterState;     // clustering.hpp
+struct DetectedObject;  // objects.hpp
 
 /// The fixed display colour C_j of cluster j (0-based): 12 hand-picked distinct colours,
 /// then golden-ratio hues.
@@ -49,13 +51,13 @@ struct OverlayStyle {
                                ///< to a quarter; 0 none
 };
 
-/// Objects over a picture: each pixel of object i (objects.labels == track id) takes
-/// (1 - tint) of `base` and tint of object_color(i); border pixels (a 4-neighbour with another
-/// label) white; then the ids and boxes of `list`. `base` (the frame's colour, usually) and
 /// The picture objects are drawn over: the frame's colour, or for a depth-only frame its
 /// depth in grey over the depth's own range (near bright, no depth black).
 void render_frame_picture(const RgbdFrame& frame, ColorImage& out);
 
+/// Objects over a picture: each pixel of object i (objects.labels == track id) takes
+/// (1 - tint) of `base` and tint of object_color(i); border pixels (a 4-neighbour with another
+/// label) white; then the ids and boxes of `list`. `base` (the frame's colour, usually) and
 /// `objects` must have the same size, and `intrinsics` their pixels (used for the boxes);
 /// throws ParamError otherwise. Pixels of no object keep `base`.
 void render_object_overlay(const ColorImage& base, const LabelImage& objects,

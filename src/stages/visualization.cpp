@@ -1,5 +1,8 @@
 #include "wul3d/visualization.hpp"
 
+#include "wul3d/clustering.hpp"
+#include "wul3d/objects.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>

@@ -8,8 +8,10 @@
 
 #include "synthetic_scene.hpp"
 #include "wul3d/background.hpp"
+#include "wul3d/clustering.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/normals.hpp"
+#include "wul3d/objects.hpp"
 
 using namespace wul3d;
 using namespace wul3d::test;
