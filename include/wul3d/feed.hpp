@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "wul3d/capture.hpp"
 #include "wul3d/io.hpp"
@@ -22,9 +23,13 @@ struct FeedOptions {
     std::string camera;     ///< a live camera, BACKEND[:ARG] (parse_camera_spec)
     bool lossless = false;  ///< camera only: capture waits for processing (replays, tests)
     SourceOptions source;   ///< how to read `input`
-    /// Recording only: frames read ahead on a thread of their own while the caller
-    /// processes the current one (0: each frame is read in next(), on the caller's thread).
+    /// Recording only: frames read ahead, per reader, on threads of their own while the
+    /// caller processes the current one (0: each frame is read in next(), on the caller's
+    /// thread).
     std::size_t read_ahead = 0;
+    /// Recording, with read_ahead: threads that read at once, each with a decoder of its own
+    /// (FrameSource::clone; one where the source has no second reader, as a bag).
+    std::size_t readers = 1;
 };
 
 namespace detail {
@@ -71,13 +76,17 @@ public:
     std::uint64_t dropped() const { return live_ ? live_->dropped() : 0; }
     /// Random access (recordings only; nullptr for a camera).
     FrameSource* source() { return source_.get(); }
+    /// Threads reading the recording ahead (0: none, frames are read in next()).
+    std::size_t readers() const { return readers_; }
 
 private:
     bool stop_requested() const { return stop_ && stop_(); }
 
     std::unique_ptr<FrameSource> source_;
+    std::vector<std::unique_ptr<FrameSource>> clones_;  // the further readers' sources
     std::unique_ptr<LiveSource> live_;
-    std::unique_ptr<detail::ReadAhead> ahead_;  // declared after source_: stops before it goes
+    std::unique_ptr<detail::ReadAhead> ahead_;  // declared after the sources: stops before they go
+    std::size_t readers_ = 0;
     std::string input_;
     std::function<bool()> stop_;
     std::size_t index_ = 0;

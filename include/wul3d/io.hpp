@@ -181,6 +181,10 @@ public:
     virtual InputFormat format() const = 0;
     /// The calibration of raw items (Unregistered only); nullptr otherwise.
     virtual const StereoCalibration* calibration() const { return nullptr; }
+    /// A second reader of the same frames (the same names, the same items), independent of
+    /// this one, so that two threads may each read with their own; nullptr where the source
+    /// has none (a bag, one PCD file). Lists no folder again.
+    virtual std::unique_ptr<FrameSource> clone() const { return nullptr; }
 };
 
 /// Opens `path`. Auto-detection: a file that starts as a ROS bag does is a bag (bag.hpp);

@@ -145,6 +145,7 @@ public:
         return frames_[i].depth.stem().string();
     }
     InputFormat format() const override { return InputFormat::Bop; }
+    std::unique_ptr<FrameSource> clone() const override { return std::make_unique<BopSource>(*this); }
 
     void read(std::size_t i, SourceItem& item) override {
         detail::check_index(i, size());

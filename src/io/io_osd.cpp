@@ -59,6 +59,7 @@ public:
         return frames_.depth[i].stem().string();
     }
     InputFormat format() const override { return InputFormat::Osd; }
+    std::unique_ptr<FrameSource> clone() const override { return std::make_unique<OsdSource>(*this); }
 
     void read(std::size_t i, SourceItem& item) override {
         check_index(i, size());

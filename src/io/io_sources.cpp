@@ -209,6 +209,7 @@ public:
         return dirs_.names[i];
     }
     InputFormat format() const override { return InputFormat::Frames; }
+    std::unique_ptr<FrameSource> clone() const override { return std::make_unique<FramesSource>(*this); }
 
     void read(std::size_t i, SourceItem& item) override {
         check_index(i, size());
@@ -314,6 +315,7 @@ public:
         return dirs_.names[i];
     }
     InputFormat format() const override { return InputFormat::Unregistered; }
+    std::unique_ptr<FrameSource> clone() const override { return std::make_unique<UnregisteredSource>(*this); }
     const StereoCalibration* calibration() const override { return &calib_; }
 
     void read(std::size_t i, SourceItem& item) override {
@@ -396,6 +398,7 @@ public:
         return depth_[i].stem().string();
     }
     InputFormat format() const override { return InputFormat::Ocid; }
+    std::unique_ptr<FrameSource> clone() const override { return std::make_unique<OcidSource>(*this); }
 
     void read(std::size_t i, SourceItem& item) override {
         check_index(i, size());

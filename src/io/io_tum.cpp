@@ -107,6 +107,7 @@ public:
         return pairs_[i].name;
     }
     InputFormat format() const override { return InputFormat::Tum; }
+    std::unique_ptr<FrameSource> clone() const override { return std::make_unique<TumSource>(*this); }
 
     void read(std::size_t i, SourceItem& item) override {
         check_index(i, size());

@@ -1,6 +1,8 @@
 // The frame feed of a run (feed.hpp): a recording or a live camera behind one loop step.
 #include "wul3d/feed.hpp"
 
+#include <algorithm>
+
 #include "wul3d/error.hpp"
 #include "read_ahead.hpp"
 
@@ -20,8 +22,17 @@ FrameFeed::FrameFeed(const FeedOptions& o, std::function<bool()> stop)
     } else {
         if (o.lossless) throw ParamError("--lossless needs --camera");
         source_ = open_source(o.input, o.source);
-        if (o.read_ahead > 0)
-            ahead_ = std::make_unique<detail::ReadAhead>(*source_, source_->size(), o.read_ahead);
+        if (o.read_ahead > 0) {
+            std::vector<FrameSource*> readers{source_.get()};
+            while (readers.size() < std::min(o.readers, source_->size())) {
+                std::unique_ptr<FrameSource> clone = source_->clone();
+                if (!clone) break;
+                readers.push_back(clone.get());
+                clones_.push_back(std::move(clone));
+            }
+            readers_ = readers.size();
+            ahead_ = std::make_unique<detail::ReadAhead>(readers, source_->size(), o.read_ahead * readers_);
+        }
     }
 }
 

@@ -6,21 +6,30 @@
 
 namespace wul3d::detail {
 
-ReadAhead::ReadAhead(FrameSource& source, std::size_t count, std::size_t depth)
-    : source_(source), end_(count), ring_(std::max<std::size_t>(1, depth)) {
-    reader_ = std::thread([this] { read_loop(); });
+ReadAhead::ReadAhead(std::vector<FrameSource*> readers, std::size_t count, std::size_t depth)
+    : end_(count), ring_(std::max<std::size_t>(1, depth)) {
+    threads_.reserve(readers.size());
+    try {
+        for (FrameSource* source : readers) threads_.emplace_back([this, source] { read_loop(*source); });
+    } catch (...) {
+        stop();
+        throw;
+    }
 }
 
-ReadAhead::~ReadAhead() {
+ReadAhead::~ReadAhead() { stop(); }
+
+void ReadAhead::stop() {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         stopping_ = true;
     }
     changed_.notify_all();
-    reader_.join();
+    for (std::thread& t : threads_) t.join();
+    threads_.clear();
 }
 
-void ReadAhead::read_loop() {
+void ReadAhead::read_loop(FrameSource& source) {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
         // A slot is free when the frame that last used it has been taken.
@@ -33,7 +42,7 @@ void ReadAhead::read_loop() {
         lock.unlock();
         std::exception_ptr error;
         try {
-            source_.read(i, slot.item);
+            source.read(i, slot.item);
         } catch (...) {
             error = std::current_exception();
         }
@@ -41,7 +50,10 @@ void ReadAhead::read_loop() {
         slot.error = error;
         slot.ready = true;
         changed_.notify_all();
-        if (error) return;  // the loop ends at this frame: nothing after it is needed
+        if (error) {  // the run ends at this frame: nothing after it is needed
+            end_ = std::min(end_, i + 1);
+            return;
+        }
     }
 }
 
@@ -54,7 +66,7 @@ bool ReadAhead::next(SourceItem& item) {
     ++next_taken_;
     std::exception_ptr error = std::exchange(slot.error, nullptr);
     if (error) {
-        end_ = next_taken_;  // the reader stopped at this frame: nothing follows it
+        end_ = next_taken_;  // the readers stop at this frame: nothing follows it
     } else {
         std::swap(item, slot.item);
     }

@@ -213,17 +213,21 @@ void check_out_apart_from_inputs(const RunOptions& o) {
 
 /// How a run shares its worker threads (threads.hpp's count, all cores by default): a
 /// quarter of them, 1 to 4, write (a frame's outputs cost about as much as its processing),
-/// one reads ahead, and the stages take the rest, at least one. On 2 cores the stages then
-/// run on one thread beside the reader and the writer: alternated on osd_mosd, that ran the
-/// whole command 1.5 times as fast as the stages on both cores fighting them for the cores
-/// (docs/SPEED.md, "The command end to end").
+/// as many read (decoding a frame costs about what writing its outputs does: 10 and 8 ms at
+/// 640x480 on the 2-core machine), and the stages take the rest, at least one. On 2 cores
+/// the stages then run on one thread beside the reader and the writer: alternated on
+/// osd_mosd, that ran the whole command 1.5 times as fast as the stages on both cores
+/// fighting them for the cores (docs/SPEED.md, "The command end to end").
 struct RunThreads {
-    int total, writers, stages;
+    int total, readers, writers, stages;
 };
-RunThreads run_threads() {
+int run_writers(int total) { return std::clamp(total / 4, 1, 4); }
+/// `readers`: the threads that read (a camera's capture thread; fewer than wanted where the
+/// recording has no second reader, FrameSource::clone).
+RunThreads run_threads(int readers) {
     const int total = num_threads();
-    const int writers = std::clamp(total / 4, 1, 4);
-    return {total, writers, std::max(1, total - 1 - writers)};
+    const int writers = run_writers(total);
+    return {total, readers, writers, std::max(1, total - readers - writers)};
 }
 
 /// summary.json's frame-independent part.
@@ -250,6 +254,7 @@ nlohmann::json summary_json(const RunOptions& o, const FrameFeed& feed, const Ru
     summary["frames_file"] = kFramesFile;
     summary["threads"] = threads.total;
     summary["threads_stages"] = threads.stages;
+    summary["threads_readers"] = threads.readers;
     summary["threads_writers"] = threads.writers;
     summary["stage_ms_median"] = log.medians();
     summary["ms_per_frame_median"] = s.ms_per_frame_median;
@@ -376,6 +381,7 @@ private:
     static FeedOptions feed_options(const RunOptions& o) {
         FeedOptions f = o.feed;
         f.read_ahead = 2;  // the next frames decode while this one is processed
+        f.readers = static_cast<std::size_t>(run_writers(num_threads()));  // RunThreads
         return f;
     }
     fs::path out_dir() const { return fs::path(o_.out_dir); }
@@ -519,7 +525,7 @@ private:
     SourceItem item_;
     StageLog log_;
     RunSummary s_;
-    const RunThreads threads_ = run_threads();
+    const RunThreads threads_ = run_threads(feed_.live() ? 1 : static_cast<int>(feed_.readers()));
     const Clock::time_point start_ = Clock::now();
     FramesLog* frames_log_ = nullptr;                      // run()'s, while it runs
     detail::WriteBehind<PendingFrame>* writes_ = nullptr;  // run()'s, while it runs

@@ -35,7 +35,7 @@ using wul3d::test::ramp_depth;
 using wul3d::test::sample_dir;
 using wul3d::test::slurp;
 using wul3d::test::solid_color;
-using wul3d::test::spit;
+using wul3d::test::write_text;
 using wul3d::test::TempDir;
 
 // ---- single files -------------------------------------------------------------------
@@ -208,7 +208,7 @@ TEST(IoImages, ReaderErrors_TruncatedAndCorruptPng) {
 
     for (std::size_t keep : {bytes.size() - 1, bytes.size() / 2, std::size_t{40}, std::size_t{8}}) {
         const fs::path cut = tmp / ("cut" + std::to_string(keep) + ".png");
-        spit(cut, bytes.substr(0, keep));
+        write_text(cut, bytes.substr(0, keep));
         expect_input_error([&] { wul3d::read_depth_png(cut.string(), 0.001f); },
                            {cut.string(), "cannot decode"});
         expect_input_error([&] { wul3d::read_color_image(cut.string()); },
@@ -217,18 +217,18 @@ TEST(IoImages, ReaderErrors_TruncatedAndCorruptPng) {
     std::string flipped = bytes;
     flipped[bytes.size() / 2] = static_cast<char>(flipped[bytes.size() / 2] ^ 0x5a);
     const fs::path corrupt = tmp / "corrupt.png";
-    spit(corrupt, flipped);
+    write_text(corrupt, flipped);
     expect_input_error([&] { wul3d::read_depth_png(corrupt.string(), 0.001f); },
                        {corrupt.string(), "cannot decode"});
 
     const fs::path text = tmp / "text.png";
-    spit(text, "this is not an image\n");
+    write_text(text, "this is not an image\n");
     expect_input_error([&] { wul3d::read_depth_png(text.string(), 0.001f); },
                        {text.string(), "cannot decode"});
     expect_input_error([&] { wul3d::read_color_image(text.string()); },
                        {text.string(), "cannot decode"});
     const fs::path empty = tmp / "empty.png";
-    spit(empty, "");
+    write_text(empty, "");
     expect_input_error([&] { wul3d::read_label_png(empty.string()); },
                        {empty.string(), "cannot decode"});
 }
@@ -261,7 +261,7 @@ TEST(IoImages, PngWithAncillaryChunksReadsQuietly) {
         chunks += be32(static_cast<std::uint32_t>(body.size() - 4)) + body + be32(crc32(body));
     }
     bytes.insert(33, chunks);
-    spit(path, bytes);
+    write_text(path, bytes);
     testing::internal::CaptureStderr();
     const wul3d::DepthImage back = wul3d::read_depth_png(path.string(), 0.001f);
     EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
@@ -345,7 +345,7 @@ TEST(IoImages, Png16BitSamplesAreBigEndianInTheFile) {
     std::vector<std::string> rows(2);
     for (std::size_t p = 0; p < v.size(); ++p) rows[p / 3] += be16(v[p]);
     const fs::path path = tmp / "depth.png";
-    spit(path, png_file(3, 2, 16, 0, zlib_stored(unfiltered(rows))));
+    write_text(path, png_file(3, 2, 16, 0, zlib_stored(unfiltered(rows))));
     EXPECT_EQ(wul3d::read_depth_png(path.string(), 0.001f).data, v);
     EXPECT_EQ(wul3d::read_label_png(path.string()).labels, v);
 }
@@ -396,7 +396,7 @@ TEST(IoImages, PalettePngs_AreColourWithAlphaDropped_AndTheirIndicesAreLabels) {
     const std::string idat = zlib_stored(unfiltered({"\xc6"}));
     const std::vector<std::uint8_t> expect = {200, 100, 0, 10, 20, 30, 40, 50, 60, 70, 80, 90};
     const fs::path opaque = tmp / "palette.png";
-    spit(opaque, png_file(4, 1, 2, 3, idat, plte));
+    write_text(opaque, png_file(4, 1, 2, 3, idat, plte));
     const wul3d::ColorImage c = wul3d::read_color_image(opaque.string());
     EXPECT_EQ(c.width, 4);
     EXPECT_EQ(c.rgb, expect);
@@ -407,13 +407,13 @@ TEST(IoImages, PalettePngs_AreColourWithAlphaDropped_AndTheirIndicesAreLabels) {
     EXPECT_EQ(l.labels, indices);
     // 8 bits an index, the same entries.
     const fs::path wide = tmp / "palette8.png";
-    spit(wide, png_file(4, 1, 8, 3, zlib_stored(unfiltered({std::string("\x03\x00\x01\x02", 4)})), plte));
+    write_text(wide, png_file(4, 1, 8, 3, zlib_stored(unfiltered({std::string("\x03\x00\x01\x02", 4)})), plte));
     EXPECT_EQ(wul3d::read_label_png(wide.string()).labels, indices);
     EXPECT_EQ(wul3d::read_color_image(wide.string()).rgb, expect);
 
     // With tRNS (alpha for the first two entries): four channels, the alpha is dropped.
     const fs::path transparent = tmp / "palette_trns.png";
-    spit(transparent, png_file(4, 1, 2, 3, idat, plte + png_chunk("tRNS", std::string("\x00\x80", 2))));
+    write_text(transparent, png_file(4, 1, 2, 3, idat, plte + png_chunk("tRNS", std::string("\x00\x80", 2))));
     EXPECT_EQ(wul3d::read_color_image(transparent.string()).rgb, expect);
     EXPECT_EQ(wul3d::read_label_png(transparent.string()).labels, indices);
     expect_input_error([&] { wul3d::read_depth_png(transparent.string(), 0.001f); },
@@ -424,28 +424,28 @@ TEST(IoImages, GreyAlphaLowBitAndInterlacedPngs) {
     TempDir tmp;
     // Grey + alpha, 8-bit: colour is the grey three times; not labels (4 channels, as OpenCV had it).
     const fs::path ga = tmp / "grey_alpha.png";
-    spit(ga, png_file(2, 1, 8, 4, zlib_stored(unfiltered({std::string("\x10\xff\xe0\x00", 4)}))));
+    write_text(ga, png_file(2, 1, 8, 4, zlib_stored(unfiltered({std::string("\x10\xff\xe0\x00", 4)}))));
     EXPECT_EQ(wul3d::read_color_image(ga.string()).rgb, (std::vector<std::uint8_t>{16, 16, 16, 224, 224, 224}));
     expect_input_error([&] { wul3d::read_label_png(ga.string()); }, {ga.string(), "got 8-bit 4-channel"});
     const fs::path ga16 = tmp / "grey_alpha16.png";
-    spit(ga16, png_file(1, 1, 16, 4, zlib_stored(unfiltered({be16(1000) + be16(65535)}))));
+    write_text(ga16, png_file(1, 1, 16, 4, zlib_stored(unfiltered({be16(1000) + be16(65535)}))));
     expect_input_error([&] { wul3d::read_depth_png(ga16.string(), 0.001f); },
                        {ga16.string(), "got 16-bit 4-channel"});
 
     // 1-bit and 4-bit grey are scaled to 8 bits: as labels, as colour.
     const fs::path g1 = tmp / "grey1.png";
-    spit(g1, png_file(8, 1, 1, 0, zlib_stored(unfiltered({"\xb1"}))));
+    write_text(g1, png_file(8, 1, 1, 0, zlib_stored(unfiltered({"\xb1"}))));
     EXPECT_EQ(wul3d::read_label_png(g1.string()).labels,
               (std::vector<std::uint16_t>{255, 0, 255, 255, 0, 0, 0, 255}));
     const fs::path g4 = tmp / "grey4.png";
-    spit(g4, png_file(3, 1, 4, 0, zlib_stored(unfiltered({"\x1f\x70"}))));
+    write_text(g4, png_file(3, 1, 4, 0, zlib_stored(unfiltered({"\x1f\x70"}))));
     EXPECT_EQ(wul3d::read_label_png(g4.string()).labels, (std::vector<std::uint16_t>{17, 255, 119}));
     EXPECT_EQ(wul3d::read_color_image(g4.string()).rgb,
               (std::vector<std::uint8_t>{17, 17, 17, 255, 255, 255, 119, 119, 119}));
 
     // RGB with a tRNS colour: four channels, read as its RGB.
     const fs::path rgbt = tmp / "rgb_trns.png";
-    spit(rgbt, png_file(1, 1, 8, 2, zlib_stored(unfiltered({"\x01\x02\x03"})),
+    write_text(rgbt, png_file(1, 1, 8, 2, zlib_stored(unfiltered({"\x01\x02\x03"})),
                         png_chunk("tRNS", be16(1) + be16(2) + be16(3))));
     EXPECT_EQ(wul3d::read_color_image(rgbt.string()).rgb, (std::vector<std::uint8_t>{1, 2, 3}));
     expect_input_error([&] { wul3d::read_label_png(rgbt.string()); }, {rgbt.string(), "got 8-bit 4-channel"});
@@ -465,7 +465,7 @@ TEST(IoImages, GreyAlphaLowBitAndInterlacedPngs) {
         }
     }
     const fs::path interlaced = tmp / "interlaced.png";
-    spit(interlaced, png_file(w, h, 16, 0, zlib_stored(unfiltered(rows)), "", true));
+    write_text(interlaced, png_file(w, h, 16, 0, zlib_stored(unfiltered(rows)), "", true));
     const wul3d::DepthImage d = wul3d::read_depth_png(interlaced.string(), 0.001f);
     ASSERT_EQ(d.data.size(), static_cast<std::size_t>(w * h));
     for (int y = 0; y < h; ++y)
@@ -489,7 +489,7 @@ TEST(IoImages, DamagedImageDataWithValidCrc_OneQuietInputError) {
     for (std::uint32_t i = 2; i < len; ++i) bytes[idat + 4 + i] = static_cast<char>(0xff - i * 7 % 256);
     bytes.replace(idat + 4 + len, 4, be32(crc32(bytes.substr(idat, 4 + len))));
     const fs::path garbage = tmp / "garbage.png";
-    spit(garbage, bytes);
+    write_text(garbage, bytes);
     expect_input_error([&] { wul3d::read_depth_png(garbage.string(), 0.001f); },
                        {garbage.string(), "cannot decode PNG ("});
     expect_input_error([&] { wul3d::read_label_png(garbage.string()); }, {garbage.string(), "cannot decode PNG ("});
@@ -497,11 +497,11 @@ TEST(IoImages, DamagedImageDataWithValidCrc_OneQuietInputError) {
     // Too little image data: an error. Too much: libpng warns and reads the image; quietly.
     const std::string row = be16(7) + be16(8);
     const fs::path short_data = tmp / "short.png";
-    spit(short_data, png_file(2, 3, 16, 0, zlib_stored(unfiltered({row, row}))));
+    write_text(short_data, png_file(2, 3, 16, 0, zlib_stored(unfiltered({row, row}))));
     expect_input_error([&] { wul3d::read_depth_png(short_data.string(), 0.001f); },
                        {short_data.string(), "cannot decode PNG (Not enough image data)"});
     const fs::path long_data = tmp / "long.png";
-    spit(long_data, png_file(2, 1, 16, 0, zlib_stored(unfiltered({row, row, row}))));
+    write_text(long_data, png_file(2, 1, 16, 0, zlib_stored(unfiltered({row, row, row}))));
     testing::internal::CaptureStderr();
     const wul3d::DepthImage d = wul3d::read_depth_png(long_data.string(), 0.001f);
     EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
@@ -517,7 +517,7 @@ TEST(OpenSource, DamagedFrame_LeavesItsImageEmpty) {
                                R"({"fx": 5, "fy": 5, "cx": 4, "cy": 3, "width": 8, "height": 6})");
     }
     // f1's image data stops after two of its six rows.
-    spit(tmp / "f1" / "depth.png", png_file(8, 6, 16, 0, zlib_stored(unfiltered({std::string(16, 'a'), std::string(16, 'b')}))));
+    write_text(tmp / "f1" / "depth.png", png_file(8, 6, 16, 0, zlib_stored(unfiltered({std::string(16, 'a'), std::string(16, 'b')}))));
     auto src = wul3d::open_source(tmp.path().string(), {});
     wul3d::SourceItem item;
     src->read(0, item);
@@ -552,7 +552,7 @@ void write_jpeg(const fs::path& path, int w, int h, int components, const std::v
         jpeg_write_scanlines(&c, &row, 1);
     }
     jpeg_finish_compress(&c);
-    spit(path, std::string(reinterpret_cast<const char*>(buf), size));
+    write_text(path, std::string(reinterpret_cast<const char*>(buf), size));
     jpeg_destroy_compress(&c);
     std::free(buf);
 }
@@ -605,7 +605,7 @@ TEST(IoImages, DamagedJpeg_OneQuietInputErrorOrQuietPixels) {
     const std::string good = slurp(tmp / "good.jpg");
 
     // No end-of-image marker: the check before libjpeg.
-    spit(tmp / "cut.jpg", good.substr(0, good.size() / 2));
+    write_text(tmp / "cut.jpg", good.substr(0, good.size() / 2));
     expect_input_error([&] { wul3d::read_color_image((tmp / "cut.jpg").string()); },
                        {"cut.jpg", "cannot decode JPEG (truncated"});
     // A frame header of 0 x 0 pixels: libjpeg's error, on one line.
@@ -613,7 +613,7 @@ TEST(IoImages, DamagedJpeg_OneQuietInputErrorOrQuietPixels) {
     const std::size_t sof = bad.find("\xff\xc0");
     ASSERT_NE(sof, std::string::npos);
     bad.replace(sof + 5, 4, std::string(4, '\0'));
-    spit(tmp / "sof.jpg", bad);
+    write_text(tmp / "sof.jpg", bad);
     expect_input_error([&] { wul3d::read_color_image((tmp / "sof.jpg").string()); },
                        {"sof.jpg", "cannot decode JPEG ("});
     // Damaged scan data: libjpeg warns and decodes what it can, as before; quietly.
@@ -622,7 +622,7 @@ TEST(IoImages, DamagedJpeg_OneQuietInputErrorOrQuietPixels) {
     ASSERT_NE(sos, std::string::npos);
     const std::size_t mid = sos + (bad.size() - sos) / 2;
     for (std::size_t i = mid; i < mid + 40; ++i) bad[i] = static_cast<char>(0x5a);
-    spit(tmp / "scan.jpg", bad);
+    write_text(tmp / "scan.jpg", bad);
     testing::internal::CaptureStderr();
     const wul3d::ColorImage c = wul3d::read_color_image((tmp / "scan.jpg").string());
     EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
@@ -632,20 +632,20 @@ TEST(IoImages, DamagedJpeg_OneQuietInputErrorOrQuietPixels) {
 TEST(IoImages, ReaderErrors_BadJsonAndMissingKeys) {
     TempDir tmp;
     const fs::path bad = tmp / "bad.json";
-    spit(bad, "{\"fx\": 525, ");
+    write_text(bad, "{\"fx\": 525, ");
     expect_input_error([&] { wul3d::read_intrinsics_json(bad.string()); },
                        {bad.string(), "invalid JSON"});
     expect_input_error([&] { wul3d::read_calibration_json(bad.string()); },
                        {bad.string(), "invalid JSON"});
 
     const fs::path no_fx = tmp / "intrinsics.json";
-    spit(no_fx, R"({"fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480})");
+    write_text(no_fx, R"({"fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480})");
     expect_input_error([&] { wul3d::read_intrinsics_json(no_fx.string()); },
                        {no_fx.string(), "missing key 'fx'"});
-    spit(no_fx, R"({"fx": "525", "fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480})");
+    write_text(no_fx, R"({"fx": "525", "fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480})");
     expect_input_error([&] { wul3d::read_intrinsics_json(no_fx.string()); },
                        {no_fx.string(), "'fx'", "number"});
-    spit(no_fx, R"({"fx": 0, "fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480})");
+    write_text(no_fx, R"({"fx": 0, "fy": 525, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480})");
     expect_input_error([&] { wul3d::read_intrinsics_json(no_fx.string()); }, {no_fx.string(), "fx 0"});
 
     // Calibration: a missing nested key is named with its path; a non-rotation is rejected.
@@ -654,12 +654,12 @@ TEST(IoImages, ReaderErrors_BadJsonAndMissingKeys) {
     std::string text = slurp(calib);
     const std::string good = text;
     text.replace(text.find("\"translation_m\""), 15, "\"translation\"");
-    spit(calib, text);
+    write_text(calib, text);
     expect_input_error([&] { wul3d::read_calibration_json(calib.string()); },
                        {calib.string(), "missing key 'depth_to_color.translation_m'"});
     text = good;
     text.replace(text.rfind("\"fy\""), 4, "\"fz\"");  // keys are sorted: colour, then depth
-    spit(calib, text);
+    write_text(calib, text);
     expect_input_error([&] { wul3d::read_calibration_json(calib.string()); },
                        {calib.string(), "missing key 'depth.fy'"});
     wul3d::StereoCalibration skew = wul3d::kinect_v2_default_calibration();

@@ -1,12 +1,10 @@
 #pragma once
-// What the io tests share (images_test.cpp, sources_test.cpp): files read and written whole,
-// the check that a reader refuses quietly, and small images.
+// What the io tests share (images_test.cpp, sources_test.cpp): the check that a reader
+// refuses quietly, and small images.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -17,18 +15,6 @@
 namespace wul3d::test {
 
 namespace fs = std::filesystem;
-
-inline std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-inline void spit(const fs::path& p, const std::string& bytes) {
-    std::ofstream out(p, std::ios::binary | std::ios::trunc);
-    out << bytes;
-}
 
 inline bool contains(const std::string& s, const std::string& part) {
     return s.find(part) != std::string::npos;

@@ -24,7 +24,7 @@ using wul3d::test::ramp_depth;
 using wul3d::test::sample_dir;
 using wul3d::test::slurp;
 using wul3d::test::solid_color;
-using wul3d::test::spit;
+using wul3d::test::write_text;
 using wul3d::test::TempDir;
 
 TEST(OpenSource, ParseInputFormat) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -17,6 +18,7 @@
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/output.hpp"
+#include "wul3d/threads.hpp"
 #include "wul3d/visualization.hpp"
 
 namespace wul3d {
@@ -122,6 +124,31 @@ TEST(RunSequence, SameBytesAsTheCommand) {
     for (const std::string& f : files) {
         if (f == "summary.json" || f == "frames.jsonl") continue;  // timings differ
         EXPECT_EQ(slurp(dir / "lib" / f), slurp(dir / "cli" / f)) << f;
+    }
+}
+
+// The run's threads shared out (summary.json): on 8 threads 2 read, 2 write, 4 run the
+// stages; on 2 one of each. The outputs are the same bytes either way.
+TEST(RunSequence, ThreadsShared_ReadersAsManyAsWriters_SameBytes) {
+    const int saved = num_threads();
+    TempDir dir;
+    const std::pair<int, std::array<int, 3>> cases[] = {{2, {1, 1, 1}}, {8, {2, 2, 4}}};
+    for (const auto& [threads, split] : cases) {
+        set_num_threads(threads);
+        run_sequence(sample_run(dir / std::to_string(threads)));
+        const nlohmann::json summary =
+            nlohmann::json::parse(slurp(dir / std::to_string(threads) / "summary.json"));
+        EXPECT_EQ(summary["threads"], threads);
+        EXPECT_EQ(summary["threads_readers"], split[0]) << threads;
+        EXPECT_EQ(summary["threads_writers"], split[1]) << threads;
+        EXPECT_EQ(summary["threads_stages"], split[2]) << threads;
+    }
+    set_num_threads(saved);
+    const auto files = test::list_files(dir / "2");
+    ASSERT_EQ(files, test::list_files(dir / "8"));
+    for (const std::string& f : files) {
+        if (f == "summary.json" || f == "frames.jsonl") continue;  // timings differ
+        EXPECT_EQ(slurp(dir / "2" / f), slurp(dir / "8" / f)) << f;
     }
 }
 
