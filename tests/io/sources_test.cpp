@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -17,14 +16,10 @@
 namespace {
 
 namespace fs = std::filesystem;
-using wul3d::test::contains;
 using wul3d::test::expect_input_error;
-using wul3d::test::list_files;
 using wul3d::test::ramp_depth;
 using wul3d::test::sample_dir;
-using wul3d::test::slurp;
 using wul3d::test::solid_color;
-using wul3d::test::write_text;
 using wul3d::test::TempDir;
 
 TEST(OpenSource, ParseInputFormat) {
