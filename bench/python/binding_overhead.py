@@ -10,9 +10,9 @@ Every call is timed twice: `wall`, perf_counter around process() in Python, and 
 result.times["call"], steady_clock around the C++ Pipeline::process inside the binding (the
 stages, result.times["total"], plus the library's own untimed work; nothing of the binding's).
 overhead = wall - call, call by call: what Python adds to the same C++ work on the same frame
-(argument checks, the GIL hand-over, the images copied out, the instances and dicts, and the
-previous result freed, which a `r = pipeline.process(...)` loop does inside the call's
-statement). The frames are read and decoded before the timing. `reads`: the first read of
+(argument checks, the GIL hand-over, the images handed over or copied out, the instances
+and dicts, and the previous result freed, which a `r = pipeline.process(...)` loop does
+inside the call's statement). The frames are read and decoded before the timing. `reads`: the first read of
 r.instances, r.plane, r.times and r.stats after the call, timed apart: the binding makes
 those Python objects on first read, so a loop that reads them pays this too.
 

@@ -5,6 +5,7 @@
 /// the object stages: support plane -> segmentation -> objects (tracks and their weights).
 /// Holds the stages' buffers (no allocation after the first frame) and the two objects that
 /// live across frames, ClusterState and ObjectTracker, out of sight (pipeline.cpp).
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -72,6 +73,15 @@ public:
     /// Registers a raw two-camera frame first (timed as "registration").
     const FrameResult& process(const RawRgbdFrame& raw, const StereoCalibration& calib,
                                RegistrationMode mode);
+
+    /// The last result's images handed over without a copy (the Python module's results): its
+    /// labels, colours and objects are swapped with `labels`, `rgb` and `objects`, vectors of
+    /// any size and contents, which the next frame sizes and writes again, every pixel. With
+    /// decimation > 1 only, where these images are made for the caller alone (the way back
+    /// from decimation writes each pixel of each); at decimation 1 the stages' own work is in
+    /// them, nothing is swapped and this returns false. The result keeps its sizes.
+    bool swap_images(std::vector<std::uint16_t>& labels, std::vector<std::uint8_t>& rgb,
+                     std::vector<std::uint16_t>& objects);
 
     const PipelineParams& params() const;
     /// The cloud, normals and clusters the stages ran on: the decimated frame's with

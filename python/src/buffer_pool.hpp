@@ -3,8 +3,10 @@
 // is 2.1 MB (labels, objects, colours); asked of the allocator each frame, it comes back as
 // new pages that the kernel maps and zeroes on first write (about 0.5 ms a frame), and the
 // previous result's pages are unmapped when Python drops it. Here each array's memory is a
-// buffer leased from its pipeline's pool: when the last numpy array on it is freed, the
-// buffer goes back to the pool, already mapped, and the next result is copied into it.
+// vector leased from its pipeline's pool: when the last numpy array on it is freed, the
+// vector goes back to the pool, already mapped. With decimation (the default) the pipeline
+// then writes the next frame's images into such vectors and hands them over without a copy
+// (Pipeline::swap_images); at every pixel the result is copied into them.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -52,75 +54,85 @@ inline void copy_streaming(void* dst, const void* src, std::size_t bytes) {
 #endif
 }
 
-class BufferPool : public std::enable_shared_from_this<BufferPool> {
+/// Vectors of T for the results' arrays, one pool per element type and pipeline.
+template <class T>
+class VectorPool : public std::enable_shared_from_this<VectorPool<T>> {
 public:
-    /// Buffers kept for reuse: two results' images (a loop that keeps the previous result
+    /// Vectors kept for reuse: two results' images (a loop that keeps the previous result
     /// while the next is made needs one result's worth); more are freed.
-    static constexpr std::size_t kMaxFree = 6;
+    static constexpr std::size_t kMaxFree = 4;
 
-    /// A C-contiguous array of `shape` on a leased buffer, its contents not initialised. The
-    /// array owns the lease: it stays valid as long as Python holds it, after the pool too.
-    template <class T>
-    pybind11::array_t<T> array(const std::vector<pybind11::ssize_t>& shape) {
-        std::size_t n = 1;
-        for (const pybind11::ssize_t d : shape) n *= static_cast<std::size_t>(d);
-        auto lease = std::make_unique<Lease>(weak_from_this(), take(n * sizeof(T)));
-        T* data = reinterpret_cast<T*>(lease->buffer.data.get());
+    /// A vector of n elements, its contents whatever they were: a free one of that size if
+    /// there is one, else the newest free one resized, else a new one.
+    std::vector<T> take(std::size_t n) {
+        std::vector<T> v;
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            std::size_t pick = free_.size();
+            for (std::size_t i = free_.size(); i-- > 0;) {
+                if (free_[i].size() == n) {
+                    pick = i;
+                    break;
+                }
+            }
+            if (pick == free_.size() && !free_.empty()) pick = free_.size() - 1;
+            if (pick < free_.size()) {
+                v = std::move(free_[pick]);
+                free_.erase(free_.begin() + static_cast<std::ptrdiff_t>(pick));
+            }
+        }
+        v.resize(n);
+        return v;
+    }
+
+    /// A C-contiguous array of `shape` on `v` (as many elements), which it owns: given back
+    /// to the pool when Python frees the array, if the pool is still there (its pipeline
+    /// alive), else freed.
+    pybind11::array_t<T> array(std::vector<T>&& v, const std::vector<pybind11::ssize_t>& shape) {
+        auto lease = std::make_unique<Lease>(this->weak_from_this(), std::move(v));
+        T* data = lease->vector.data();
         pybind11::capsule owner(lease.get(), [](void* p) { delete static_cast<Lease*>(p); });
         lease.release();  // the capsule frees it from here on
         return pybind11::array_t<T>(shape, data, owner);
     }
 
-    /// Buffers waiting for reuse (tests: results dropped give their memory back).
+    /// A vector back for reuse.
+    void give_back(std::vector<T>&& v) {
+        std::vector<T> dropped;  // the oldest, freed after the lock is released
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (free_.size() >= kMaxFree) {
+            dropped = std::move(free_.front());
+            free_.erase(free_.begin());
+        }
+        free_.push_back(std::move(v));
+    }
+
+    /// Vectors waiting for reuse (tests: results dropped give their memory back).
     std::size_t free_buffers() {
         const std::lock_guard<std::mutex> lock(mutex_);
         return free_.size();
     }
 
 private:
-    struct Buffer {
-        std::unique_ptr<std::byte[]> data;
-        std::size_t bytes = 0;
-    };
-
-    /// One array's buffer; given back to the pool when the array is freed, if the pool is
-    /// still there (its pipeline alive), else freed.
     struct Lease {
-        Lease(std::weak_ptr<BufferPool> p, Buffer b) : pool(std::move(p)), buffer(std::move(b)) {}
+        Lease(std::weak_ptr<VectorPool> p, std::vector<T>&& v) : pool(std::move(p)), vector(std::move(v)) {}
         ~Lease() {
-            if (const std::shared_ptr<BufferPool> p = pool.lock()) p->give_back(std::move(buffer));
+            if (const std::shared_ptr<VectorPool> p = pool.lock()) p->give_back(std::move(vector));
         }
         Lease(const Lease&) = delete;
         Lease& operator=(const Lease&) = delete;
-        std::weak_ptr<BufferPool> pool;
-        Buffer buffer;
+        std::weak_ptr<VectorPool> pool;
+        std::vector<T> vector;
     };
 
-    Buffer take(std::size_t bytes) {
-        {
-            const std::lock_guard<std::mutex> lock(mutex_);
-            for (std::size_t i = free_.size(); i-- > 0;) {
-                if (free_[i].bytes != bytes) continue;
-                Buffer b = std::move(free_[i]);
-                free_.erase(free_.begin() + static_cast<std::ptrdiff_t>(i));
-                return b;
-            }
-        }
-        return Buffer{std::unique_ptr<std::byte[]>(new std::byte[bytes == 0 ? 1 : bytes]), bytes};
-    }
-
-    void give_back(Buffer b) {
-        Buffer dropped;  // the oldest, freed after the lock is released
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (free_.size() >= kMaxFree) {
-            dropped = std::move(free_.front());
-            free_.erase(free_.begin());
-        }
-        free_.push_back(std::move(b));
-    }
-
     std::mutex mutex_;
-    std::vector<Buffer> free_;
+    std::vector<std::vector<T>> free_;
+};
+
+/// A pipeline's pools: 16-bit labels (labels, objects) and 8-bit colours.
+struct ResultPools {
+    std::shared_ptr<VectorPool<std::uint16_t>> labels = std::make_shared<VectorPool<std::uint16_t>>();
+    std::shared_ptr<VectorPool<std::uint8_t>> rgb = std::make_shared<VectorPool<std::uint8_t>>();
 };
 
 }  // namespace wul3d::python

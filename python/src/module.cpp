@@ -49,7 +49,7 @@ py::array_t<float> floats(const std::array<float, N>& a) {
     return out;
 }
 
-/// Everything process() returns; owns copies of the frame's images (None for an image
+/// Everything process() returns; owns the frame's images (None for an image
 /// that process(outputs=...) left out). The instances, plane, times and stats are kept as
 /// the library's values and made Python objects on first read (then the same object on each
 /// read): a loop that reads none of them does not pay for some sixty objects a frame.
@@ -68,7 +68,7 @@ struct Result {
     py::object instances_py, plane_py, times_py, stats_py;  ///< made on first read
 };
 
-/// The images process() copies out: all by default, or those named by `outputs`.
+/// The images process() gives: all by default, or those named by `outputs`.
 struct ImageSelection {
     bool labels = true, objects = true, colors = true;
 };
@@ -92,39 +92,56 @@ ImageSelection to_selection(const py::object& outputs) {
     return s;
 }
 
-/// The result's images copied into buffers of the pipeline's pool (buffer_pool.hpp).
-py::array_t<std::uint16_t> copy_out(BufferPool& pool, const LabelImage& image) {
-    auto out = pool.array<std::uint16_t>({image.height, image.width});
-    copy_streaming(out.mutable_data(), image.labels.data(), image.labels.size() * sizeof(std::uint16_t));
-    return out;
+/// An image of the result, copied into a vector of the pipeline's pool (buffer_pool.hpp).
+template <class T>
+py::array_t<T> copy_out(VectorPool<T>& pool, const std::vector<T>& image, const std::vector<py::ssize_t>& shape) {
+    std::vector<T> v = pool.take(image.size());
+    copy_streaming(v.data(), image.data(), image.size() * sizeof(T));
+    return pool.array(std::move(v), shape);
 }
 
-py::array_t<std::uint8_t> copy_out(BufferPool& pool, const ColorImage& image) {
-    auto out = pool.array<std::uint8_t>({image.height, image.width, 3});
-    copy_streaming(out.mutable_data(), image.rgb.data(), image.rgb.size());
-    return out;
-}
-
-/// The images asked for, copied out of the pipeline (whose buffers the next frame reuses).
-void copy_images(const FrameResult& r, const ImageSelection& selection, BufferPool& pool, Result& out) {
+/// The images asked for: handed over by the pipeline without a copy where it can
+/// (Pipeline::swap_images, with decimation), the pool's vectors taking their place, else
+/// copied out (the pipeline's buffers are reused by the next frame).
+void take_images(Pipeline& pipeline, const FrameResult& r, const ImageSelection& selection, ResultPools& pools,
+                 Result& out) {
     out.width = r.labels.width;
     out.height = r.labels.height;
-    out.labels = selection.labels ? py::object(copy_out(pool, r.labels)) : py::none();
-    out.colors = selection.colors ? py::object(copy_out(pool, r.colors)) : py::none();
-    if (!selection.objects) {
-        out.objects = py::none();
-    } else if (r.objects.labels.empty()) {  // objects not detected: all background
-        auto zeros = pool.array<std::uint16_t>({r.labels.height, r.labels.width});
-        std::fill_n(zeros.mutable_data(), zeros.size(), 0);
-        out.objects = zeros;
+    const std::vector<py::ssize_t> grey{r.labels.height, r.labels.width}, rgb{r.labels.height, r.labels.width, 3};
+    if (!selection.labels && !selection.objects && !selection.colors) {
+        out.labels = out.colors = out.objects = py::none();
+        return;
+    }
+    const std::size_t pixels = r.labels.labels.size();  // r's vectors are the pool's after a swap
+    std::vector<std::uint16_t> labels = pools.labels->take(pixels);
+    std::vector<std::uint8_t> colours = pools.rgb->take(r.colors.rgb.size());
+    std::vector<std::uint16_t> objects = pools.labels->take(r.objects.labels.size());
+    const bool swapped = pipeline.swap_images(labels, colours, objects);
+    auto image = [&](bool wanted, auto& pool, auto& taken, const auto& own, const std::vector<py::ssize_t>& shape) {
+        if (!wanted) {
+            pool.give_back(std::move(taken));
+            return py::object(py::none());
+        }
+        if (swapped) return py::object(pool.array(std::move(taken), shape));
+        pool.give_back(std::move(taken));
+        return py::object(copy_out(pool, own, shape));
+    };
+    out.labels = image(selection.labels, *pools.labels, labels, r.labels.labels, grey);
+    out.colors = image(selection.colors, *pools.rgb, colours, r.colors.rgb, rgb);
+    if (selection.objects && (swapped ? objects.empty() : r.objects.labels.empty())) {
+        // Objects not detected: all background.
+        pools.labels->give_back(std::move(objects));
+        std::vector<std::uint16_t> zeros = pools.labels->take(pixels);
+        std::fill(zeros.begin(), zeros.end(), std::uint16_t{0});
+        out.objects = pools.labels->array(std::move(zeros), grey);
     } else {
-        out.objects = copy_out(pool, r.objects);
+        out.objects = image(selection.objects, *pools.labels, objects, r.objects.labels, grey);
     }
 }
 
-Result make_result(const FrameResult& r, const ImageSelection& selection, BufferPool& pool) {
+Result make_result(Pipeline& pipeline, const FrameResult& r, const ImageSelection& selection, ResultPools& pools) {
     Result out;
-    copy_images(r, selection, pool, out);
+    take_images(pipeline, r, selection, pools, out);
     out.object_list = r.object_list;
     out.plane.found = r.plane.found;
     out.plane.support = r.plane.support;
@@ -249,7 +266,7 @@ public:
         const ImageSelection selection = to_selection(outputs);
         const FrameResult* r = nullptr;
         double call_ms = 0;
-        // Held until the result is copied: it is valid until the next process(). A thread
+        // Held until the result is taken: it is valid until the next process(). A thread
         // waiting for the lock waits without the GIL, so this thread can take it back.
         std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
         {
@@ -274,7 +291,7 @@ public:
             }
             call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         }
-        Result out = make_result(*r, selection, *pool_);
+        Result out = make_result(pipeline_, *r, selection, pools_);
         out.call_ms = call_ms;
         return out;
     }
@@ -286,7 +303,7 @@ private:
     RgbdFrame frame_;
     std::mutex mutex_;
     /// The results' memory; shared with their arrays' leases, which may outlive the pipeline.
-    std::shared_ptr<BufferPool> pool_ = std::make_shared<BufferPool>();
+    ResultPools pools_;
 };
 
 /// One frame read from disk (wul3d.read), registered when the input is unregistered.
@@ -610,10 +627,11 @@ Args:
         (NaN, inf and <= 0 = no depth).
     intrinsics: wul3d.Intrinsics, or a dict with fx, fy, cx, cy (as intrinsics.json).
     depth_scale (float): metres per unit of a uint16 depth (default 0.001, millimetres).
-    outputs (keyword only): the images to copy into the Result, a tuple of names from
-        'labels', 'objects', 'colors'; None (default) copies all three. The others are None
-        in the Result; the stages, instances, plane, times and stats are the same. Each image
-        left out saves its copy (a 640x480 frame's three images are 2.1 MB).
+    outputs (keyword only): the images given in the Result, a tuple of names from
+        'labels', 'objects', 'colors'; None (default) gives all three. The others are None
+        in the Result; the stages, instances, plane, times and stats are the same. With
+        decimation (the default) the images are handed over without a copy; with
+        decimate=1 each image left out saves its copy (a 640x480 frame's three are 2.1 MB).
 
 C-contiguous arrays are required (TypeError for a wrong dtype, ValueError for a wrong shape
 or order). uint16 depth and RGB colour are read in place, not copied; float32 depth is

@@ -119,6 +119,16 @@ Pipeline::~Pipeline() = default;
 Pipeline::Pipeline(Pipeline&&) noexcept = default;
 Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
 
+bool Pipeline::swap_images(std::vector<std::uint16_t>& labels, std::vector<std::uint8_t>& rgb,
+                           std::vector<std::uint16_t>& objects) {
+    if (impl_->params_.decimation <= 1) return false;
+    FrameResult& r = impl_->result_;
+    r.labels.labels.swap(labels);
+    r.colors.rgb.swap(rgb);
+    r.objects.labels.swap(objects);
+    return true;
+}
+
 const PipelineParams& Pipeline::params() const { return impl_->params_; }
 const OrganizedCloud& Pipeline::cloud() const { return impl_->cloud_; }
 const NormalMap& Pipeline::normals() const { return impl_->normals_; }

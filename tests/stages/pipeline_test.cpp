@@ -224,6 +224,42 @@ TEST(Pipeline, ClusteringBesideTheObjectStages_SameResultsAsOneAfterTheOther) {
     EXPECT_GT(overlap, 0.0) << "the stages did not run side by side (test premise)";
 }
 
+// swap_images hands the images over and takes any vectors in their place (scribbled over, of
+// other sizes): the next frames' images are those of a pipeline that never swapped, every
+// pixel written again. At decimation 1 nothing is swapped.
+TEST(Pipeline, SwapImages_TheNextFrameWritesEveryPixelOfWhatItGets) {
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    PipelineParams params;
+    params.decimation = 2;
+    Pipeline plain(params), swapping(params);
+    SourceItem item;
+    for (std::size_t pass = 0; pass < 2; ++pass) {
+        for (std::size_t i = 0; i < source->size(); ++i) {
+            source->read(i, item);
+            SCOPED_TRACE(item.frame.name);
+            const FrameResult& a = plain.process(item.frame);
+            swapping.process(item.frame);
+            // Scribbled vectors: the same size, a smaller and a larger one in turn.
+            const std::size_t n = a.labels.labels.size(), sizes[] = {n, n / 3, 2 * n};
+            std::vector<std::uint16_t> labels(sizes[i % 3], 0x4d4d), objects(sizes[(i + 1) % 3], 0x4d4d);
+            std::vector<std::uint8_t> rgb(3 * sizes[(i + 2) % 3], 0x4d);
+            ASSERT_TRUE(swapping.swap_images(labels, rgb, objects));
+            EXPECT_EQ(labels, a.labels.labels);
+            EXPECT_EQ(rgb, a.colors.rgb);
+            EXPECT_EQ(objects, a.objects.labels);
+        }
+    }
+    params.decimation = 1;
+    Pipeline every_pixel(params);
+    source->read(0, item);
+    const FrameResult& r = every_pixel.process(item.frame);
+    std::vector<std::uint16_t> labels(3, 7), objects;
+    std::vector<std::uint8_t> rgb;
+    EXPECT_FALSE(every_pixel.swap_images(labels, rgb, objects));
+    EXPECT_EQ(labels, std::vector<std::uint16_t>(3, 7));
+    EXPECT_EQ(r.labels.labels.size(), static_cast<std::size_t>(r.labels.width) * r.labels.height);
+}
+
 // An error inside the stages that run side by side reaches the caller as itself (an exception
 // may not leave an OpenMP section): a first frame with fewer points in range than k.
 TEST(Pipeline, ErrorBesideTheObjectStagesReachesTheCaller) {
