@@ -39,6 +39,10 @@ import threading
 import time
 import uuid
 
+import wul3d
+
+from . import _wul3d
+
 # discover, output_dir, foreign_entry and the names of what the batch writes are wul3d.batch's
 # API too (docs/SCALE.md), defined in discovery.py and staging.py.
 from .discovery import MAX_DEPTH, discover, discover_all, text  # noqa: F401
@@ -57,7 +61,6 @@ def run_options():
     """The options of `wul3d run` that pass through, keyword -> (type, help): the pipeline's
     parameters from the library's table (wul3d.parameters(); its switch, remove_plane, is the
     command's --no-plane flag, in RUN_FLAGS), then the run's own options."""
-    from . import _wul3d
     types = {"int": int, "float": float, "str": str}
     options = {"preset": (str, 'as `wul3d run --preset`: "default" or "paper"')}
     for p in _wul3d.parameters():
@@ -93,8 +96,6 @@ def _one_line(e: BaseException) -> str:
 
 def _frame_scores(input_dir: pathlib.Path, out_dir: pathlib.Path, names):
     """Per frame with INPUT/<frame>/label.png: the UOIS scores of objects.png against it."""
-    import wul3d
-
     scores = []
     for name in names:
         gt_path = input_dir / name / "label.png"
@@ -111,9 +112,6 @@ def _frame_scores(input_dir: pathlib.Path, out_dir: pathlib.Path, names):
 def _run(input_dir: str, out: str, options: dict) -> dict:
     """wul3d.run; with the paths as bytes where they are not UTF-8 (the binding takes bytes,
     and wul3d.run would make "b'...'" of them)."""
-    import wul3d
-    from . import _wul3d
-
     if text(input_dir) == input_dir and text(out) == out:
         return wul3d.run(input_dir, out, **options)
     return _wul3d._run(os.fsencode(input_dir), os.fsencode(out), dict(options))
@@ -287,8 +285,6 @@ class _Progress:
 
 def _uois_table(records):
     """The UOIS summary over all scored frames and per sequence (wul3d eval's figures)."""
-    from . import _wul3d
-
     scored = [r for r in records if r.get("scores")]
     if not scored:
         return None
@@ -398,8 +394,6 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
     from distributed import Client, LocalCluster, wait
     from distributed.utils import TimeoutError as DaskTimeoutError
 
-    from . import _wul3d
-
     options = dict(options or {})
     _wul3d._check_run_options(options)  # a bad option fails once, here, not in every task
     out_given = os.fspath(out)
@@ -434,8 +428,6 @@ def run_batch(root, out, scheduler=None, workers=None, threads_per_worker=None, 
 def _run_locked(root, out, found, inputs, signals, scheduler, workers, threads_per_worker,
                 options, retries, progress, client, timeout_s, score, overwrite, Client,
                 LocalCluster, wait, DaskTimeoutError):
-    from . import _wul3d
-
     _wul3d._remove_stale_temporaries(os.fsencode(out))  # of a run killed mid-write
     for e in sorted(os.scandir(out), key=lambda e: e.name):  # of a batch killed mid-way
         if e.name.startswith(STAGING_PREFIX) and e.is_dir(follow_symlinks=False):
