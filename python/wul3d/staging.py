@@ -35,6 +35,7 @@ def is_finished(out_dir: pathlib.Path) -> bool:
 
 
 def lstat_or_none(path):
+    """os.lstat (links not followed), or None where it fails."""
     try:
         return os.lstat(path)
     except OSError:
