@@ -60,6 +60,11 @@ RgbdFrame render_scene(const Scene& scene, std::vector<int>* truth = nullptr);
 /// down 0.5 rad over a table 0.6 m below it, from 0.4 to 1.6 m away; no boxes yet.
 Scene pitched_tabletop_scene();
 
+/// pitched_tabletop_scene() with two boxes of one colour: a small one (12 x 10 x 10 cm,
+/// truth kTruthBox0 + 1) standing in front of a tall one (20 x 25 x 10 cm, kTruthBox0),
+/// its back face against the tall one's front face: a concave junction.
+Scene small_box_before_tall_box();
+
 /// A w x h label image, all 0.
 LabelImage blank_labels(int w, int h);
 /// Sets the pixels u0 <= u <= u1, v0 <= v <= v1 (inclusive) to `id`.

@@ -92,17 +92,10 @@ ImageSelection to_selection(const py::object& outputs) {
     return s;
 }
 
-/// An image of the result, copied into a vector of the pipeline's pool (buffer_pool.hpp).
-template <class T>
-py::array_t<T> copy_out(VectorPool<T>& pool, const std::vector<T>& image, const std::vector<py::ssize_t>& shape) {
-    std::vector<T> v = pool.take(image.size());
-    copy_streaming(v.data(), image.data(), image.size() * sizeof(T));
-    return pool.array(std::move(v), shape);
-}
-
-/// The images asked for: handed over by the pipeline without a copy where it can
-/// (Pipeline::swap_images, with decimation), the pool's vectors taking their place, else
-/// copied out (the pipeline's buffers are reused by the next frame).
+/// The images asked for, in vectors of the pipeline's pools (buffer_pool.hpp): handed over
+/// by the pipeline without a copy where it can (Pipeline::swap_images, with decimation), the
+/// pool's vectors taking their place, else copied into them (the pipeline's buffers are
+/// reused by the next frame).
 void take_images(Pipeline& pipeline, const FrameResult& r, const ImageSelection& selection, ResultPools& pools,
                  Result& out) {
     out.width = r.labels.width;
@@ -117,23 +110,20 @@ void take_images(Pipeline& pipeline, const FrameResult& r, const ImageSelection&
     std::vector<std::uint8_t> colours = pools.rgb->take(r.colors.rgb.size());
     std::vector<std::uint16_t> objects = pools.labels->take(r.objects.labels.size());
     const bool swapped = pipeline.swap_images(labels, colours, objects);
+    // `taken` holds the image when swapped; else it has the image's size and gets a copy.
     auto image = [&](bool wanted, auto& pool, auto& taken, const auto& own, const std::vector<py::ssize_t>& shape) {
         if (!wanted) {
             pool.give_back(std::move(taken));
             return py::object(py::none());
         }
-        if (swapped) return py::object(pool.array(std::move(taken), shape));
-        pool.give_back(std::move(taken));
-        return py::object(copy_out(pool, own, shape));
+        if (!swapped) copy_streaming(taken.data(), own.data(), own.size() * sizeof(own[0]));
+        return py::object(pool.array(std::move(taken), shape));
     };
     out.labels = image(selection.labels, *pools.labels, labels, r.labels.labels, grey);
     out.colors = image(selection.colors, *pools.rgb, colours, r.colors.rgb, rgb);
-    if (selection.objects && (swapped ? objects.empty() : r.objects.labels.empty())) {
-        // Objects not detected: all background.
-        pools.labels->give_back(std::move(objects));
-        std::vector<std::uint16_t> zeros = pools.labels->take(pixels);
-        std::fill(zeros.begin(), zeros.end(), std::uint16_t{0});
-        out.objects = pools.labels->array(std::move(zeros), grey);
+    if (selection.objects && objects.empty()) {  // objects not detected: all background
+        objects.assign(pixels, 0);
+        out.objects = pools.labels->array(std::move(objects), grey);
     } else {
         out.objects = image(selection.objects, *pools.labels, objects, r.objects.labels, grey);
     }

@@ -9,20 +9,7 @@ using namespace wul3d::test;
 // Two boxes of one colour, the small one standing in front of the tall one and touching
 // it: their surfaces meet at a concave junction, which is cut.
 TEST(SegmentObjects, TouchingSameColourBoxes_SeparatedAtTheConcaveJunction) {
-    Scene s = pitched_tabletop_scene();
-    SceneBox tall;
-    tall.x = 0.05f;
-    tall.z = 1.0f;
-    tall.w = 0.2f;
-    tall.h = 0.25f;
-    tall.d = 0.1f;
-    SceneBox small = tall;  // same colour
-    small.x = 0.0f;
-    small.z = 0.9f;  // its back face touches the tall box's front face (z = 0.95)
-    small.w = 0.12f;
-    small.h = 0.1f;
-    small.d = 0.1f;
-    s.boxes = {tall, small};
+    const Scene s = small_box_before_tall_box();
     std::vector<int> truth;
     const LabelImage out = segment(s, Segmenter::Geometric, truth);
     int a = 0, b = 0;

@@ -77,18 +77,7 @@ TEST(Merge, BoxTopAndFrontFace_Joined) {
 // A small box standing against a tall one of the same colour: their faces meet at a concave
 // fold, which the merge does not cross.
 TEST(Merge, BoxesAtAConcaveFold_StayApart) {
-    Scene s = pitched_tabletop_scene();
-    SceneBox tall = front_box();
-    tall.x = 0.05f;
-    tall.z = 1.0f;
-    tall.h = 0.25f;
-    tall.d = 0.1f;
-    SceneBox small = tall;
-    small.x = 0.0f;
-    small.z = 0.9f;  // its back face touches the tall box's front face (z = 0.95)
-    small.w = 0.12f;
-    small.h = 0.1f;
-    s.boxes = {tall, small};
+    const Scene s = small_box_before_tall_box();
     const PlaneStage st = up_to_the_plane(s);
     std::vector<int> labels(st.truth.size(), 0);
     for (std::size_t p = 0; p < labels.size(); ++p) {

@@ -143,21 +143,8 @@ TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
 // one): it rests on a segment the support holds, as a box on a box or an object whose foot
 // another hides, and stays.
 TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
-    Scene s = pitched_tabletop_scene();
-    SceneBox tall;
-    tall.x = 0.05f;
-    tall.z = 1.0f;
-    tall.w = 0.2f;
-    tall.h = 0.25f;
-    tall.d = 0.1f;
-    SceneBox small = tall;
-    small.x = 0.0f;
-    small.z = 0.9f;
-    small.w = 0.12f;
-    small.h = 0.1f;
-    small.d = 0.1f;
-    small.g = 200;
-    s.boxes = {tall, small};
+    Scene s = small_box_before_tall_box();
+    s.boxes[1].g = 200;
     PlaneStage st = up_to_the_plane(s);
     lift(st, kTruthBox0, 0.1f);
     SegmentStats stats;
