@@ -9,13 +9,14 @@ namespace wul3d::bench {
 
 namespace {
 RgbdFrame load_frame(const std::string& name) {
-    auto source = open_source(std::string(WUL3D_SAMPLE_DIR) + "/uois_tabletop/" + name,
-                              SourceOptions{});
+    auto source = open_source(sample_path("uois_tabletop/" + name), SourceOptions{});
     SourceItem item;
     source->read(0, item);
     return item.frame;
 }
 }  // namespace
+
+std::string sample_path(const std::string& relative) { return std::string(WUL3D_SAMPLE_DIR) + "/" + relative; }
 
 const std::vector<RgbdFrame>& tabletop_frames() {
     static const std::vector<RgbdFrame> frames = [] {

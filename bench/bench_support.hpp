@@ -2,6 +2,7 @@
 // Real frames and stage inputs for the benchmarks, loaded once, and the counters of the peer
 // comparisons. Every stage benchmark copies its inputs from here outside the timed loop.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -9,6 +10,9 @@
 #include "wul3d/pipeline.hpp"
 
 namespace wul3d::bench {
+
+/// data/samples/<relative>: the shipped sample data.
+std::string sample_path(const std::string& relative);
 
 /// data/samples/uois_tabletop/image_0000: a real 640x480 tabletop frame (MIT licence).
 const RgbdFrame& tabletop_frame();

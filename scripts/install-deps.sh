@@ -9,6 +9,8 @@
 #                                                  imgproc); the only package with OpenCVConfig.cmake
 #   libpng-dev libjpeg-dev                         PNG reading and writing, JPEG reading (libpng,
 #                                                  libjpeg-turbo; not OpenCV's imgcodecs)
+#   libdeflate-dev                                 the PNG reader's inflate of the common kinds and
+#                                                  its CRC-32 check (src/io/png_rows.cpp): faster than zlib
 #   libeigen3-dev libtbb-dev                       linear algebra; parallel loops (STYLE.md: TBB or OpenMP)
 #   libcli11-dev nlohmann-json3-dev                command line, JSON (header-only)
 #   libgtest-dev libgmock-dev                      the test suite (tests/)
@@ -54,6 +56,7 @@ packages=(
   git
   libopencv-dev
   libpng-dev
+  libdeflate-dev
   libjpeg-dev
   libeigen3-dev
   libcli11-dev

@@ -12,6 +12,8 @@
 #include "wul3d/clustering.hpp"
 #include "wul3d/frame.hpp"
 
+struct libdeflate_decompressor;
+
 namespace wul3d {
 class FrameSource;
 struct SourceOptions;
@@ -26,6 +28,20 @@ struct ImageScratch {
     std::vector<unsigned char> cleaned;  ///< PNG without ancillary chunks, when it had any
     std::vector<unsigned char*> rows;    ///< where each image row goes, for libpng / libjpeg
     std::vector<unsigned char> pixels;   ///< 8-bit labels before widening; a CMYK JPEG row
+    /// decode_png_rows' (png_rows.hpp): the IDAT chunks joined (a file of several), the
+    /// inflated rows with their filter bytes, and libdeflate's decompressor, made on first
+    /// use. A copy of the scratch makes its own.
+    std::vector<unsigned char> idat, inflated;
+    struct Inflater {
+        Inflater() = default;
+        Inflater(const Inflater&) {}
+        Inflater& operator=(const Inflater&) { return *this; }
+        ~Inflater();
+        libdeflate_decompressor* get();  ///< nullptr when out of memory
+
+    private:
+        libdeflate_decompressor* d_ = nullptr;
+    } inflater;
 };
 
 /// The whole of the regular file `path` into `bytes` (capacity reused). InputError naming the

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "io_expect.hpp"
+#include "png_bytes.hpp"
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
@@ -36,6 +37,7 @@ using wul3d::test::sample_dir;
 using wul3d::test::slurp;
 using wul3d::test::solid_color;
 using wul3d::test::write_text;
+using namespace wul3d::test::png_bytes;
 using wul3d::test::TempDir;
 
 // ---- single files -------------------------------------------------------------------
@@ -233,21 +235,6 @@ TEST(IoImages, ReaderErrors_TruncatedAndCorruptPng) {
                        {empty.string(), "cannot decode"});
 }
 
-/// CRC-32 of the PNG specification, to build chunks by hand.
-std::uint32_t crc32(const std::string& bytes) {
-    std::uint32_t c = 0xffffffffu;
-    for (unsigned char b : bytes) {
-        c ^= b;
-        for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xedb88320u ^ (c >> 1) : c >> 1;
-    }
-    return c ^ 0xffffffffu;
-}
-
-std::string be32(std::uint32_t v) {
-    return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
-            static_cast<char>(v)};
-}
-
 TEST(IoImages, PngWithAncillaryChunksReadsQuietly) {
     TempDir tmp;
     const fs::path path = tmp / "depth.png";
@@ -286,57 +273,6 @@ TEST(IoImages, ReaderErrors_WrongBitDepth) {
 }
 
 // ---- PNG and JPEG made here, byte by byte or with libjpeg ---------------------------------
-
-/// Adler-32, the checksum that ends a zlib stream.
-std::uint32_t adler32(const std::string& bytes) {
-    std::uint32_t a = 1, b = 0;
-    for (unsigned char c : bytes) {
-        a = (a + c) % 65521u;
-        b = (b + a) % 65521u;
-    }
-    return (b << 16) | a;
-}
-
-/// A zlib stream holding `raw` uncompressed (stored deflate blocks), as a PNG's IDAT data.
-std::string zlib_stored(const std::string& raw) {
-    std::string z = "\x78\x01";
-    std::size_t pos = 0;
-    do {
-        const std::size_t n = std::min<std::size_t>(65535, raw.size() - pos);
-        const bool last = pos + n == raw.size();
-        const auto len = static_cast<std::uint16_t>(n), nlen = static_cast<std::uint16_t>(~n);
-        z += static_cast<char>(last ? 1 : 0);
-        z += {static_cast<char>(len & 0xff), static_cast<char>(len >> 8),
-              static_cast<char>(nlen & 0xff), static_cast<char>(nlen >> 8)};
-        z += raw.substr(pos, n);
-        pos += n;
-    } while (pos < raw.size());
-    return z + be32(adler32(raw));
-}
-
-std::string png_chunk(const std::string& type, const std::string& data) {
-    return be32(static_cast<std::uint32_t>(data.size())) + type + data + be32(crc32(type + data));
-}
-
-/// A PNG file: the IHDR of the arguments, `chunks` (PLTE, tRNS), and an IDAT holding the
-/// zlib stream `idat`.
-std::string png_file(std::uint32_t w, std::uint32_t h, int bit_depth, int color_type,
-                     const std::string& idat, const std::string& chunks = "", bool interlaced = false) {
-    const std::string ihdr = be32(w) + be32(h) +
-                             std::string{static_cast<char>(bit_depth), static_cast<char>(color_type),
-                                         0, 0, static_cast<char>(interlaced ? 1 : 0)};
-    return std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + chunks +
-           png_chunk("IDAT", idat) + png_chunk("IEND", "");
-}
-
-/// Scanlines with filter type 0 (None): each of `rows` prefixed by a zero byte.
-std::string unfiltered(const std::vector<std::string>& rows) {
-    std::string raw;
-    for (const auto& r : rows) raw += '\0' + r;
-    return raw;
-}
-
-std::string be16(std::uint16_t v) { return {static_cast<char>(v >> 8), static_cast<char>(v & 0xff)}; }
 
 TEST(IoImages, Png16BitSamplesAreBigEndianInTheFile) {
     TempDir tmp;
