@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Compares what two wul3d binaries write with `wul3d run` on the same inputs: every output
-# file byte for byte (cmp), summary.json on every key but the timings. Used to show that a
+# file byte for byte (a PNG whose bytes differ, by its decoded pixels), summary.json on every
+# key but the timings (the PNGs through Debian's python3-pil). Used to show that a
 # restructuring changed no output.
 #   scripts/compare-run-outputs.sh OLD_WUL3D NEW_WUL3D [WORKDIR]
 # Inputs: the shipped samples (with --select and --ply once), and ../shared/data's osd_mosd
@@ -27,7 +28,32 @@ for c in "${cases[@]}"; do
   # shellcheck disable=SC2086
   "$new" run "$input" -o "$work/$name/new" -q $args >/dev/null
   ok=1
-  diff -r -q -x summary.json -x frames.jsonl "$work/$name/old" "$work/$name/new" || ok=0
+  # Every file byte for byte; a PNG whose bytes differ compares by its pixels (an encoder
+  # change writes other bytes for the same image), and is counted apart.
+  pngs=$(/usr/bin/python3 - "$work/$name/old" "$work/$name/new" <<'PY'
+import pathlib, sys
+from PIL import Image
+old, new = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+skip = {"summary.json", "frames.jsonl"}
+def files(root):
+    return sorted(str(p.relative_to(root)) for p in root.rglob("*") if p.is_file() and p.name not in skip)
+a, b = files(old), files(new)
+if a != b:
+    sys.exit(f"different files: {sorted(set(a) ^ set(b))}")
+by_pixels = 0
+for f in a:
+    x, y = (old / f).read_bytes(), (new / f).read_bytes()
+    if x == y:
+        continue
+    if f.endswith(".png"):
+        ix, iy = Image.open(old / f), Image.open(new / f)
+        if ix.mode == iy.mode and ix.size == iy.size and ix.tobytes() == iy.tobytes():
+            by_pixels += 1
+            continue
+    sys.exit(f"{f} differs")
+print(by_pixels)
+PY
+) || ok=0
   python3 - "$work/$name/old" "$work/$name/new" <<'PY' || ok=0
 import json, pathlib, sys
 # Per-frame statistics: summary.json's "per_frame" before issue 24, OUT/frames.jsonl since.
@@ -60,7 +86,9 @@ if added:
 sys.exit(0 if a == b else f"summary.json / frames.jsonl differ beyond timings: {sys.argv[1]}")
 PY
   if [[ $ok == 0 ]]; then status=1; echo "$name: DIFFERS"; continue; fi
-  echo "$name: $(find "$work/$name/new" -type f | wc -l) files identical (summary.json: but timings)"
+  by_pixels=""
+  [[ ${pngs:-0} != 0 ]] && by_pixels=" (of them $pngs PNGs by their pixels)"
+  echo "$name: $(find "$work/$name/new" -type f | wc -l) files identical$by_pixels (summary.json: but timings)"
 done
 [[ -z ${3:-} ]] && rm -rf "$work"
 exit $status

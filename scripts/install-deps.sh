@@ -9,8 +9,8 @@
 #                                                  imgproc); the only package with OpenCVConfig.cmake
 #   libpng-dev libjpeg-dev                         PNG reading and writing, JPEG reading (libpng,
 #                                                  libjpeg-turbo; not OpenCV's imgcodecs)
-#   libdeflate-dev                                 the PNG reader's inflate of the common kinds and
-#                                                  its CRC-32 check (src/io/png_rows.cpp): faster than zlib
+#   libdeflate-dev                                 the PNG reader's inflate of the common kinds, the
+#                                                  checksums of reading and writing (src/io/png_*.cpp)
 #   libeigen3-dev libtbb-dev                       linear algebra; parallel loops (STYLE.md: TBB or OpenMP)
 #   libcli11-dev nlohmann-json3-dev                command line, JSON (header-only)
 #   libgtest-dev libgmock-dev                      the test suite (tests/)
@@ -33,7 +33,8 @@
 #                                                  docs/SCALE.md)
 #   clang libclang-rt-14-dev libomp-14-dev         the fuzzers (fuzz/, .ci/run): clang 14's libFuzzer
 #                                                  (-fsanitize=fuzzer), its sanitizer runtimes, OpenMP
-#   zlib1g-dev                                     tests/robust_cli_test.cpp writes PNG chunks (crc32)
+#   zlib1g-dev                                     the PNG writer's deflate (src/io/png_encode.cpp); the
+#                                                  tests write PNG chunks
 #   librosbag-dev                                  ROS 1 bags as input (src/bag/, docs/INPUTS.md); built
 #                                                  only when found
 #   libclass-loader-dev librcpputils-dev           headers that Debian's rosbag/bag.h includes (through

@@ -5,7 +5,6 @@
 #include <png.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <cstdio>  // before jpeglib.h, which needs FILE and size_t
 #include <jpeglib.h>
@@ -25,6 +24,7 @@
 #include <stdexcept>
 
 #include "io_detail.hpp"
+#include "png_encode.hpp"
 #include "png_rows.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
@@ -537,68 +537,17 @@ void decode_or_clear(Image& image, Data& data, Decode&& decode) {
 
 // ---- writing ------------------------------------------------------------------------
 
-/// libpng's output: a growing buffer, and whether growing it failed.
-struct PngOutput {
-    std::vector<unsigned char>* bytes = nullptr;
-    bool failed = false;
-};
-
-void png_write_memory(png_structp png, png_bytep data, std::size_t n) {
-    auto* out = static_cast<PngOutput*>(png_get_io_ptr(png));
-    try {
-        out->bytes->insert(out->bytes->end(), data, data + n);
-    } catch (const std::exception&) {
-        out->failed = true;  // no exception through libpng's frames: png_error below
-    }
-    if (out->failed) png_error(png, "out of memory");
-}
-
-void png_flush_none(png_structp) {}
-
 /// Encodes `height` rows of `width` pixels at `pixels`, each 8-bit grey, 8-bit RGB
-/// (channels 3) or 16-bit grey in the host's byte order (bits 16), to PNG, and writes `path`
-/// atomically. IoError names the path.
+/// (channels 3) or 16-bit grey in the host's byte order (bits 16), to PNG (encode_png), and
+/// writes `path` atomically. IoError names the path.
 void write_png(const std::string& path, int width, int height, int bits, int channels,
                const void* pixels) {
-    const std::size_t stride = static_cast<std::size_t>(width) * channels * (bits / 8);
-    std::vector<unsigned char*> rows(static_cast<std::size_t>(height));
-    // libpng copies each row before it converts it: the pixels are not written to.
-    auto* first = static_cast<unsigned char*>(const_cast<void*>(pixels));
-    for (std::size_t y = 0; y < rows.size(); ++y) rows[y] = first + y * stride;
     std::vector<unsigned char> encoded;
-    encoded.reserve(stride * rows.size() / 4 + 1024);
-    PngOutput output{&encoded};
-
-    struct Handles {
-        png_structp png = nullptr;
-        png_infop info = nullptr;
-        ~Handles() { png_destroy_write_struct(&png, &info); }
-    } h;
-    char message[kMessageSize] = "";
-    h.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, message, png_error_jump,
-                                    png_warning_drop);
-    if (h.png != nullptr) h.info = png_create_info_struct(h.png);
-    if (h.png == nullptr || h.info == nullptr) {
-        throw IoError(path + ": cannot encode PNG (cannot start libpng)");
+    try {
+        detail::encode_png(width, height, bits, channels, pixels, encoded);
+    } catch (const IoError& e) {
+        throw IoError(path + ": " + e.what());
     }
-    png_structp png = h.png;
-    png_infop info = h.info;
-    const bool ok = png_guarded(png, [&] {
-        png_set_write_fn(png, &output, png_write_memory, png_flush_none);
-        // OpenCV's settings, for the same sizes and speed as before: the Sub filter on every
-        // row, zlib's fastest level, run-length matches only.
-        png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
-        png_set_compression_level(png, Z_BEST_SPEED);
-        png_set_compression_strategy(png, Z_RLE);
-        png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
-                     bits, channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
-                     PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-        png_write_info(png, info);
-        if (bits == 16 && std::endian::native == std::endian::little) png_set_swap(png);
-        png_write_image(png, rows.data());
-        png_write_end(png, nullptr);
-    });
-    if (!ok) throw IoError(path + ": cannot encode PNG (" + message + ")");
     write_file_atomic(path, encoded.data(), encoded.size());
 }
 
