@@ -7,6 +7,10 @@
 
 #include <libdeflate.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <bit>
 #include <cstdint>
@@ -75,12 +79,12 @@ inline int paeth(int a, int b, int c) {
     return pick(pa <= std::min(pb, pc), a, pick(pb <= pc, b, c));
 }
 
-/// Sub (1), Average (3) or Paeth (4) undone on a row, the pixel to the left kept in registers.
+/// Sub (1), Average (3) or Paeth (4) undone on bytes [first, n) of a row, the pixel to the
+/// left kept in registers: a and c, one per byte of the pixel, as they stand at `first`.
 template <int bpp, int filter>
 void unfilter_left(const unsigned char* __restrict raw, const unsigned char* __restrict prior,
-                   unsigned char* __restrict out, std::size_t n) {
-    int a[bpp] = {}, c[bpp] = {};
-    for (std::size_t i = 0; i + bpp <= n; i += bpp)  // n is a whole number of pixels
+                   unsigned char* __restrict out, std::size_t first, std::size_t n, int (&a)[bpp], int (&c)[bpp]) {
+    for (std::size_t i = first; i + bpp <= n; i += bpp)  // n is a whole number of pixels
         for (int k = 0; k < bpp; ++k) {
             const int b = prior[i + k];
             const int predicted = filter == 1 ? a[k] : filter == 3 ? (a[k] + b) >> 1 : paeth(a[k], b, c[k]);
@@ -88,6 +92,71 @@ void unfilter_left(const unsigned char* __restrict raw, const unsigned char* __r
             c[k] = b;
             out[i + k] = static_cast<unsigned char>(a[k]);
         }
+}
+
+#if defined(__SSE2__)
+/// The bpp bytes at p (2 or 3; for 3, four are read) in 16-bit lanes.
+template <int bpp>
+__m128i load_pixel(const unsigned char* p) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, p, bpp == 3 ? 4 : 2);
+    return _mm_unpacklo_epi8(_mm_cvtsi32_si128(static_cast<int>(v)), _mm_setzero_si128());
+}
+
+/// |x| per 16-bit lane.
+inline __m128i abs16(__m128i x) { return _mm_max_epi16(x, _mm_sub_epi16(_mm_setzero_si128(), x)); }
+
+/// m ? x : y per lane (m all ones or all zeros).
+inline __m128i select(__m128i m, __m128i x, __m128i y) {
+    return _mm_or_si128(_mm_and_si128(m, x), _mm_andnot_si128(m, y));
+}
+
+/// Average (3) or Paeth (4) on a row of 2- or 3-byte pixels, a pixel's bytes in the 16-bit
+/// lanes of one register: the chain from pixel to pixel, which sets the pace, is a pixel a
+/// step rather than a byte. Stops before the pixel whose 4-byte load would pass the row's
+/// end; unfilter_left goes on from there with a and c. Returns where it stopped.
+template <int bpp, int filter>
+std::size_t unfilter_sse2(const unsigned char* __restrict raw, const unsigned char* __restrict prior,
+                          unsigned char* __restrict out, std::size_t n, int (&a_out)[bpp], int (&c_out)[bpp]) {
+    const __m128i bytes = _mm_set1_epi16(0xff);
+    __m128i a = _mm_setzero_si128(), c = _mm_setzero_si128();
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += bpp) {
+        const __m128i b = load_pixel<bpp>(prior + i), x = load_pixel<bpp>(raw + i);
+        __m128i predicted;
+        if constexpr (filter == 3) {
+            predicted = _mm_srli_epi16(_mm_add_epi16(a, b), 1);
+        } else {
+            const __m128i bc = _mm_sub_epi16(b, c), ac = _mm_sub_epi16(a, c);
+            const __m128i pa = abs16(bc), pb = abs16(ac), pc = abs16(_mm_add_epi16(bc, ac));
+            const __m128i nearer_bc = select(_mm_cmpgt_epi16(pb, pc), c, b);
+            predicted = select(_mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc)), nearer_bc, a);
+        }
+        c = b;
+        a = _mm_and_si128(_mm_add_epi16(x, predicted), bytes);
+        const auto v = static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_packus_epi16(a, a)));
+        std::memcpy(out + i, &v, bpp);
+    }
+    alignas(16) std::int16_t lanes[8];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), a);
+    for (int k = 0; k < bpp; ++k) a_out[k] = lanes[k];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), c);
+    for (int k = 0; k < bpp; ++k) c_out[k] = lanes[k];
+    return i;
+}
+#endif
+
+/// Sub, Average or Paeth on a row: SSE2 for Average and Paeth on 2- and 3-byte pixels (a
+/// frame's depth and colour), the rest by unfilter_left.
+template <int bpp, int filter>
+void unfilter_pixels(const unsigned char* __restrict raw, const unsigned char* __restrict prior,
+                     unsigned char* __restrict out, std::size_t n) {
+    int a[bpp] = {}, c[bpp] = {};
+    std::size_t first = 0;
+#if defined(__SSE2__)
+    if constexpr (filter != 1 && bpp > 1) first = unfilter_sse2<bpp, filter>(raw, prior, out, n, a, c);
+#endif
+    unfilter_left<bpp, filter>(raw, prior, out, first, n, a, c);
 }
 
 /// Row `raw` (n bytes, without its filter byte) unfiltered into `out`, the row above being
@@ -107,9 +176,9 @@ void unfilter_row(int filter, const unsigned char* __restrict raw, const unsigne
         return;
     }
     switch (filter) {
-        case 1: unfilter_left<bpp, 1>(raw, prior, out, n); break;
-        case 3: unfilter_left<bpp, 3>(raw, prior, out, n); break;
-        default: unfilter_left<bpp, 4>(raw, prior, out, n); break;  // the caller refused past 4
+        case 1: unfilter_pixels<bpp, 1>(raw, prior, out, n); break;
+        case 3: unfilter_pixels<bpp, 3>(raw, prior, out, n); break;
+        default: unfilter_pixels<bpp, 4>(raw, prior, out, n); break;  // the caller refused past 4
     }
 }
 
