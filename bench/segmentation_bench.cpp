@@ -30,6 +30,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
         sum.containers += stats.ms.containers;
         sum.color += stats.ms.color;
         sum.stacks += stats.ms.stacks;
+        sum.pieces += stats.ms.pieces;
         sum.gaps += stats.ms.gaps;
         sum.occluded += stats.ms.occluded;
         sum.scope += stats.ms.scope;
@@ -45,6 +46,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     state.counters["containers_ms"] = Counter(sum.containers, Counter::kAvgIterations);
     state.counters["color_ms"] = Counter(sum.color, Counter::kAvgIterations);
     state.counters["stacks_ms"] = Counter(sum.stacks, Counter::kAvgIterations);
+    state.counters["pieces_ms"] = Counter(sum.pieces, Counter::kAvgIterations);
     state.counters["gaps_ms"] = Counter(sum.gaps, Counter::kAvgIterations);
     state.counters["occluded_ms"] = Counter(sum.occluded, Counter::kAvgIterations);
     state.counters["scope_ms"] = Counter(sum.scope, Counter::kAvgIterations);

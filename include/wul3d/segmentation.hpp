@@ -247,6 +247,10 @@ struct SegmentStats {
     struct StackCounts {
         int splits = 0;  ///< segments the stack rule cut in two (each adds a segment)
     } stacks;
+    struct PieceCounts {
+        int splits = 0;  ///< pieces of a segment apart from its largest, made segments (those
+                         ///< under min_points then dropped)
+    } pieces;
     struct OcclusionCounts {
         int joins = 0;  ///< parts of one surface joined across the object before them
     } occlusion;
@@ -256,11 +260,11 @@ struct SegmentStats {
     } scope;
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
     /// components, re-attachment, convexity merge, container rule, colour cue, stack rule,
-    /// floor gaps, occlusion, the scope, and the renumbering passes with the output. For the
+    /// pieces, floor gaps, occlusion, the scope, and the renumbering passes with the output. For the
     /// profile in bench/.
     struct Phases {
         double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
-               color = 0, stacks = 0, gaps = 0, occluded = 0, scope = 0, compact = 0;
+               color = 0, stacks = 0, pieces = 0, gaps = 0, occluded = 0, scope = 0, compact = 0;
     } ms;
 };
 

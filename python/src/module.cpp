@@ -189,6 +189,7 @@ py::dict stats_dict(const Result& r) {
     out["color_splits"] = r.segment_stats.colour.splits;
     out["texture_splits"] = r.segment_stats.colour.texture_splits;
     out["stack_splits"] = r.segment_stats.stacks.splits;
+    out["piece_splits"] = r.segment_stats.pieces.splits;
     return out;
 }
 

@@ -76,6 +76,7 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"color_splits", r.segment_stats.colour.splits},
             {"texture_splits", r.segment_stats.colour.texture_splits},
             {"stack_splits", r.segment_stats.stacks.splits},
+            {"piece_splits", r.segment_stats.pieces.splits},
             {"scope", r.segment_stats.scope.applied ? "support" : "scene"},
             {"out_of_scope", r.segment_stats.scope.out_of_scope},
             {"objects", r.object_list.size()}};

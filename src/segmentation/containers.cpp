@@ -329,7 +329,13 @@ int join_insides(const Ctx& x, SegmentBuffers& ws, int n) {
         if (b[1] < prm.containers.inside_share * b[0] || std::fabs(b[2] - fit[5]) > prm.containers.height_tol_m) continue;
         joins += join_sets(ws.parent, static_cast<int>(fit[0]), static_cast<int>(fit[1]));
     }
-    if (joins > 0) relabel_to_roots(ws);
+    if (joins == 0) return 0;
+    relabel_to_roots(ws);
+    // The joined containers stay whole through the pieces phase: the rim hides what joins
+    // the inside to the wall, and pixels cut along it can leave them apart in the image.
+    ws.rim_joined.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (int l = 1; l <= n; ++l)
+        if (const int root = find_root(ws.parent, l); root != l) ws.rim_joined[static_cast<std::size_t>(root)] = 1;
     return joins;
 }
 
@@ -358,6 +364,7 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 /// boundary, and one over the rows of the candidates' insides; with islands, add_islands and
 /// drop_islands.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
+    ws.rim_joined.clear();
     if (!support || x.prm.containers.min_boundary <= 0 || n < 1) return;
     const int islands = x.prm.containers.islands ? add_islands(x, ws, n) : 0;
     stats.containers.joins = join_rims(x, *support, ws, n + islands);

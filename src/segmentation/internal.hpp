@@ -28,6 +28,11 @@ struct BoundaryStep {
 };
 }  // namespace detail
 
+/// Pixels u0..u1 of row v, all of segment `label` (the pieces phase).
+struct LabelRun {
+    int v, u0, u1, label;
+};
+
 /// segment_objects' buffers (SegmentWorkspace, opaque to its callers).
 struct SegmentWorkspace::Buffers {
     NormalMap smooth;                  ///< smoothed normals (cuts.normal_smooth_px)
@@ -36,6 +41,10 @@ struct SegmentWorkspace::Buffers {
                                        ///< spent, the container rule's open pixels (islands)
     std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
     std::vector<int> label;    ///< 0 none, 1..n
+    std::vector<LabelRun> runs;        ///< pieces: the runs of equal labels, row by row
+    std::vector<int> row_runs;         ///< pieces: each row's first run (H + 1)
+    std::vector<int> run_parent;       ///< pieces: union-find over runs
+    std::vector<int> run_pixels;       ///< pieces: per root run, its piece's pixels
     std::vector<int> queue;
     std::vector<int> dist;
     std::vector<int> sizes;
@@ -74,6 +83,8 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::array<double, 3>> rim_back;  ///< back's pixels, inside, top per candidate
     std::vector<int> rim_next;         ///< candidates of one back segment, linked
     std::vector<int> rim_far_px;       ///< the back's far rim, of the pair being fitted
+    std::vector<std::uint8_t> rim_joined;  ///< per segment, 1 = joined across its rim (kept
+                                           ///< whole by the pieces phase); empty: none
     // Floor gaps:
     std::vector<std::uint8_t> gap_seen;  ///< 1 = explored this frame (0 between frames)
     std::vector<int> gap_touched;        ///< pixels marked by searches that filled nothing
@@ -354,6 +365,10 @@ void split_by_colour(const Ctx& x, const Plane* support, SegmentBuffers& ws, int
 /// Stacks (stacks.cpp; SegmentParams, "Stacks"; `support` not null): cuts a segment whose
 /// upward faces lie at two heights in two. stats.stack_splits.
 void split_stacks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
+
+/// Pieces (pieces.cpp): each 4-connected piece of a segment but its largest becomes a
+/// segment of its own (under min_points, dropped at the end). stats.pieces.
+void split_pieces(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Floor gaps (floor_gaps.cpp; ContainerParams::gap_max_px): small unlabelled patches beside a
 /// container's inside, enclosed by one segment, join it. stats.gaps_filled.

@@ -69,6 +69,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     rule(geometric, ms.containers, join_containers);
     rule(hybrid, ms.color, split_by_colour);
     rule(geometric && support, ms.stacks, split_stacks);
+    rule(geometric, ms.pieces, split_pieces);
     rule(geometric, ms.gaps, fill_floor_gaps);
     rule(geometric, ms.occluded, join_occluded);
     rule(support && params.scope.mode == Scope::Support, ms.scope, restrict_to_support);

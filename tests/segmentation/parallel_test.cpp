@@ -185,7 +185,7 @@ Segmented segment_at(const SegmentParams& params, const OrganizedCloud& cloud, c
     const SegmentStats s = segment_objects(params, cloud, normals, classes, support, clusters, ws, out);
     Segmented r;
     r.labels = out.labels;
-    r.stats = {s.segments,    s.colour.splits, s.colour.texture_splits, s.stacks.splits,
+    r.stats = {s.segments,    s.colour.splits, s.colour.texture_splits, s.stacks.splits, s.pieces.splits,
                s.merge.joins,      s.containers.joins,   s.occlusion.joins,
                static_cast<long long>(s.containers.gaps_filled), static_cast<long long>(s.reattached),
                s.scope.applied, s.scope.out_of_scope};
