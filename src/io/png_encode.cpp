@@ -73,6 +73,9 @@ struct Deflater {
 }  // namespace
 
 void encode_png(int width, int height, int bits, int channels, const void* pixels, std::vector<unsigned char>& out) {
+    if (width <= 0 || height <= 0)
+        throw IoError("cannot encode PNG (an image of " + std::to_string(width) + "x" + std::to_string(height) +
+                      " pixels is empty)");
     const std::size_t row_bytes = static_cast<std::size_t>(width) * channels * (bits / 8);
     if (row_bytes >= std::numeric_limits<uInt>::max())  // zlib takes a row in one piece
         throw IoError("cannot encode PNG (rows of " + std::to_string(width) + " pixels are too long)");

@@ -1,8 +1,8 @@
 // The PNG decoder of the common kinds (png_rows.hpp). libpng inflates with zlib and undoes
 // the Paeth filter, the one most encoders choose for photographs and depth, with a branch per
-// byte: reading a 640 x 480 frame's two PNGs took about 9 ms, near a frame's whole
-// processing. Here libdeflate inflates the rows at once and the filters are undone without
-// branches (PNG specification, section 9: filter types 0-4).
+// byte that mispredicts: reading a frame cost as much as processing it (docs/SPEED.md). Here
+// libdeflate inflates the rows at once and the filters are undone without branches (PNG
+// specification, section 9: filter types 0-4).
 #include "png_rows.hpp"
 
 #include <libdeflate.h>
