@@ -171,17 +171,9 @@ Scene pitched_tabletop_scene() {
 
 Scene small_box_before_tall_box() {
     Scene s = pitched_tabletop_scene();
-    SceneBox tall;
-    tall.x = 0.05f;
-    tall.z = 1.0f;
-    tall.w = 0.2f;
-    tall.h = 0.25f;
-    tall.d = 0.1f;
-    SceneBox small = tall;  // same colour
-    small.x = 0.0f;
-    small.z = 0.9f;  // its back face touches the tall box's front face (z = 0.95)
-    small.w = 0.12f;
-    small.h = 0.1f;
+    const SceneBox tall{.x = 0.05f, .z = 1.0f, .w = 0.2f, .h = 0.25f, .d = 0.1f};
+    // Same colour; its back face touches the tall box's front face (z = 0.95).
+    const SceneBox small{.x = 0.0f, .z = 0.9f, .w = 0.12f, .h = 0.1f, .d = tall.d};
     s.boxes = {tall, small};
     return s;
 }

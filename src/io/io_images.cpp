@@ -24,6 +24,7 @@
 #include <stdexcept>
 
 #include "io_detail.hpp"
+#include "png_format.hpp"
 #include "png_encode.hpp"
 #include "png_rows.hpp"
 #include "wul3d/error.hpp"
@@ -34,6 +35,8 @@ namespace wul3d {
 
 namespace fs = std::filesystem;
 using detail::ImageScratch;
+using detail::kPngSignature;
+using detail::read_be32;
 using detail::size_str;
 
 namespace {
@@ -62,17 +65,10 @@ std::string bytes_str(std::uint64_t n) {
 // stripped: libpng then never parses a text or colour profile chunk. libpng is told not to
 // compute the CRCs again.
 
-constexpr std::array<unsigned char, 8> kPngSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-
 /// CRC-32 of the PNG specification (ISO 3309), over [data, data + n): libdeflate's, the
 /// same polynomial with the CPU's carry-less multiply (a table lookup per byte cost a tenth
 /// of a frame's read).
 std::uint32_t png_crc(const unsigned char* data, std::size_t n) { return libdeflate_crc32(0, data, n); }
-
-std::uint32_t be32(const unsigned char* p) {
-    return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
-           std::uint32_t{p[3]};
-}
 
 bool is_png(const std::vector<unsigned char>& b) {
     return b.size() >= kPngSignature.size() &&
@@ -95,14 +91,14 @@ const std::vector<unsigned char>& check_png(const std::string& path,
         if (pos + 12 > n) {
             throw InputError(path + ": cannot decode PNG (truncated: the file ends before its IEND chunk)");
         }
-        const std::uint32_t len = be32(&bytes[pos]);
+        const std::uint32_t len = read_be32(&bytes[pos]);
         if (len > 0x7fffffffu || pos + 12 + len > n) {
             throw InputError(path + ": cannot decode PNG (truncated or corrupt chunk at byte " +
                              std::to_string(pos) + ")");
         }
         const unsigned char* type = &bytes[pos + 4];
         const std::string name(reinterpret_cast<const char*>(type), 4);
-        if (png_crc(type, 4 + std::size_t{len}) != be32(type + 4 + len)) {
+        if (png_crc(type, 4 + std::size_t{len}) != read_be32(type + 4 + len)) {
             throw InputError(path + ": cannot decode PNG (CRC error in chunk at byte " +
                              std::to_string(pos) + ", the file is corrupt)");
         }
@@ -119,7 +115,7 @@ const std::vector<unsigned char>& check_png(const std::string& path,
     if (!ancillary) return bytes;
     cleaned.assign(bytes.begin(), bytes.begin() + kPngSignature.size());
     for (std::size_t p = kPngSignature.size(); p < pos;) {
-        const std::size_t chunk = 12 + std::size_t{be32(&bytes[p])};
+        const std::size_t chunk = 12 + std::size_t{read_be32(&bytes[p])};
         const std::string name(reinterpret_cast<const char*>(&bytes[p + 4]), 4);
         if (name == "IHDR" || name == "PLTE" || name == "IDAT" || name == "IEND" || name == "tRNS") {
             cleaned.insert(cleaned.end(), bytes.begin() + p, bytes.begin() + p + chunk);

@@ -8,34 +8,26 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <array>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <string>
 
+#include "png_format.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d::detail {
 
 namespace {
 
-constexpr std::array<unsigned char, 8> kSignature = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
 constexpr std::size_t kIdatBytes = 8192;  ///< libpng's IDAT size (PNG_ZBUF_SIZE)
-
-void put_be32(unsigned char* p, std::uint32_t v) {
-    p[0] = static_cast<unsigned char>(v >> 24);
-    p[1] = static_cast<unsigned char>(v >> 16);
-    p[2] = static_cast<unsigned char>(v >> 8);
-    p[3] = static_cast<unsigned char>(v);
-}
 
 /// The chunk whose data (`n` bytes) follows its length and type at `chunk`: both written, and
 /// its CRC after the data. Returns the end of the chunk.
 unsigned char* close_chunk(unsigned char* chunk, const char* type, std::size_t n) {
-    put_be32(chunk, static_cast<std::uint32_t>(n));
+    write_be32(chunk, static_cast<std::uint32_t>(n));
     std::memcpy(chunk + 4, type, 4);
-    put_be32(chunk + 8 + n, libdeflate_crc32(0, chunk + 4, 4 + n));
+    write_be32(chunk + 8 + n, libdeflate_crc32(0, chunk + 4, 4 + n));
     return chunk + 12 + n;
 }
 
@@ -113,12 +105,12 @@ void encode_png(int width, int height, int bits, int channels, const void* pixel
     // The file: signature, IHDR, the stream in IDAT chunks of kIdatBytes (as libpng cuts it:
     // the same file as libpng's with these settings), IEND.
     const std::size_t n_idat = (zlib_stream.size() + kIdatBytes - 1) / kIdatBytes;
-    out.resize(kSignature.size() + (12 + 13) + 12 * n_idat + zlib_stream.size() + 12);
+    out.resize(kPngSignature.size() + (12 + 13) + 12 * n_idat + zlib_stream.size() + 12);
     unsigned char* const p = out.data();
-    std::memcpy(p, kSignature.data(), kSignature.size());
-    unsigned char* chunk = p + kSignature.size();
-    put_be32(chunk + 8, static_cast<std::uint32_t>(width));
-    put_be32(chunk + 12, static_cast<std::uint32_t>(height));
+    std::memcpy(p, kPngSignature.data(), kPngSignature.size());
+    unsigned char* chunk = p + kPngSignature.size();
+    write_be32(chunk + 8, static_cast<std::uint32_t>(width));
+    write_be32(chunk + 12, static_cast<std::uint32_t>(height));
     chunk[16] = static_cast<unsigned char>(bits);
     chunk[17] = channels == 3 ? 2 : 0;    // colour type: RGB or grey
     chunk[18] = chunk[19] = chunk[20] = 0;  // deflate, adaptive filtering, not interlaced

@@ -19,6 +19,7 @@
 
 #include "branch_free.hpp"
 #include "io_detail.hpp"
+#include "png_format.hpp"
 
 namespace wul3d::detail {
 
@@ -33,22 +34,16 @@ libdeflate_decompressor* ImageScratch::Inflater::get() {
 
 namespace {
 
-std::uint32_t be32(const unsigned char* p) {
-    return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) |
-           std::uint32_t{p[3]};
-}
-
 /// The zlib stream of the IDAT chunks of `png` (checked: every chunk lies within `size`): the
 /// one chunk's data in place, or several joined in s.idat. False if IDAT chunks lie apart
 /// (libpng refuses that) or there is none.
 bool idat_stream(const unsigned char* png, std::size_t size, ImageScratch& s, const unsigned char*& data,
                  std::size_t& n) {
-    constexpr std::size_t kSignature = 8;
     int runs = 0, chunks = 0;
     bool in_run = false;
     s.idat.clear();
-    for (std::size_t pos = kSignature; pos + 12 <= size;) {
-        const std::size_t len = be32(png + pos);
+    for (std::size_t pos = kPngSignature.size(); pos + 12 <= size;) {
+        const std::size_t len = read_be32(png + pos);
         const bool idat = std::memcmp(png + pos + 4, "IDAT", 4) == 0;
         if (idat) {
             if (!in_run) ++runs;

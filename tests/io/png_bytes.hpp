@@ -54,15 +54,23 @@ inline std::string png_chunk(const std::string& type, const std::string& data) {
     return be32(static_cast<std::uint32_t>(data.size())) + type + data + be32(crc32(type + data));
 }
 
-/// A PNG file: the IHDR of the arguments, `chunks` (PLTE, tRNS), and an IDAT holding the
-/// zlib stream `idat`.
-inline std::string png_file(std::uint32_t w, std::uint32_t h, int bit_depth, int color_type,
-                     const std::string& idat, const std::string& chunks = "", bool interlaced = false) {
+/// A PNG file: the IHDR of the arguments, `chunks` (PLTE, tRNS), and an IDAT chunk for each
+/// of `idats` (pieces of one zlib stream, in order).
+inline std::string png_with_idats(std::uint32_t w, std::uint32_t h, int bit_depth, int color_type,
+                                  const std::vector<std::string>& idats, const std::string& chunks = "",
+                                  bool interlaced = false) {
     const std::string ihdr = be32(w) + be32(h) +
                              std::string{static_cast<char>(bit_depth), static_cast<char>(color_type),
                                          0, 0, static_cast<char>(interlaced ? 1 : 0)};
-    return std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + chunks +
-           png_chunk("IDAT", idat) + png_chunk("IEND", "");
+    std::string png = std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + chunks;
+    for (const std::string& idat : idats) png += png_chunk("IDAT", idat);
+    return png + png_chunk("IEND", "");
+}
+
+/// The same with one IDAT holding the zlib stream `idat`.
+inline std::string png_file(std::uint32_t w, std::uint32_t h, int bit_depth, int color_type,
+                            const std::string& idat, const std::string& chunks = "", bool interlaced = false) {
+    return png_with_idats(w, h, bit_depth, color_type, {idat}, chunks, interlaced);
 }
 
 /// Scanlines with filter type 0 (None): each of `rows` prefixed by a zero byte.

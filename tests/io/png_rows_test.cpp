@@ -71,12 +71,10 @@ std::string deflated(const std::string& raw) {
 /// A PNG whose zlib stream `z` is cut into `parts` IDAT chunks.
 std::string png_parts(std::uint32_t w, std::uint32_t h, int bit_depth, int color_type, const std::string& z,
                       int parts) {
-    std::string idats;
+    std::vector<std::string> idats;
     const std::size_t step = z.size() / parts + 1;
-    for (std::size_t pos = 0; pos < z.size(); pos += step) idats += png_chunk("IDAT", z.substr(pos, step));
-    const std::string ihdr = be32(w) + be32(h) +
-                             std::string{static_cast<char>(bit_depth), static_cast<char>(color_type), 0, 0, 0};
-    return std::string("\x89PNG\r\n\x1a\n", 8) + png_chunk("IHDR", ihdr) + idats + png_chunk("IEND", "");
+    for (std::size_t pos = 0; pos < z.size(); pos += step) idats.push_back(z.substr(pos, step));
+    return png_with_idats(w, h, bit_depth, color_type, idats);
 }
 
 /// Random rows of `width` pixels of bpp bytes, with runs of 0 and 255 among them (the edges of
