@@ -33,8 +33,8 @@
 #                                                  docs/SCALE.md)
 #   clang libclang-rt-14-dev libomp-14-dev         the fuzzers (fuzz/, .ci/run): clang 14's libFuzzer
 #                                                  (-fsanitize=fuzzer), its sanitizer runtimes, OpenMP
-#   zlib1g-dev                                     the PNG writer's deflate (src/io/png_encode.cpp); the
-#                                                  tests write PNG chunks
+#   zlib1g-dev                                     the tests' PNG files, chunks and streams written by
+#                                                  hand (tests/support, tests/io)
 #   librosbag-dev                                  ROS 1 bags as input (src/bag/, docs/INPUTS.md); built
 #                                                  only when found
 #   libclass-loader-dev librcpputils-dev           headers that Debian's rosbag/bag.h includes (through

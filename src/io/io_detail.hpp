@@ -1,6 +1,7 @@
 #pragma once
-// Private to src/io/ (and src/bag/): image readers that reuse the caller's buffers, so that a
-// FrameSource allocates nothing per frame once the first frame has been read.
+// Private to the library: image readers and writers that reuse the caller's buffers, so that
+// a FrameSource allocates nothing per frame once the first frame has been read, and a writer
+// thread nothing once it has written its first frame.
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -65,6 +66,14 @@ void read_color_image_into(const std::string& path, ImageScratch& scratch, Color
 /// CompressedImage); `what` names it in errors.
 void decode_color_image_into(const std::string& what, ImageScratch& scratch, ColorImage& out);
 void read_label_png_into(const std::string& path, ImageScratch& scratch, LabelImage& out);
+
+class PngEncoder;  // png_encode.hpp
+/// write_label_png, write_color_png and write_mask_png (io.hpp) through the encoder the
+/// writer keeps.
+void write_label_png(const std::string& path, const LabelImage& labels, PngEncoder& encoder);
+void write_color_png(const std::string& path, const ColorImage& image, PngEncoder& encoder);
+void write_mask_png(const std::string& path, int width, int height, const std::vector<std::uint8_t>& mask,
+                    PngEncoder& encoder);
 
 /// "WxH".
 inline std::string size_str(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }

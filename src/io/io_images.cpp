@@ -534,13 +534,13 @@ void decode_or_clear(Image& image, Data& data, Decode&& decode) {
 // ---- writing ------------------------------------------------------------------------
 
 /// Encodes `height` rows of `width` pixels at `pixels`, each 8-bit grey, 8-bit RGB
-/// (channels 3) or 16-bit grey in the host's byte order (bits 16), to PNG (encode_png), and
-/// writes `path` atomically. IoError names the path.
-void write_png(const std::string& path, int width, int height, int bits, int channels,
-               const void* pixels) {
+/// (channels 3) or 16-bit grey in the host's byte order (bits 16), to PNG with `encoder`,
+/// and writes `path` atomically. IoError names the path.
+void write_png(const std::string& path, int width, int height, int bits, int channels, const void* pixels,
+               detail::PngContent content, detail::PngEncoder& encoder) {
     std::vector<unsigned char> encoded;
     try {
-        detail::encode_png(width, height, bits, channels, pixels, encoded);
+        encoder.encode(width, height, bits, channels, pixels, content, encoded);
     } catch (const IoError& e) {
         throw IoError(path + ": " + e.what());
     }
@@ -707,29 +707,49 @@ LabelImage read_label_png(const std::string& path) {
 
 // ---- outputs ------------------------------------------------------------------------
 
-void write_label_png(const std::string& path, const LabelImage& labels) {
+namespace detail {
+
+void write_label_png(const std::string& path, const LabelImage& labels, PngEncoder& encoder) {
     check_buffer(path, "labels", labels.width, labels.height, labels.labels.size(), 1);
-    write_png(path, labels.width, labels.height, 16, 1, labels.labels.data());
+    write_png(path, labels.width, labels.height, 16, 1, labels.labels.data(), PngContent::Regions, encoder);
 }
 
-void write_color_png(const std::string& path, const ColorImage& image) {
+void write_color_png(const std::string& path, const ColorImage& image, PngEncoder& encoder) {
     check_buffer(path, "a colour image", image.width, image.height, image.rgb.size(), 3);
-    write_png(path, image.width, image.height, 8, 3, image.rgb.data());
+    write_png(path, image.width, image.height, 8, 3, image.rgb.data(), PngContent::Picture, encoder);
 }
 
-void write_mask_png(const std::string& path, int width, int height,
-                    const std::vector<std::uint8_t>& mask) {
+void write_mask_png(const std::string& path, int width, int height, const std::vector<std::uint8_t>& mask,
+                    PngEncoder& encoder) {
     check_buffer(path, "a mask", width, height, mask.size(), 1);
     // Any non-zero entry is written as 255, so the mask is visible in an image viewer.
     std::vector<std::uint8_t> visible(mask.size());
     std::transform(mask.begin(), mask.end(), visible.begin(),
                    [](std::uint8_t m) { return static_cast<std::uint8_t>(m ? 255 : 0); });
-    write_png(path, width, height, 8, 1, visible.data());
+    write_png(path, width, height, 8, 1, visible.data(), PngContent::Regions, encoder);
+}
+
+}  // namespace detail
+
+void write_label_png(const std::string& path, const LabelImage& labels) {
+    detail::PngEncoder encoder;
+    detail::write_label_png(path, labels, encoder);
+}
+
+void write_color_png(const std::string& path, const ColorImage& image) {
+    detail::PngEncoder encoder;
+    detail::write_color_png(path, image, encoder);
+}
+
+void write_mask_png(const std::string& path, int width, int height, const std::vector<std::uint8_t>& mask) {
+    detail::PngEncoder encoder;
+    detail::write_mask_png(path, width, height, mask, encoder);
 }
 
 void write_depth_png(const std::string& path, const DepthImage& depth) {
     check_buffer(path, "a depth image", depth.width, depth.height, depth.data.size(), 1);
-    write_png(path, depth.width, depth.height, 16, 1, depth.data.data());
+    detail::PngEncoder encoder;
+    write_png(path, depth.width, depth.height, 16, 1, depth.data.data(), detail::PngContent::Picture, encoder);
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

@@ -13,7 +13,10 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "io/io_detail.hpp"
+#include "io/png_encode.hpp"
 #include "json_text.hpp"
+#include "output_detail.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
 #include "wul3d/visualization.hpp"
@@ -279,25 +282,32 @@ void write_frame(const std::string& out_dir, const std::string& name, const Pipe
 
 void write_frame(const std::string& out_dir, const std::string& name, const OrganizedCloud* cloud,
                  const RgbdFrame& frame, const FrameResult& r, const FrameOutputs& extra) {
+    detail::PngEncoder encoder;
+    detail::write_frame(out_dir, name, cloud, frame, r, extra, encoder);
+}
+
+void detail::write_frame(const std::string& out_dir, const std::string& name, const OrganizedCloud* cloud,
+                         const RgbdFrame& frame, const FrameResult& r, const FrameOutputs& extra,
+                         PngEncoder& encoder) {
     check_frame_name(name);
     write_folder_atomic((fs::path(out_dir) / name).string(), [&](const std::string& dir) {
         const fs::path tmp_dir(dir);
         const OutputFiles& files = extra.files;
-        if (files.labels) write_label_png((tmp_dir / "labels.png").string(), r.labels);
-        if (files.colors) write_color_png((tmp_dir / "colors.png").string(), r.colors);
+        if (files.labels) detail::write_label_png((tmp_dir / "labels.png").string(), r.labels, encoder);
+        if (files.colors) detail::write_color_png((tmp_dir / "colors.png").string(), r.colors, encoder);
         if (extra.selected)
-            write_mask_png((tmp_dir / "selected.png").string(), r.labels.width,
-                           r.labels.height, *extra.selected);
-        if (files.objects) write_label_png((tmp_dir / "objects.png").string(), r.objects);
+            detail::write_mask_png((tmp_dir / "selected.png").string(), r.labels.width, r.labels.height,
+                                   *extra.selected, encoder);
+        if (files.objects) detail::write_label_png((tmp_dir / "objects.png").string(), r.objects, encoder);
         if (files.json)
             write_text_file((tmp_dir / "objects.json").string(), objects_json(r, extra.selected_id));
         if (extra.selected_object)
-            write_mask_png((tmp_dir / "selected_object.png").string(), r.objects.width,
-                           r.objects.height, *extra.selected_object);
+            detail::write_mask_png((tmp_dir / "selected_object.png").string(), r.objects.width,
+                                   r.objects.height, *extra.selected_object, encoder);
         if (files.overlay) {
             ColorImage picture;
             overlay_picture(frame, r, picture);
-            write_color_png((tmp_dir / "overlay.png").string(), picture);
+            detail::write_color_png((tmp_dir / "overlay.png").string(), picture, encoder);
         }
         if (files.ply && cloud && cloud->size() == r.labels.labels.size()) {
             write_ply((tmp_dir / "cloud.ply").string(), *cloud, r.labels, r.colors);

@@ -26,6 +26,8 @@
 #include "wul3d/stop.hpp"
 #include "wul3d/threads.hpp"
 #include "wul3d/write_guard.hpp"
+#include "io/png_encode.hpp"
+#include "output_detail.hpp"
 #include "write_behind.hpp"
 
 namespace wul3d {
@@ -354,9 +356,9 @@ public:
         FramesLog frames_log((out_dir() / kFramesFile).string());
         frames_log_ = &frames_log;
         const ScopedTeam stages_team(threads_.stages);
-        detail::WriteBehind<PendingFrame> writes(
+        detail::WriteBehind<PendingFrame, detail::PngEncoder> writes(
             static_cast<std::size_t>(threads_.writers) + 2, threads_.writers,
-            [this](PendingFrame& p) { write(p); });
+            [this](PendingFrame& p, detail::PngEncoder& encoder) { write(p, encoder); });
         writes_ = &writes;
         try {
             while (step()) {}
@@ -402,12 +404,12 @@ private:
         return n;
     }
 
-    /// A writer thread's job: one frame's folder.
-    void write(PendingFrame& p) const {
+    /// A writer thread's job: one frame's folder, with the writer's encoder.
+    void write(PendingFrame& p, detail::PngEncoder& encoder) const {
         omp_set_num_threads(1);  // a writer's overlay is one thread's work among several
         const auto t0 = Clock::now();
-        write_frame(o_.out_dir, p.name, p.has_cloud ? &p.cloud : nullptr, p.frame(), p.result,
-                    p.outputs);
+        detail::write_frame(o_.out_dir, p.name, p.has_cloud ? &p.cloud : nullptr, p.frame(), p.result,
+                            p.outputs, encoder);
         p.output_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     }
 
@@ -529,7 +531,7 @@ private:
     const RunThreads threads_ = run_threads(feed_.live() ? 1 : static_cast<int>(feed_.readers()));
     const Clock::time_point start_ = Clock::now();
     FramesLog* frames_log_ = nullptr;                      // run()'s, while it runs
-    detail::WriteBehind<PendingFrame>* writes_ = nullptr;  // run()'s, while it runs
+    detail::WriteBehind<PendingFrame, detail::PngEncoder>* writes_ = nullptr;  // run()'s, while it runs
     bool said_depth_only_ = false;
     bool write_failed_ = false;
     std::size_t taken_ = 0;      // frames processed and handed to the writers

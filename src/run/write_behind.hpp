@@ -13,14 +13,15 @@
 namespace wul3d::detail {
 
 /// A ring of `capacity` jobs written by `writers` threads. The loop fills the slot next()
-/// gives and submit()s it; writers run `write` on submitted jobs, any number at once; the
+/// gives and submit()s it; writers run `write` on submitted jobs, any number at once, each
+/// writer with its own WriterState (what it reuses from job to job: an encoder's tables); the
 /// loop takes finished jobs back with oldest() in the order they were submitted, so what it
 /// does with them (a log line, a callback) keeps the frame order. Jobs live in the ring:
 /// their buffers are reused from frame to frame.
-template <class Job>
+template <class Job, class WriterState>
 class WriteBehind {
 public:
-    WriteBehind(std::size_t capacity, int writers, std::function<void(Job&)> write)
+    WriteBehind(std::size_t capacity, int writers, std::function<void(Job&, WriterState&)> write)
         : ring_(capacity < 1 ? 1 : capacity), write_(std::move(write)) {
         for (int t = 0; t < (writers < 1 ? 1 : writers); ++t)
             threads_.emplace_back([this] { write_loop(); });
@@ -77,6 +78,7 @@ private:
     };
 
     void write_loop() {
+        WriterState state;
         std::unique_lock<std::mutex> lock(mutex_);
         for (;;) {
             changed_.wait(lock, [this] { return stopping_ || started_ < submitted_; });
@@ -85,7 +87,7 @@ private:
             lock.unlock();
             std::exception_ptr error;
             try {
-                write_(slot.job);
+                write_(slot.job, state);
             } catch (...) {
                 error = std::current_exception();
             }
@@ -97,7 +99,7 @@ private:
     }
 
     std::vector<Slot> ring_;
-    std::function<void(Job&)> write_;
+    std::function<void(Job&, WriterState&)> write_;
     // Jobs [taken_, submitted_) are in flight; [started_, submitted_) wait for a writer.
     std::size_t submitted_ = 0, started_ = 0, taken_ = 0;
     bool stopping_ = false;
