@@ -106,38 +106,75 @@ inline __m128i select(__m128i m, __m128i x, __m128i y) {
     return _mm_or_si128(_mm_and_si128(m, x), _mm_andnot_si128(m, y));
 }
 
-/// Average (3) or Paeth (4) on a row of 2- or 3-byte pixels, a pixel's bytes in the 16-bit
-/// lanes of one register: the chain from pixel to pixel, which sets the pace, is a pixel a
-/// step rather than a byte. Stops before the pixel whose 4-byte load would pass the row's
-/// end; unfilter_left goes on from there with a and c. Returns where it stopped.
+/// The chain of a row under Average or Paeth: the pixel to the left (a) and the one above it
+/// (c), a pixel's bytes in the 16-bit lanes of one register.
+struct Chain {
+    __m128i a = _mm_setzero_si128(), c = _mm_setzero_si128();
+
+    /// a and c as unfilter_left takes them, one int per byte.
+    template <int bpp>
+    void to_ints(int (&a_out)[bpp], int (&c_out)[bpp]) const {
+        alignas(16) std::int16_t lanes[8];
+        _mm_store_si128(reinterpret_cast<__m128i*>(lanes), a);
+        for (int k = 0; k < bpp; ++k) a_out[k] = lanes[k];
+        _mm_store_si128(reinterpret_cast<__m128i*>(lanes), c);
+        for (int k = 0; k < bpp; ++k) c_out[k] = lanes[k];
+    }
+};
+
+/// Average (3) or Paeth (4) undone on the pixel at raw (the one above at prior) into out,
+/// all its bytes at once: the chain from pixel to pixel, which sets the pace, is a pixel a
+/// step rather than a byte. Reads and writes 4 bytes: a 3-byte pixel's fourth is the next
+/// pixel's first, written again in the next step.
+template <int bpp, int filter>
+inline void unfilter_pixel(const unsigned char* raw, const unsigned char* prior, unsigned char* out, Chain& s) {
+    const __m128i b = load_pixel<bpp>(prior), x = load_pixel<bpp>(raw);
+    __m128i predicted;
+    if constexpr (filter == 3) {
+        predicted = _mm_srli_epi16(_mm_add_epi16(s.a, b), 1);
+    } else {
+        const __m128i bc = _mm_sub_epi16(b, s.c), ac = _mm_sub_epi16(s.a, s.c);
+        const __m128i pa = abs16(bc), pb = abs16(ac), pc = abs16(_mm_add_epi16(bc, ac));
+        const __m128i nearer_bc = select(_mm_cmpgt_epi16(pb, pc), s.c, b);
+        predicted = select(_mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc)), nearer_bc, s.a);
+    }
+    s.c = b;
+    s.a = _mm_and_si128(_mm_add_epi16(x, predicted), _mm_set1_epi16(0xff));
+    const auto v = static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_packus_epi16(s.a, s.a)));
+    std::memcpy(out, &v, bpp == 3 ? 4 : 2);
+}
+
+/// unfilter_pixel on the pixels of a row from byte i on, stopping before the pixel whose
+/// 4-byte load or store would pass the row's end. Returns where it stopped.
 template <int bpp, int filter>
 std::size_t unfilter_sse2(const unsigned char* __restrict raw, const unsigned char* __restrict prior,
-                          unsigned char* __restrict out, std::size_t n, int (&a_out)[bpp], int (&c_out)[bpp]) {
-    const __m128i bytes = _mm_set1_epi16(0xff);
-    __m128i a = _mm_setzero_si128(), c = _mm_setzero_si128();
-    std::size_t i = 0;
-    for (; i + 4 <= n; i += bpp) {
-        const __m128i b = load_pixel<bpp>(prior + i), x = load_pixel<bpp>(raw + i);
-        __m128i predicted;
-        if constexpr (filter == 3) {
-            predicted = _mm_srli_epi16(_mm_add_epi16(a, b), 1);
-        } else {
-            const __m128i bc = _mm_sub_epi16(b, c), ac = _mm_sub_epi16(a, c);
-            const __m128i pa = abs16(bc), pb = abs16(ac), pc = abs16(_mm_add_epi16(bc, ac));
-            const __m128i nearer_bc = select(_mm_cmpgt_epi16(pb, pc), c, b);
-            predicted = select(_mm_cmpgt_epi16(pa, _mm_min_epi16(pb, pc)), nearer_bc, a);
-        }
-        c = b;
-        a = _mm_and_si128(_mm_add_epi16(x, predicted), bytes);
-        const auto v = static_cast<std::uint32_t>(_mm_cvtsi128_si32(_mm_packus_epi16(a, a)));
-        std::memcpy(out + i, &v, bpp);
-    }
-    alignas(16) std::int16_t lanes[8];
-    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), a);
-    for (int k = 0; k < bpp; ++k) a_out[k] = lanes[k];
-    _mm_store_si128(reinterpret_cast<__m128i*>(lanes), c);
-    for (int k = 0; k < bpp; ++k) c_out[k] = lanes[k];
+                          unsigned char* __restrict out, std::size_t i, std::size_t n, Chain& s) {
+    for (; i + 4 <= n; i += bpp) unfilter_pixel<bpp, filter>(raw + i, prior + i, out + i, s);
     return i;
+}
+
+/// Two rows, each under Average or Paeth (filter0 the upper, filter1 the lower), undone
+/// together: the lower row trails the upper by kTrail pixels, so that what it reads of the
+/// upper was written steps before, and the two chains, independent, run side by side (one
+/// row's chain leaves the core idle most of each step). Then each row's end by
+/// unfilter_left.
+template <int bpp, int filter0, int filter1>
+void unfilter_pair(const unsigned char* raw0, const unsigned char* raw1, const unsigned char* prior,
+                   unsigned char* out0, unsigned char* out1, std::size_t n) {
+    constexpr std::size_t kTrail = 4 * bpp;
+    Chain s0, s1;
+    std::size_t i = 0;
+    for (; i < kTrail && i + 4 <= n; i += bpp) unfilter_pixel<bpp, filter0>(raw0 + i, prior + i, out0 + i, s0);
+    for (; i + 4 <= n; i += bpp) {
+        unfilter_pixel<bpp, filter0>(raw0 + i, prior + i, out0 + i, s0);
+        unfilter_pixel<bpp, filter1>(raw1 + i - kTrail, out0 + i - kTrail, out1 + i - kTrail, s1);
+    }
+    int a[bpp] = {}, c[bpp] = {};
+    s0.to_ints<bpp>(a, c);
+    unfilter_left<bpp, filter0>(raw0, prior, out0, i, n, a, c);
+    const std::size_t i1 = unfilter_sse2<bpp, filter1>(raw1, out0, out1, i < kTrail ? 0 : i - kTrail, n, s1);
+    s1.to_ints<bpp>(a, c);
+    unfilter_left<bpp, filter1>(raw1, out0, out1, i1, n, a, c);
 }
 #endif
 
@@ -149,7 +186,11 @@ void unfilter_pixels(const unsigned char* __restrict raw, const unsigned char* _
     int a[bpp] = {}, c[bpp] = {};
     std::size_t first = 0;
 #if defined(__SSE2__)
-    if constexpr (filter != 1 && bpp > 1) first = unfilter_sse2<bpp, filter>(raw, prior, out, n, a, c);
+    if constexpr (filter != 1 && bpp > 1) {
+        Chain s;
+        first = unfilter_sse2<bpp, filter>(raw, prior, out, 0, n, s);
+        s.to_ints<bpp>(a, c);
+    }
 #endif
     unfilter_left<bpp, filter>(raw, prior, out, first, n, a, c);
 }
@@ -177,16 +218,47 @@ void unfilter_row(int filter, const unsigned char* __restrict raw, const unsigne
     }
 }
 
+/// Rows y and y + 1 by unfilter_pair when both are under Average or Paeth (on 2- and 3-byte
+/// pixels, with SSE2: most rows of a frame's depth and colour); false otherwise.
+template <int bpp>
+bool unfilter_two_rows(int filter0, int filter1, const unsigned char* raw0, const unsigned char* raw1,
+                       const unsigned char* prior, unsigned char* out0, unsigned char* out1, std::size_t n) {
+#if defined(__SSE2__)
+    if constexpr (bpp > 1) {
+        const int both = filter0 * 8 + filter1;
+        switch (both) {
+            case 3 * 8 + 3: unfilter_pair<bpp, 3, 3>(raw0, raw1, prior, out0, out1, n); return true;
+            case 3 * 8 + 4: unfilter_pair<bpp, 3, 4>(raw0, raw1, prior, out0, out1, n); return true;
+            case 4 * 8 + 3: unfilter_pair<bpp, 4, 3>(raw0, raw1, prior, out0, out1, n); return true;
+            case 4 * 8 + 4: unfilter_pair<bpp, 4, 4>(raw0, raw1, prior, out0, out1, n); return true;
+            default: return false;
+        }
+    }
+#endif
+    (void)filter0, (void)filter1, (void)raw0, (void)raw1, (void)prior, (void)out0, (void)out1, (void)n;
+    return false;
+}
+
 template <int bpp>
 bool unfilter_rows(const unsigned char* in, std::size_t height, std::size_t row_bytes, unsigned char* out,
                    const unsigned char* zeros) {
     const unsigned char* prior = zeros;
-    for (std::size_t y = 0; y < height; ++y) {
+    for (std::size_t y = 0; y < height;) {
         const unsigned char* const row = in + y * (row_bytes + 1);
-        if (row[0] > 4) return false;
         unsigned char* const dst = out + y * row_bytes;
+        if (row[0] > 4) return false;
+        if (y + 1 < height) {
+            const unsigned char* const next = row + row_bytes + 1;
+            if (next[0] > 4) return false;
+            if (unfilter_two_rows<bpp>(row[0], next[0], row + 1, next + 1, prior, dst, dst + row_bytes, row_bytes)) {
+                prior = dst + row_bytes;
+                y += 2;
+                continue;
+            }
+        }
         unfilter_row<bpp>(row[0], row + 1, prior, dst, row_bytes);
         prior = dst;
+        ++y;
     }
     return true;
 }

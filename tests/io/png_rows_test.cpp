@@ -160,8 +160,9 @@ TEST(PngRows, EveryFilterType_EveryKind_ThePixelsTheyWereMadeOf) {
     }
 }
 
+// And rows too short for the lower of two rows to trail the upper by its 4 pixels (3, 5).
 TEST(PngRows, OnePixelWideAndOneRowHigh) {
-    for (const auto& [w, h] : {std::pair{1, 9}, std::pair{9, 1}, std::pair{1, 1}}) {
+    for (const auto& [w, h] : {std::pair{1, 9}, std::pair{9, 1}, std::pair{1, 1}, std::pair{3, 6}, std::pair{5, 5}}) {
         for (const int bpp : {1, 2, 3}) {
             const auto rows = random_rows(w, h, bpp, static_cast<unsigned>(w * 10 + h + bpp));
             const std::string png = png_file(w, h, bpp == 2 ? 16 : 8, bpp == 3 ? 2 : 0,
