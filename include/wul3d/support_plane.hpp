@@ -33,6 +33,8 @@ struct PlaneResult {
     bool found = false;           ///< false: no support; every active point is kept
     Plane support;                ///< valid when found
     std::vector<Plane> candidates;  ///< every merged plane that met min_extent
+    bool low_found = false;       ///< a board or tray lies on the support (its points removed)
+    Plane low_support;            ///< its top's plane, valid when low_found
     std::size_t kept = 0;         ///< pixels of class kPlaneObject or kPlaneFoot
 };
 

@@ -28,6 +28,7 @@ using PlaneBuffers = PlaneWorkspace::Buffers;
 using detail::Band;
 using detail::Grid;
 using detail::HullMask;
+using detail::InlierTest;
 using detail::make_grid;
 using detail::make_hull_mask;
 
@@ -82,37 +83,6 @@ Plane fit(const double* s) {
     p.up = -p.ny;
     return p;
 }
-
-/// A grid point is an inlier of a plane when it lies on the plane's band and its normal
-/// agrees with the plane's. No branch: a point without a usable normal holds the zero
-/// normal and fails the normal test, so loops over the grid vectorize. Reads the gathered
-/// grid (gather_grid), G points.
-struct InlierTest {
-    const float *x, *y, *z, *nx, *ny, *nz;
-    int G;
-    Band band;
-    float cos_inlier;
-
-    /// `band_share` narrows the band: refine_support parts layers on half of it.
-    bool operator()(const Plane& pl, int g, float band_share = 1.0f) const {
-        const float h = pl.nx * x[g] + pl.ny * y[g] + pl.nz * z[g] + pl.d;
-        const bool on = std::fabs(h) <= band_share * band(z[g]);
-        const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
-        return on & facing;
-    }
-    /// take(g, (*this)(pl, g)) over the whole grid. G is read once: an int that take()
-    /// stores could be G as far as the compiler knows.
-    template <class Take>
-    void for_each(const Plane& pl, Take&& take) const {
-        const int n = G;
-        for (int g = 0; g < n; ++g) take(g, (*this)(pl, g));
-    }
-    std::size_t count(const Plane& pl) const {
-        unsigned inliers = 0;
-        for_each(pl, [&](int, bool in) { inliers += static_cast<unsigned>(in); });
-        return static_cast<std::size_t>(inliers);
-    }
-};
 
 // ---------------------------------------------------------------------------------------
 // The phases of remove_support_plane, in their order. Costs: N pixels, G = N / s^2 grid
@@ -616,6 +586,10 @@ std::size_t keep_all_active(const std::vector<std::uint8_t>& active, std::vector
 
 }  // namespace
 
+bool detail::fit_grid_points(const InlierTest& grid, int min_points, const std::uint8_t* take, Plane& out) {
+    return fit_grid_subset(grid, min_points, [=](int g) { return take[g] != 0; }, out);
+}
+
 PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
                                  const OrganizedCloud& cloud, const NormalMap& normals,
                                  const std::vector<std::uint8_t>& active, PlaneWorkspace& workspace,
@@ -654,7 +628,12 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     // 6-7: every pixel classified; enclosed on-plane patches given back to the objects.
     std::size_t kept = detail::classify_pixels(grid, K, cloud, normals, active, pl, band, cos_inlier, ws, classes);
     kept += detail::restore_islands(params, cloud, active, pl, ws, classes);
-    result.kept = kept;
+
+    // 8: a board or tray lying on the support, the objects on it: background, as the support is.
+    const std::size_t low_removed =
+        detail::remove_low_support(params, grid, cloud, normals, inliers, pl, ws, classes, result.low_support);
+    result.low_found = low_removed > 0;
+    result.kept = kept - low_removed;
     return result;
 }
 

@@ -1,10 +1,12 @@
 #pragma once
 // remove_support_plane's scratch (PlaneWorkspace::Buffers) and the phases that plane.cpp and
 // plane_islands.cpp share. Private to the library.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "branch_free.hpp"
 #include "wul3d/cloud.hpp"
 #include "wul3d/plane.hpp"
 
@@ -31,6 +33,7 @@ struct PlaneWorkspace::Buffers {
     std::vector<std::uint8_t> tall_foot;  ///< per grid cell: something rises from it past
                                           ///< max_object_height_m over the candidate counted
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
+    std::vector<int> low_piece;         ///< grid points of a low support's top (remove_low_support)
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
     struct Run {
         int row, begin, end;  ///< pixels [begin, end) of the row
@@ -124,6 +127,37 @@ inline HullMask make_hull_mask(const Grid& grid, const PinholeIntrinsics& K, con
                     static_cast<float>(K.cy) * inv_s + 0.5f, pl.nx, pl.ny, pl.nz};
 }
 
+/// A grid point is an inlier of a plane when it lies on the plane's band and its normal
+/// agrees with the plane's. No branch: a point without a usable normal holds the zero
+/// normal and fails the normal test, so loops over the grid vectorize. Reads the gathered
+/// grid (gather_grid), G points.
+struct InlierTest {
+    const float *x, *y, *z, *nx, *ny, *nz;
+    int G;
+    Band band;
+    float cos_inlier;
+
+    /// `band_share` narrows the band: refine_support parts layers on half of it.
+    bool operator()(const Plane& pl, int g, float band_share = 1.0f) const {
+        const float h = pl.nx * x[g] + pl.ny * y[g] + pl.nz * z[g] + pl.d;
+        const bool on = std::fabs(h) <= band_share * band(z[g]);
+        const bool facing = nx[g] * pl.nx + ny[g] * pl.ny + nz[g] * pl.nz >= cos_inlier;
+        return on & facing;
+    }
+    /// take(g, (*this)(pl, g)) over the whole grid. G is read once: an int that take()
+    /// stores could be G as far as the compiler knows.
+    template <class Take>
+    void for_each(const Plane& pl, Take&& take) const {
+        const int n = G;
+        for (int g = 0; g < n; ++g) take(g, (*this)(pl, g));
+    }
+    std::size_t count(const Plane& pl) const {
+        unsigned inliers = 0;
+        for_each(pl, [&](int, bool in) { inliers += static_cast<unsigned>(in); });
+        return static_cast<std::size_t>(inliers);
+    }
+};
+
 /// 6. Classify every pixel (plane_pixels.cpp): below or on the plane (and facing like it)
 /// is removed; on the band but facing otherwise is a candidate foot; above and over the
 /// support is object. In: the support `pl` and its extent `ws.hull`. Out: `classes` (N,
@@ -142,6 +176,22 @@ std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const 
 std::size_t restore_islands(const PlaneParams& params, const OrganizedCloud& cloud,
                             const std::vector<std::uint8_t>& active, const Plane& pl,
                             PlaneWorkspace::Buffers& ws, std::vector<std::uint8_t>& classes);
+
+/// The least-squares plane of the grid points with take[g] != 0 into `out` (plane.cpp; the
+/// same sums on any number of threads); false (and `out` unchanged) under min_points. O(G).
+bool fit_grid_points(const InlierTest& grid, int min_points, const std::uint8_t* take, Plane& out);
+
+/// 8. A low support (plane_low_support.cpp): a board or tray lying on the support `pl`, the
+/// objects on it. Its top is the densest layer of grid points facing like `pl` over its
+/// band and at most 5 cm above it, whose largest 8-connected piece spans 0.1 m^2 on the
+/// plane (more than any object lying flat). Over that piece's extent in the image, every
+/// object pixel not above the low support's band is removed (its top, its sides, what lies
+/// under it), but those on its band facing otherwise, which become candidate feet. Out:
+/// `classes`, `low` (its plane, when found); returns the pixels removed (0: none found).
+/// O(G) for the layer and its pieces, O(N) for the pixels; OpenCV allocates the hull.
+std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, const OrganizedCloud& cloud,
+                               const NormalMap& normals, const InlierTest& inliers, const Plane& pl,
+                               PlaneWorkspace::Buffers& ws, std::vector<std::uint8_t>& classes, Plane& low);
 
 }  // namespace detail
 }  // namespace wul3d

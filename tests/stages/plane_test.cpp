@@ -625,3 +625,80 @@ TEST(RemoveSupportPlane, SamePlaneToTheBitOnAnyNumberOfThreads) {
     omp_set_num_threads(threads_before);
     EXPECT_GE(compared, 10);
 }
+
+namespace {
+
+/// A board lying on the table (`w` x `d` metres, 2 cm thick, kTruthBox0), two boxes standing
+/// on it (kTruthBox0 + 1, + 2) and one on the table beside it (kTruthBox0 + 3).
+Scene board_scene(float w, float d) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox board;
+    board.x = -0.05f;
+    board.z = 1.1f;
+    board.w = w;
+    board.d = d;
+    board.h = 0.02f;
+    board.r = board.g = board.b = 220;
+    SceneBox on_board;
+    on_board.w = on_board.h = on_board.d = 0.1f;
+    on_board.lift = board.h;
+    on_board.x = board.x - 0.06f;
+    on_board.z = board.z - 0.04f;
+    SceneBox other = on_board;
+    other.x = board.x + 0.06f;
+    other.z = board.z + 0.06f;
+    other.g = 160;
+    SceneBox beside = on_board;
+    beside.lift = 0;
+    beside.x = board.x + w / 2 + 0.15f;
+    beside.z = 0.9f;
+    beside.b = 160;
+    s.boxes = {board, on_board, other, beside};
+    return s;
+}
+
+}  // namespace
+
+// A board or tray lying on the support, objects on it (the floor family of eval/scenegen.py,
+// YCB-Video's board on a carpet): its top is a second, low support. It is removed as the
+// table is, the boxes on it and beside it kept. Too small for a support (a book, a box lying
+// flat), it stays an object.
+TEST(RemoveSupportPlane, BoardOnTheTable_RemovedAsALowSupport_ItsBoxesKept) {
+    std::vector<int> truth;
+    const Prepared f = prepared(render_scene(board_scene(0.6f, 0.45f), &truth));
+    const Removal r = remove_with_defaults(f);
+    ASSERT_TRUE(r.result.found);
+    ASSERT_TRUE(r.result.low_found);
+    const Plane& table = r.result.support;
+    const Plane& low = r.result.low_support;
+    EXPECT_GT(table.nx * low.nx + table.ny * low.ny + table.nz * low.nz, 0.999f);
+    std::size_t board = 0, board_object = 0;  // its sides' top centimetre may be feet, as the table's edge
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        if (truth[p] != kTruthBox0 || !f.active[p]) continue;
+        ++board;
+        board_object += r.classes[p] == kPlaneObject;
+    }
+    ASSERT_GT(board, 5000u);
+    EXPECT_LT(static_cast<double>(board_object) / static_cast<double>(board), 0.03);
+    double over_table = 0;  // the board's top over the table, over its pixels removed
+    std::size_t n = 0;
+    for (std::size_t p = 0; p < truth.size(); ++p) {
+        if (truth[p] != kTruthBox0 || !f.active[p] || std::fabs(low.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p])) > 0.003f)
+            continue;
+        over_table += table.height(f.cloud.x[p], f.cloud.y[p], f.cloud.z[p]);
+        ++n;
+    }
+    ASSERT_GT(n, 1000u);
+    EXPECT_NEAR(over_table / static_cast<double>(n), 0.02, 0.004);
+    for (int box = 1; box <= 3; ++box) {
+        const KeptCount k = kept_of(f, r.classes, truth, kTruthBox0 + box);
+        ASSERT_GT(k.points, 300u) << "box " << box;
+        EXPECT_GT(k.share(), 0.9) << "box " << box;
+    }
+
+    const Prepared small = prepared(render_scene(board_scene(0.25f, 0.25f), &truth));
+    const Removal s = remove_with_defaults(small);
+    ASSERT_TRUE(s.result.found);
+    EXPECT_FALSE(s.result.low_found);
+    EXPECT_GT(kept_of(small, s.classes, truth, kTruthBox0).share(), 0.9);
+}

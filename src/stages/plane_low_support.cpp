@@ -1,0 +1,180 @@
+// 8. A low support (plane_internal.hpp): a board or tray lying on the support, the objects on
+// it. Its top is a layer of points facing up a little above the support's band, larger than
+// an object; it is background as the support is, and the objects on it stand apart on it as
+// on a table.
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "plane_internal.hpp"
+
+namespace wul3d::detail {
+
+namespace {
+
+/// A low support's top lies at most this far over the support: a board, a tray's bottom, a
+/// mat (the floor family's boards are 1-3 cm thick, on carpets of up to 1.2 cm). Boxes lying
+/// flat are taller, or smaller than kMinArea.
+constexpr float kMaxHeightM = 0.05f;
+/// ... and spans at least this area (its visible top's convex hull on the plane): more than
+/// a book or a box lying flat, less than a board that holds several objects (the floor
+/// family's are 0.12-0.48 m^2).
+constexpr float kMinAreaM2 = 0.1f;
+/// A tray's rim stands round its bottom: up to kMaxHeightM over the bottom, within this many
+/// grid cells outside the convex hull of the bottom's visible piece (a rim is 1-2 cm wide).
+constexpr int kRimCells = 2;
+/// The layer's histogram: bins of 2 mm over (0, kMaxHeightM], windows of 5 bins.
+constexpr float kBinM = 0.002f;
+constexpr int kBins = static_cast<int>(kMaxHeightM / kBinM), kWindow = 2;
+
+/// The height of the densest layer of grid points facing like `pl` between its band and
+/// kMaxHeightM over it (`h` per grid point, NaN where not a candidate), or NaN under
+/// `min_points` in the layer. O(G) and O(bins).
+float densest_layer(const float* h, int G, int min_points) {
+    int histogram[kBins] = {};
+    for (int g = 0; g < G; ++g)
+        if (h[g] > 0.0f && h[g] <= kMaxHeightM) ++histogram[std::min(kBins - 1, static_cast<int>(h[g] / kBinM))];
+    int best = -1, best_count = min_points - 1;
+    for (int c = 0; c < kBins; ++c) {
+        int count = 0;
+        for (int b = std::max(0, c - kWindow); b <= std::min(kBins - 1, c + kWindow); ++b) count += histogram[b];
+        if (count > best_count) {
+            best_count = count;
+            best = c;
+        }
+    }
+    return best < 0 ? std::nanf("") : (static_cast<float>(best) + 0.5f) * kBinM;
+}
+
+/// The largest 8-connected piece of the grid points with in[g] != 0: its points' indices
+/// into `piece`. `label` (G) and `stack` are scratch. O(G).
+void largest_piece(const Grid& grid, const std::vector<std::uint8_t>& in, std::vector<int>& label,
+                   std::vector<int>& stack, std::vector<int>& piece) {
+    const int G = grid.size();
+    label.assign(static_cast<std::size_t>(G), -1);
+    piece.clear();
+    std::vector<int>& current = stack;  // reused: the flood's stack holds each piece's points
+    for (int seed = 0, id = 0; seed < G; ++seed) {
+        if (!in[seed] || label[seed] >= 0) continue;
+        current.clear();
+        current.push_back(seed);
+        label[seed] = id;
+        for (std::size_t k = 0; k < current.size(); ++k) {
+            const int g = current[k], gu = g % grid.w, gv = g / grid.w;
+            for (int dv = -1; dv <= 1; ++dv)
+                for (int du = -1; du <= 1; ++du) {
+                    const int u = gu + du, v = gv + dv;
+                    if (u < 0 || v < 0 || u >= grid.w || v >= grid.h) continue;
+                    const int q = v * grid.w + u;
+                    if (!in[q] || label[q] >= 0) continue;
+                    label[q] = id;
+                    current.push_back(q);
+                }
+        }
+        if (current.size() > piece.size()) piece = current;
+        ++id;
+    }
+}
+
+/// The area of the convex hull of `piece`'s points moved onto the plane `pl`, in m^2.
+double area_on_plane(const PlaneWorkspace::Buffers::GridPoints& gp, const std::vector<int>& piece,
+                     const Plane& pl) {
+    // Two axes in the plane: any direction not along the normal, made orthogonal.
+    const cv::Vec3f n(pl.nx, pl.ny, pl.nz);
+    const cv::Vec3f a = std::fabs(n[0]) < 0.9f ? cv::Vec3f(1, 0, 0) : cv::Vec3f(0, 1, 0);
+    const cv::Vec3f e1 = cv::normalize(a - n * a.dot(n)), e2 = n.cross(e1);
+    std::vector<cv::Point2f> points, hull;
+    points.reserve(piece.size());
+    for (const int g : piece) {
+        const cv::Vec3f p(gp.x[g], gp.y[g], gp.z[g]);
+        points.emplace_back(p.dot(e1), p.dot(e2));
+    }
+    if (points.size() < 3) return 0;
+    cv::convexHull(points, hull);
+    return cv::contourArea(hull);
+}
+
+}  // namespace
+
+std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, const OrganizedCloud& cloud,
+                               const NormalMap& normals, const InlierTest& inliers, const Plane& pl,
+                               PlaneWorkspace::Buffers& ws, std::vector<std::uint8_t>& classes, Plane& low) {
+    const int G = grid.size();
+    const auto& gp = ws.grid;
+    // 1. The layer: grid points facing like the support, over its band, up to kMaxHeightM.
+    ws.layer_t.resize(static_cast<std::size_t>(G));
+    float* const h = ws.layer_t.data();
+    for (int g = 0; g < G; ++g) {
+        const float height = pl.height(gp.x[g], gp.y[g], gp.z[g]);
+        const bool facing = gp.nx[g] * pl.nx + gp.ny[g] * pl.ny + gp.nz[g] * pl.nz >= inliers.cos_inlier;
+        h[g] = facing && gp.usable[g] && height > inliers.band(gp.z[g]) ? height : std::nanf("");
+    }
+    const float layer = densest_layer(h, G, params.min_region_points);
+    if (std::isnan(layer)) return 0;
+    // 2. Its largest piece, large enough on the plane.
+    ws.tall_foot.assign(static_cast<std::size_t>(G), 0);  // scratch: the layer's points
+    for (int g = 0; g < G; ++g)
+        ws.tall_foot[static_cast<std::size_t>(g)] = std::fabs(h[g] - layer) <= inliers.band(gp.z[g]);
+    largest_piece(grid, ws.tall_foot, ws.region, ws.stack, ws.low_piece);
+    if (static_cast<int>(ws.low_piece.size()) < params.min_region_points ||
+        area_on_plane(gp, ws.low_piece, pl) < kMinAreaM2)
+        return 0;
+    // 3. Its plane, fitted to the piece, then again to the largest piece of that plane's
+    // inliers (the layer's heights were over the support, which need not be quite parallel).
+    for (int round = 0; round < 2; ++round) {
+        ws.tall_foot.assign(static_cast<std::size_t>(G), 0);
+        for (const int g : ws.low_piece) ws.tall_foot[static_cast<std::size_t>(g)] = 1;
+        if (!fit_grid_points(inliers, params.min_region_points, ws.tall_foot.data(), low)) return 0;
+        if (round == 1) break;
+        for (int g = 0; g < G; ++g) ws.tall_foot[static_cast<std::size_t>(g)] = gp.usable[g] && inliers(low, g);
+        largest_piece(grid, ws.tall_foot, ws.region, ws.stack, ws.low_piece);
+    }
+    // Its extent in the image: the piece's convex hull on the grid, a cell wider.
+    std::vector<cv::Point> cells;
+    cells.reserve(ws.low_piece.size());
+    for (const int g : ws.low_piece) cells.emplace_back(g % grid.w, g / grid.w);
+    std::vector<cv::Point> corners;
+    cv::convexHull(cells, corners);
+    cv::Mat hull = cv::Mat::zeros(grid.h, grid.w, CV_8U), extent;
+    cv::fillConvexPoly(hull, corners, cv::Scalar(1));
+    cv::dilate(hull, extent, cv::Mat::ones(2 * kRimCells + 1, 2 * kRimCells + 1, CV_8U));
+    // 4. It holds objects: min_region_points grid points stand over its extent, clear of its
+    // band (books lying side by side, with nothing on them, are objects, not a support).
+    int standing = 0;
+    for (int g = 0; g < G; ++g) {
+        if (!gp.active[g] || !extent.data[g]) continue;
+        const float hl = low.height(gp.x[g], gp.y[g], gp.z[g]);
+        standing += hl > 2.0f * inliers.band(gp.z[g]) && hl <= params.max_object_height_m;
+    }
+    if (standing < params.min_region_points) return 0;
+    // 5. Every object pixel over that extent that is not above the low support's band: its
+    // top (facing like it), its sides and what lies between it and the support are removed;
+    // on its band but facing otherwise, a candidate foot, as on the support.
+    const int W = cloud.width, H = cloud.height;
+    std::size_t removed = 0;
+    for (int v = 0; v < H; ++v) {
+        const std::uint8_t* const cell_row = extent.ptr<std::uint8_t>(v / grid.s);
+        const std::uint8_t* const hull_row = hull.ptr<std::uint8_t>(v / grid.s);
+        for (int u = 0; u < W; ++u) {
+            const std::size_t p = static_cast<std::size_t>(v) * W + u;
+            if (classes[p] != kPlaneObject || !cell_row[u / grid.s]) continue;
+            const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z), band = inliers.band(z);
+            const bool rim = !hull_row[u / grid.s] && hl <= kMaxHeightM;  // round the bottom: a tray's rim
+            if (hl > band && !rim) continue;
+            const bool facing = normals.valid[p] &&
+                                normals.nx[p] * low.nx + normals.ny[p] * low.ny + normals.nz[p] * low.nz >=
+                                    inliers.cos_inlier;
+            if (!rim && hl >= -band && !facing && normals.valid[p]) {
+                classes[p] = kPlaneFoot;
+                continue;
+            }
+            classes[p] = kPlaneRemoved;
+            ++removed;
+        }
+    }
+    return removed;
+}
+
+}  // namespace wul3d::detail
