@@ -178,6 +178,23 @@ Scene small_box_before_tall_box() {
     return s;
 }
 
+Scene board_on_table_scene(float w, float d) {
+    Scene s = pitched_tabletop_scene();
+    const SceneBox board{.x = -0.05f, .z = 1.1f, .w = w, .h = 0.02f, .d = d, .r = 220, .g = 220, .b = 220};
+    const SceneBox on_board{.x = board.x - 0.06f, .z = board.z - 0.04f, .w = 0.1f, .h = 0.1f, .d = 0.1f, .lift = board.h};
+    SceneBox other = on_board;
+    other.x = board.x + 0.06f;
+    other.z = board.z + 0.06f;
+    other.g = 160;
+    SceneBox beside = on_board;
+    beside.lift = 0;
+    beside.x = board.x + w / 2 + 0.15f;
+    beside.z = 0.9f;
+    beside.b = 160;
+    s.boxes = {board, on_board, other, beside};
+    return s;
+}
+
 LabelImage blank_labels(int w, int h) {
     LabelImage l;
     l.width = w;

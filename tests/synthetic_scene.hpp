@@ -65,6 +65,11 @@ Scene pitched_tabletop_scene();
 /// its back face against the tall one's front face: a concave junction.
 Scene small_box_before_tall_box();
 
+/// pitched_tabletop_scene() with a board lying on the table (`w` x `d` metres, 2 cm thick,
+/// kTruthBox0), two boxes standing on it (kTruthBox0 + 1, + 2) and one on the table beside
+/// it (kTruthBox0 + 3): a low support (DESIGN.md, "Support plane").
+Scene board_on_table_scene(float w, float d);
+
 /// A w x h label image, all 0.
 LabelImage blank_labels(int w, int h);
 /// Sets the pixels u0 <= u <= u1, v0 <= v <= v1 (inclusive) to `id`.

@@ -190,6 +190,7 @@ py::dict stats_dict(const Result& r) {
     out["texture_splits"] = r.segment_stats.colour.texture_splits;
     out["stack_splits"] = r.segment_stats.stacks.splits;
     out["piece_splits"] = r.segment_stats.pieces.splits;
+    out["low_support"] = r.plane.low_found;
     return out;
 }
 

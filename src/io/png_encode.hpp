@@ -10,8 +10,8 @@ namespace wul3d::detail {
 /// What an image holds, which decides how it is compressed.
 enum class PngContent {
     /// Labels and masks: areas of one value, most rows like the one above. The Up filter
-    /// leaves runs of zeros, which a run-length deflate takes at memory speed (a tenth of
-    /// zlib's fastest level on a frame's labels, for files about twice as large).
+    /// leaves runs of zeros, which a run-length deflate takes at memory speed (for files about
+    /// twice as large as zlib's run-length level writes).
     Regions,
     /// Colours and depth: no long runs. libdeflate's fastest level on the unfiltered rows
     /// (faster than any filter and zlib's fastest level, and smaller files).

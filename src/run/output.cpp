@@ -251,10 +251,15 @@ std::string objects_json(const FrameResult& r, int selected_id) {
     }
     nlohmann::json j = {{"objects", objs},
                         {"scope", r.segment_stats.scope.applied ? "support" : "scene"},
-                        {"support_plane", nullptr}};
+                        {"support_plane", nullptr},
+                        {"low_support", nullptr}};
     if (r.plane.found) {
         const Plane& pl = r.plane.support;
         j["support_plane"] = {{"normal", {pl.nx, pl.ny, pl.nz}}, {"d_m", pl.d}};
+    }
+    if (r.plane.low_found) {
+        const Plane& pl = r.plane.low_support;
+        j["low_support"] = {{"normal", {pl.nx, pl.ny, pl.nz}}, {"d_m", pl.d}};
     }
     return json_text(j, 1) + "\n";
 }

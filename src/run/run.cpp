@@ -70,6 +70,7 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"normal_radius_px", r.normal_radius_px},
             {"ms", r.times.total()},
             {"support_plane", r.plane.found},
+            {"low_support", r.plane.low_found},
             {"segments", r.segment_stats.segments},
             {"merges", r.segment_stats.merge.joins},
             {"containers", r.segment_stats.containers.joins},

@@ -44,6 +44,7 @@ def assert_same_as_cli(results, out_dir):
             np.testing.assert_array_equal(np.float32(r.plane["normal"]),
                                           np.float32(doc["support_plane"]["normal"]))
             assert np.float32(r.plane["d_m"]) == np.float32(doc["support_plane"]["d_m"])
+        assert r.stats["low_support"] == (doc["low_support"] is not None)
 
 
 def test_tabletop_frames_equal_wul3d_run(tabletop_cli_out):
@@ -79,7 +80,7 @@ def test_result_fields():
     assert r.stats["active_points"] > 0
     assert r.stats["segments"] >= len(r.instances) > 0
     assert {"merges", "containers", "occluded_joins", "gaps_filled", "color_splits", "texture_splits", "stack_splits",
-            "piece_splits"} <= set(r.stats)
+            "piece_splits", "low_support"} <= set(r.stats)
     assert pipeline.params["k"] == 7 and pipeline.params["decimate"] == 2
     # The result owns its arrays: the next frame does not change it.
     before = r.labels.copy()

@@ -3,15 +3,19 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <map>
 #include <set>
 #include <string>
 
 #include "stages/side_by_side.hpp"  // src/stages/: the pipeline's private choice, tested here
+#include "synthetic_scene.hpp"
 #include "test_support.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/io.hpp"
+#include "wul3d/output.hpp"
 
 using namespace wul3d;
 using namespace wul3d::test;
@@ -463,3 +467,31 @@ TEST(GeneratedScene, CylinderBehindABox_NotJoinedAsItsInside) {
 }
 
 #endif
+
+// A board lying on the table with boxes on it (DESIGN.md, "Support plane": a low support),
+// through the whole pipeline at 640x480 and the default decimation: the board is background,
+// each box on it an object of its own, and objects.json gives the board's plane.
+TEST(Pipeline, BoardOnTheTable_BackgroundUnderItsBoxes_InObjectsJson) {
+    Scene s = board_on_table_scene(0.6f, 0.45f);
+    s.width = 640;
+    s.height = 480;
+    std::vector<int> truth;
+    const RgbdFrame frame = render_scene(s, &truth);
+    Pipeline pipeline{PipelineParams{}};
+    const FrameResult r = pipeline.process(frame);
+    ASSERT_TRUE(r.plane.found);
+    ASSERT_TRUE(r.plane.low_found);
+    const std::vector<std::uint16_t>& objects = r.objects.labels;
+    int board_label = -1, first = -1, second = -1;
+    EXPECT_GT(dominant_share(objects, truth, kTruthBox0, &board_label), 0.9);
+    EXPECT_EQ(board_label, 0);
+    EXPECT_GT(dominant_share(objects, truth, kTruthBox0 + 1, &first), 0.8);
+    EXPECT_GT(dominant_share(objects, truth, kTruthBox0 + 2, &second), 0.8);
+    EXPECT_NE(first, 0);
+    EXPECT_NE(second, 0);
+    EXPECT_NE(first, second);
+    const nlohmann::json doc = nlohmann::json::parse(objects_json(r));
+    ASSERT_TRUE(doc["low_support"].is_object());
+    EXPECT_FLOAT_EQ(doc["low_support"]["d_m"].get<float>(), r.plane.low_support.d);
+    EXPECT_FLOAT_EQ(doc["low_support"]["normal"][1].get<float>(), r.plane.low_support.ny);
+}

@@ -626,38 +626,6 @@ TEST(RemoveSupportPlane, SamePlaneToTheBitOnAnyNumberOfThreads) {
     EXPECT_GE(compared, 10);
 }
 
-namespace {
-
-/// A board lying on the table (`w` x `d` metres, 2 cm thick, kTruthBox0), two boxes standing
-/// on it (kTruthBox0 + 1, + 2) and one on the table beside it (kTruthBox0 + 3).
-Scene board_scene(float w, float d) {
-    Scene s = pitched_tabletop_scene();
-    SceneBox board;
-    board.x = -0.05f;
-    board.z = 1.1f;
-    board.w = w;
-    board.d = d;
-    board.h = 0.02f;
-    board.r = board.g = board.b = 220;
-    SceneBox on_board;
-    on_board.w = on_board.h = on_board.d = 0.1f;
-    on_board.lift = board.h;
-    on_board.x = board.x - 0.06f;
-    on_board.z = board.z - 0.04f;
-    SceneBox other = on_board;
-    other.x = board.x + 0.06f;
-    other.z = board.z + 0.06f;
-    other.g = 160;
-    SceneBox beside = on_board;
-    beside.lift = 0;
-    beside.x = board.x + w / 2 + 0.15f;
-    beside.z = 0.9f;
-    beside.b = 160;
-    s.boxes = {board, on_board, other, beside};
-    return s;
-}
-
-}  // namespace
 
 // A board or tray lying on the support, objects on it (the floor family of eval/scenegen.py,
 // YCB-Video's board on a carpet): its top is a second, low support. It is removed as the
@@ -665,7 +633,7 @@ Scene board_scene(float w, float d) {
 // flat), it stays an object.
 TEST(RemoveSupportPlane, BoardOnTheTable_RemovedAsALowSupport_ItsBoxesKept) {
     std::vector<int> truth;
-    const Prepared f = prepared(render_scene(board_scene(0.6f, 0.45f), &truth));
+    const Prepared f = prepared(render_scene(board_on_table_scene(0.6f, 0.45f), &truth));
     const Removal r = remove_with_defaults(f);
     ASSERT_TRUE(r.result.found);
     ASSERT_TRUE(r.result.low_found);
@@ -696,7 +664,7 @@ TEST(RemoveSupportPlane, BoardOnTheTable_RemovedAsALowSupport_ItsBoxesKept) {
         EXPECT_GT(k.share(), 0.9) << "box " << box;
     }
 
-    const Prepared small = prepared(render_scene(board_scene(0.25f, 0.25f), &truth));
+    const Prepared small = prepared(render_scene(board_on_table_scene(0.25f, 0.25f), &truth));
     const Removal s = remove_with_defaults(small);
     ASSERT_TRUE(s.result.found);
     EXPECT_FALSE(s.result.low_found);
