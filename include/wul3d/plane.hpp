@@ -20,7 +20,9 @@ namespace wul3d {
 struct PlaneParams {
     int grid_stride_px = 4;        ///< planes are grown on every n-th pixel in u and v; [1, 32]
     float grow_angle_deg = 12.0f;  ///< a grid point joins a region when its normal is within
-                                   ///< this of the region's mean normal; (0, 90)
+                                   ///< this of the region's mean normal; (0, 90). The
+                                   ///< pipeline widens it with the depth's noise, at most
+                                   ///< 1.5 times (docs/DESIGN.md, "Support plane")
     float grow_dist_m = 0.012f;    ///< ... and it lies within this of the region's plane; > 0
     int min_region_points = 40;    ///< grid points of a region worth fitting; >= 3
     float merge_angle_deg = 6.0f;  ///< regions this parallel ...; (0, 90)

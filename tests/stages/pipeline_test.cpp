@@ -410,6 +410,47 @@ TEST(GeneratedScene, NoisyActiveStereoDepth_TheMeasuredNoiseWidensTheNormalsAndF
     EXPECT_LT(static_cast<double>(in_object), 0.05 * static_cast<double>(table));
 }
 
+// A generated tabletop (eval/scenegen.py tune seed 13) under the active-stereo camera, the
+// table seen from 0.7 to 2 m: its noise grows with z^2, and the far table's normals tilt past
+// the plane's grow angle even at the radius the frame's noise chooses. With the angle of a
+// quiet camera no support is found and the table comes out as objects. The grow angle widens
+// with the measured noise past what the least normal radius takes, here 1.5 times: given as
+// 8 degrees (widened to 12) the table is missed; given as the default 12, it is the support.
+TEST(GeneratedScene, NoisyActiveStereoDepth_TheGrowAngleWidensAndTheFarTableIsTheSupport) {
+    TempDir dir;
+    const GeneratedFrame g = render_generated(dir, 13, "active_stereo");
+    std::set<int> truth_objects;
+    for (const std::uint16_t t : g.truth.labels)
+        if (t != 0) truth_objects.insert(t);
+    ASSERT_GE(truth_objects.size(), 5u);
+    auto run = [&](float grow_angle_deg) {
+        PipelineParams params;
+        params.plane.grow_angle_deg = grow_angle_deg;
+        Pipeline pipeline(params);
+        return pipeline.process(g.frame);
+    };
+    // The share of the table's pixels (truth 0: the table and what is not an object) in objects.
+    auto table_in_objects = [&](const FrameResult& r) {
+        std::size_t table = 0, in_object = 0;
+        for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
+            if (g.truth.labels[p] != 0) continue;
+            ++table;
+            in_object += r.objects.labels[p] != 0;
+        }
+        return static_cast<double>(in_object) / static_cast<double>(table);
+    };
+    const FrameResult narrow = run(PlaneParams{}.grow_angle_deg / 1.5f);
+    ASSERT_FALSE(narrow.plane.found) << "12 degrees should miss the table (test premise)";
+    ASSERT_GT(table_in_objects(narrow), 0.5);
+    const FrameResult r = run(PlaneParams{}.grow_angle_deg);
+    EXPECT_GT(r.depth_noise_px, 0.65f);  // 1.5 times the noise the least radius takes
+    ASSERT_TRUE(r.plane.found);
+    EXPECT_LT(table_in_objects(r), 0.05);
+    std::size_t found = 0;  // objects that one predicted object holds the most of
+    for (const int t : truth_objects) found += dominant_object(r.objects, g.truth, t).second > 0.5;
+    EXPECT_GE(found, truth_objects.size() - 2);
+}
+
 // A generated scene (eval/scenegen.py tune seed 23): two plain boxes flush side by side, one
 // hue, a light one and a dark one (chromaticities 17 apart, brightness 344 against 223).
 // Their contact crosses their shared top and front planes, and the boundary runs along the
