@@ -36,7 +36,8 @@ struct PlaneParams {
     float min_up = 0.1f;           ///< a support faces up in the image: -n_y >= min_up (y is
                                    ///< down; a wall facing a camera that looks down has
                                    ///< n_y >= 0, a floor cos(pitch): 0.1 takes a camera
-                                   ///< looking down up to 84 degrees); [-1, 1]
+                                   ///< looking down up to 84 degrees; when none does, a
+                                   ///< plane facing any way that holds objects); [-1, 1]
     float max_object_height_m = 0.5f;  ///< points up to this height over the support count as
                                        ///< standing on it; > 0
     float island_min_height_m = 0.0025f;  ///< an on-plane patch enclosed by object points (a

@@ -388,7 +388,8 @@ struct SupportChoice {
     int hull_of = -1;  ///< the candidate whose extent ws.hull holds, -1 none
 };
 
-/// 4. The support: among planes that face up, the one that carries most: score = points
+/// 4. The support: among planes that face up (any way, with `any_facing`, but then holding
+/// min_region_points at least), the one that carries most: score = points
 /// standing on it (at most its extent; none where something taller than an object rises from
 /// the same foot) + 0.1 x its extent. A candidate scores at most
 /// 1.1 x its extent, so once one scores more, smaller candidates are not counted (each
@@ -398,7 +399,7 @@ struct SupportChoice {
 /// O(C log C) to rank, mark_slivers, then O(G) (a hull, a pass and a parallel pass) per
 /// candidate counted, usually one or two.
 SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics& K, const Grid& grid,
-                             const GridEdges& edges, const InlierTest& inliers, PlaneBuffers& ws,
+                             const GridEdges& edges, const InlierTest& inliers, bool any_facing, PlaneBuffers& ws,
                              std::vector<Plane>& candidates) {
     const int G = grid.size();
     const auto& gp = ws.grid;
@@ -416,7 +417,7 @@ SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics&
     for (std::size_t rank = 0; rank < ws.by_extent.size(); ++rank) {
         const int c = ws.by_extent[rank];
         Plane& pl = candidates[static_cast<std::size_t>(c)];
-        if (pl.up < params.min_up || (rank < ws.sliver.size() && ws.sliver[rank])) continue;
+        if ((!any_facing && pl.up < params.min_up) || (rank < ws.sliver.size() && ws.sliver[rank])) continue;
         const double extent = static_cast<double>(pl.inliers);
         if (extent + 0.1 * extent < best_score) break;  // the score's largest value, as computed
         build_hull(params, grid, edges, inliers, pl, ws);
@@ -447,6 +448,7 @@ SupportChoice choose_support(const PlaneParams& params, const PinholeIntrinsics&
             above += cell >= 0 && hull.mask[cell] != 0 && tall[cell] == 0;
         }
         pl.above = above;
+        if (any_facing && above < static_cast<std::size_t>(params.min_region_points)) continue;
         // Points standing on a plane count up to its own extent (a small tilted plane, a box
         // top, has half the room "above" it); extent alone breaks ties (the floor of an
         // uncropped scene is often larger than the table, but little stands on it).
@@ -612,7 +614,10 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     fit_candidates(params, roots, grown.with_normal, inliers, ws, result.candidates);
 
     // 4-5: the support among them, refined.
-    const SupportChoice choice = choose_support(params, K, grid, edges, inliers, ws, result.candidates);
+    // Among the planes that face up in the image; when none does (a camera looking straight
+    // down, to which the table faces as a wall would), among those that hold objects.
+    SupportChoice choice = choose_support(params, K, grid, edges, inliers, false, ws, result.candidates);
+    if (choice.best < 0) choice = choose_support(params, K, grid, edges, inliers, true, ws, result.candidates);
     if (choice.best < 0) {
         result.kept = keep_all_active(active, classes);
         return result;

@@ -218,11 +218,9 @@ TEST(RemoveSupportPlane, CameraLookingAlmostStraightDown_TheTableIsTheSupport) {
     Prepared f = prepared(render_scene(s, &truth));
     PlaneWorkspace ws;
     std::vector<std::uint8_t> classes;
-    PlaneParams old_facing;
-    old_facing.min_up = 0.25f;
-    ASSERT_FALSE(f.remove_plane(old_facing, ws, classes).found) << "-n_y >= 0.25 should refuse it (test premise)";
     const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes);
     ASSERT_TRUE(r.found);
+    EXPECT_GE(r.support.up, PlaneParams{}.min_up);  // taken as facing up
     EXPECT_NEAR(r.support.ny, -std::cos(s.pitch_rad), 0.02f);
     EXPECT_NEAR(r.support.nz, -std::sin(s.pitch_rad), 0.02f);
     std::size_t table = 0, table_kept = 0, box = 0, box_kept = 0;
@@ -294,6 +292,33 @@ TEST(RemoveSupportPlane, BoxInTheFramesNearCorner_KeptWhereTheTableRunsOutOnBoth
     EXPECT_GT(box.share(), 0.97);
 }
 
+// A camera looking straight down on the table (OCID's and the pile family's steepest views):
+// the table faces the camera as a wall would, up in the image by nothing. No plane faces up,
+// and among those that face any way, the one that holds the box is the support.
+TEST(RemoveSupportPlane, CameraLookingStraightDown_TheTableHoldingTheBoxIsTheSupport) {
+    Scene s = pitched_tabletop_scene();
+    s.pitch_rad = 90.0f * 3.14159265f / 180.0f;
+    s.table_y = 1.0f;
+    s.table_near = -0.8f;
+    s.table_far = 0.8f;
+    s.table_half_width = 1.0f;
+    SceneBox a;
+    a.x = 0.1f;
+    a.z = 0.1f;
+    s.boxes = {a};
+    std::vector<int> truth;
+    Prepared f = prepared(render_scene(s, &truth));
+    const Removal r = remove_with_defaults(f);
+    ASSERT_TRUE(r.result.found);
+    EXPECT_LT(r.result.support.up, PlaneParams{}.min_up) << "the fallback to any facing took it";
+    EXPECT_NEAR(r.result.support.nz, -1.0f, 0.02f);
+    EXPECT_LT(kept_of(f, r.classes, truth, kTruthTable).share(), 0.005);
+    const KeptCount box = kept_of(f, r.classes, truth, kTruthBox0);
+    ASSERT_GT(box.points, 500u);
+    EXPECT_GT(box.share(), 0.95);
+}
+
+// Only a wall in view, nothing in front of it: no plane faces up, and none holds anything.
 TEST(RemoveSupportPlane, NoUpFacingPlane_KeepsEveryActivePoint) {
     // Only a wall in view: nothing faces up, so there is no support.
     Scene s;
