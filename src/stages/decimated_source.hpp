@@ -94,7 +94,6 @@ private:
     const std::uint16_t* small_;
     int W_, H_, w_, h_, factor_;
     float same_, same_rel_;  ///< in the depth images' units
-    float scale_;            ///< metres per depth unit
     const std::uint8_t* rgb_ = nullptr;        ///< input colour, with use_colour_at_edges
     const std::uint8_t* small_rgb_ = nullptr;  ///< decimated colour
     const std::uint8_t* edges_ = nullptr;      ///< edge blocks

@@ -156,8 +156,7 @@ DecimatedSource::DecimatedSource(const std::uint16_t* input, int width, int heig
       factor_(factor),
       // Depths compared in the images' units: metres = units * scale.
       same_(same_m / scale_m_per_unit),
-      same_rel_(same_rel * scale_m_per_unit),
-      scale_(scale_m_per_unit) {
+      same_rel_(same_rel * scale_m_per_unit) {
     if (factor < 1 || w_ != (W_ + factor - 1) / factor ||
         h_ != (H_ + factor - 1) / factor ||
         decimated.data.size() != static_cast<std::size_t>(w_) * h_)
