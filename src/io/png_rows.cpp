@@ -239,6 +239,8 @@ bool unfilter_two_rows(int filter0, int filter1, const unsigned char* raw0, cons
     return false;
 }
 
+/// The `height` inflated rows at `in` (each its filter byte, then row_bytes) unfiltered into
+/// `out`, two at a time where unfilter_two_rows takes them; false for a filter type past 4.
 template <int bpp>
 bool unfilter_rows(const unsigned char* in, std::size_t height, std::size_t row_bytes, unsigned char* out,
                    const unsigned char* zeros) {
