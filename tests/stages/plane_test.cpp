@@ -200,20 +200,31 @@ TEST(RemoveSupportPlane, TiltedTable_RemovesTableKeepsBoxesAndTheirFeet) {
     }
 }
 
+namespace {
+
+/// A camera 1 m over a wide table, pitched down by `pitch_deg`, the table from 0.8 m behind
+/// it to `table_far` before it, one box (kTruthBox0) at x = 0.1 m, z = `box_z`.
+Scene looking_down_scene(float pitch_deg, float table_far, float box_z) {
+    Scene s = pitched_tabletop_scene();
+    s.pitch_rad = pitch_deg * 3.14159265f / 180.0f;
+    s.table_y = 1.0f;
+    s.table_near = -0.8f;
+    s.table_far = table_far;
+    s.table_half_width = 1.0f;
+    SceneBox a;
+    a.x = 0.1f;
+    a.z = box_z;
+    s.boxes = {a};
+    return s;
+}
+
+}  // namespace
+
 // A camera looking down at 80 degrees (an OCID-like pile seen from above): the table faces
 // up in the image only by cos 80 = 0.17, which the support's facing test must still take,
 // while a wall facing any camera that looks down has -n_y <= 0.
 TEST(RemoveSupportPlane, CameraLookingAlmostStraightDown_TheTableIsTheSupport) {
-    Scene s = pitched_tabletop_scene();
-    s.pitch_rad = 80.0f * 3.14159265f / 180.0f;
-    s.table_y = 1.0f;
-    s.table_near = -0.8f;
-    s.table_far = 1.2f;
-    s.table_half_width = 1.0f;
-    SceneBox a;
-    a.x = 0.1f;
-    a.z = 0.2f;
-    s.boxes = {a};
+    const Scene s = looking_down_scene(80.0f, 1.2f, 0.2f);
     std::vector<int> truth;
     Prepared f = prepared(render_scene(s, &truth));
     PlaneWorkspace ws;
@@ -296,16 +307,7 @@ TEST(RemoveSupportPlane, BoxInTheFramesNearCorner_KeptWhereTheTableRunsOutOnBoth
 // the table faces the camera as a wall would, up in the image by nothing. No plane faces up,
 // and among those that face any way, the one that holds the box is the support.
 TEST(RemoveSupportPlane, CameraLookingStraightDown_TheTableHoldingTheBoxIsTheSupport) {
-    Scene s = pitched_tabletop_scene();
-    s.pitch_rad = 90.0f * 3.14159265f / 180.0f;
-    s.table_y = 1.0f;
-    s.table_near = -0.8f;
-    s.table_far = 0.8f;
-    s.table_half_width = 1.0f;
-    SceneBox a;
-    a.x = 0.1f;
-    a.z = 0.1f;
-    s.boxes = {a};
+    const Scene s = looking_down_scene(90.0f, 0.8f, 0.1f);
     std::vector<int> truth;
     Prepared f = prepared(render_scene(s, &truth));
     const Removal r = remove_with_defaults(f);
