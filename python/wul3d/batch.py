@@ -248,10 +248,13 @@ class IgnoreStopSignals:
 
 def _end_local_workers(cluster):
     """SIGKILL to the LocalCluster's worker processes, not restarted: a task running C++
-    for minutes would otherwise hold the cluster's close (Dask waits for it, then kills)."""
+    for minutes would otherwise hold the cluster's close (Dask waits for it, then kills).
+    Each nanny is told first that it is closing (close_gracefully): a nanny that saw its
+    worker die would start a new one, which ignores SIGTERM (IgnoreStopSignals), and
+    Python's exit would wait for it for ever (multiprocessing joins its children)."""
     for nanny in list(getattr(cluster, "workers", {}).values()):
         try:
-            nanny.auto_restart = False
+            nanny.close_gracefully(reason="wul3d.batch interrupted")
             pid = nanny.process.pid if nanny.process is not None else None
             if pid:
                 os.kill(pid, signal.SIGKILL)

@@ -351,6 +351,24 @@ def test_a_signal_stops_the_batch_at_once_with_one_line(tmp_path, signum):
     assert report["totals"]["succeeded"] == 16 - len(finished)
 
 
+def test_ended_workers_are_not_restarted():
+    """After a signal the batch SIGKILLs its local workers; a nanny that restarted one would
+    leave a process that ignores SIGTERM, and Python's exit would wait for it for ever."""
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=":0") as cluster, Client(cluster) as c:
+        c.register_worker_plugin(batch.IgnoreStopSignals())
+        pids = [n.process.pid for n in cluster.workers.values()]
+        batch._end_local_workers(cluster)
+        deadline = time.monotonic() + 5  # a restart takes about a second here
+        while time.monotonic() < deadline:
+            assert all(n.process is None or n.process.pid in pids
+                       for n in cluster.workers.values()), "a worker was restarted"
+            time.sleep(0.1)
+        for pid in pids:  # and the ones it ended are gone
+            with pytest.raises(ProcessLookupError):
+                os.kill(pid, 0)
+
+
 # ---- fuzzing: the discovery driver, briefly ----------------------------------------------------
 
 def test_discovery_fuzzer_runs_clean_for_a_few_seconds():
