@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <exception>
 #include <utility>
 
@@ -296,7 +297,7 @@ namespace {
 float plane_grow_angle(const PlaneParams& plane, const NormalParams& normals, float noise_px) {
     if (!(normals.max_tilt_noise_deg > 0)) return plane.grow_angle_deg;
     const float least_radius_noise = (static_cast<float>(normals.radius_px) + 0.5f) * std::sqrt(2.0f) *
-                                     std::tan(normals.max_tilt_noise_deg * 3.14159265f / 180.0f);
+                                     std::tan(normals.max_tilt_noise_deg * std::numbers::pi_v<float> / 180.0f);
     return plane.grow_angle_deg * std::clamp(noise_px / least_radius_noise, 1.0f, 1.5f);
 }
 

@@ -34,6 +34,7 @@ struct PlaneWorkspace::Buffers {
                                           ///< max_object_height_m over the candidate counted
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
     std::vector<int> low_piece;         ///< grid points of a low support's top (remove_low_support)
+    std::vector<std::uint8_t> low_mask; ///< per grid point: in the low support's layer, piece or plane
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
     struct Run {
         int row, begin, end;  ///< pixels [begin, end) of the row

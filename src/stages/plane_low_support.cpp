@@ -114,22 +114,22 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     const float layer = densest_layer(h, G, params.min_region_points);
     if (std::isnan(layer)) return 0;
     // 2. Its largest piece, large enough on the plane.
-    ws.tall_foot.assign(static_cast<std::size_t>(G), 0);  // scratch: the layer's points
+    ws.low_mask.assign(static_cast<std::size_t>(G), 0);
     for (int g = 0; g < G; ++g)
-        ws.tall_foot[static_cast<std::size_t>(g)] = std::fabs(h[g] - layer) <= inliers.band(gp.z[g]);
-    largest_piece(grid, ws.tall_foot, ws.region, ws.stack, ws.low_piece);
+        ws.low_mask[static_cast<std::size_t>(g)] = std::fabs(h[g] - layer) <= inliers.band(gp.z[g]);
+    largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
     if (static_cast<int>(ws.low_piece.size()) < params.min_region_points ||
         area_on_plane(gp, ws.low_piece, pl) < kMinAreaM2)
         return 0;
     // 3. Its plane, fitted to the piece, then again to the largest piece of that plane's
     // inliers (the layer's heights were over the support, which need not be quite parallel).
     for (int round = 0; round < 2; ++round) {
-        ws.tall_foot.assign(static_cast<std::size_t>(G), 0);
-        for (const int g : ws.low_piece) ws.tall_foot[static_cast<std::size_t>(g)] = 1;
-        if (!fit_grid_points(inliers, params.min_region_points, ws.tall_foot.data(), low)) return 0;
+        ws.low_mask.assign(static_cast<std::size_t>(G), 0);
+        for (const int g : ws.low_piece) ws.low_mask[static_cast<std::size_t>(g)] = 1;
+        if (!fit_grid_points(inliers, params.min_region_points, ws.low_mask.data(), low)) return 0;
         if (round == 1) break;
-        for (int g = 0; g < G; ++g) ws.tall_foot[static_cast<std::size_t>(g)] = gp.usable[g] && inliers(low, g);
-        largest_piece(grid, ws.tall_foot, ws.region, ws.stack, ws.low_piece);
+        for (int g = 0; g < G; ++g) ws.low_mask[static_cast<std::size_t>(g)] = gp.usable[g] && inliers(low, g);
+        largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
     }
     // Its extent in the image: the piece's convex hull on the grid, a cell wider.
     std::vector<cv::Point> cells;
