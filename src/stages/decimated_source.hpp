@@ -9,6 +9,21 @@
 
 namespace wul3d {
 
+/// The colour vote's buffers (DecimatedSource::use_colour_at_edges), owned by the caller and
+/// reused from frame to frame: no allocation once sized.
+struct VoteBuffers {
+    /// Each edge block's source after the vote (a block index, its own when it keeps its
+    /// label); sized to the decimated image, other blocks' entries untouched.
+    std::vector<std::int32_t> block_source;
+    /// The decimated frame as the vote reads it, padded by the grid's reach on every side
+    /// (depth 0 there: no tap is on the surface, and a sum plus 0 is the sum): per block its
+    /// depth and label (depth | label << 16), and its colour (r | g << 8 | b << 16).
+    std::vector<std::uint32_t> depth_label, rgb;
+    /// The edge blocks, as block and padded indices, a lane's worth at a time.
+    std::vector<std::int32_t> edges, padded_edges;
+    int padded_width = 0, padded_height = 0;
+};
+
 /// Which pixel of the decimated frame an input pixel takes its results from: the rules of
 /// expand_result, pixel by pixel (decimation.cpp applies them a row at a time, and the tests
 /// hold the two equal). An input pixel
@@ -40,19 +55,18 @@ public:
                     const DepthImage& decimated, int factor, float same_m, float same_rel);
     /// `edge_blocks`: one flag (0 or 1) per decimated pixel (results differ from a neighbour's);
     /// `block_labels`: the label each decimated pixel votes for (objects, or clusters). They
-    /// and the colour images stay owned by the caller, and so does `block_source`, which
-    /// receives each edge block's vote (a block index, its own when it keeps its label; sized
-    /// to the decimated image, reused from frame to frame; other blocks' entries untouched).
+    /// and the colour images stay owned by the caller, and so do `buffers`, whose
+    /// block_source receives each edge block's vote.
     /// Ignored for frames without colour. Throws InputError for colour images of other sizes
     /// than the depths'.
     void use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
                              const std::uint8_t* edge_blocks, const std::uint16_t* block_labels,
-                             std::vector<std::int32_t>& block_source);
+                             VoteBuffers& buffers);
     /// The same with the input colour at `input_rgb` (packed RGB rows of the input depth's
     /// size; nullptr: none).
     void use_colour_at_edges(const std::uint8_t* input_rgb, const ColorImage& decimated,
                              const std::uint8_t* edge_blocks, const std::uint16_t* block_labels,
-                             std::vector<std::int32_t>& block_source);
+                             VoteBuffers& buffers);
 
     /// The vote's colour scale (distance between 8-bit RGB triples), chosen with the grid on
     /// the OSD learn frames and slide_learn38 at N = 2 (docs/DESIGN.md, decimation).
@@ -87,8 +101,9 @@ private:
     }
     /// The search of an edge pixel, or of one off its own block's surface.
     std::int32_t search(int u, int v, int bu, int bv, float z, bool on_own) const;
-    /// Step 1 of the colour placement: each block's source after the vote, into `source`.
-    void vote(const std::uint16_t* labels, std::int32_t* source) const;
+    /// Step 1 of the colour placement: each edge block's source after the vote, into
+    /// buffers.block_source.
+    void vote(const std::uint16_t* labels, VoteBuffers& buffers) const;
 
     const std::uint16_t* full_;
     const std::uint16_t* small_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -165,20 +166,18 @@ DecimatedSource::DecimatedSource(const std::uint16_t* input, int width, int heig
 
 void DecimatedSource::use_colour_at_edges(const ColorImage& input, const ColorImage& decimated,
                                           const std::uint8_t* edge_blocks,
-                                          const std::uint16_t* block_labels,
-                                          std::vector<std::int32_t>& block_source) {
+                                          const std::uint16_t* block_labels, VoteBuffers& buffers) {
     if (input.empty() || decimated.empty()) return;  // depth only: depth decides alone
     if (input.width != W_ || input.height != H_ ||
         input.rgb.size() != 3 * static_cast<std::size_t>(W_) * H_)
         throw InputError("decimation: colour and depth sizes differ");
-    use_colour_at_edges(input.rgb.data(), decimated, edge_blocks, block_labels, block_source);
+    use_colour_at_edges(input.rgb.data(), decimated, edge_blocks, block_labels, buffers);
 }
 
 void DecimatedSource::use_colour_at_edges(const std::uint8_t* input_rgb,
                                           const ColorImage& decimated,
                                           const std::uint8_t* edge_blocks,
-                                          const std::uint16_t* block_labels,
-                                          std::vector<std::int32_t>& block_source) {
+                                          const std::uint16_t* block_labels, VoteBuffers& buffers) {
     if (input_rgb == nullptr || decimated.empty()) return;  // depth only: depth decides alone
     if (decimated.width != w_ || decimated.height != h_ ||
         decimated.rgb.size() != 3 * static_cast<std::size_t>(w_) * h_)
@@ -186,66 +185,143 @@ void DecimatedSource::use_colour_at_edges(const std::uint8_t* input_rgb,
     rgb_ = input_rgb;
     small_rgb_ = decimated.rgb.data();
     edges_ = edge_blocks;
-    block_source.resize(static_cast<std::size_t>(w_) * h_);
-    voted_ = block_source.data();
-    vote(block_labels, block_source.data());
+    buffers.block_source.resize(static_cast<std::size_t>(w_) * h_);
+    voted_ = buffers.block_source.data();
+    vote(block_labels, buffers);
 }
 
-void DecimatedSource::vote(const std::uint16_t* labels, std::int32_t* source) const {
-    // The grid: offsets -4, -2, 0, 2, 4 blocks in each direction. On the OSD learn frames
-    // it scored as the whole 9 x 9 window did, with a third of the votes (docs/DESIGN.md).
-    constexpr int kStep = 2, kReach = 4;
-    const float* const weight = vote_weights().data();
-    // Locals: members read after each store could have changed (char aliasing).
-    const int w = w_, h = h_;
-    const float same = same_, same_rel = same_rel_;
-    const std::uint16_t* const small = small_;
-    const std::uint8_t *const small_rgb = small_rgb_, *const edges = edges_;
-#pragma omp parallel for schedule(dynamic, 8)
-    for (int bv = 0; bv < h; ++bv) {
-        // Only edge blocks are looked up (search): found by memchr, not a test per block.
-        const std::uint8_t* const row = edges + static_cast<std::size_t>(bv) * w;
+namespace {
+
+// The vote's grid: offsets -kReach ... kReach blocks, kStep apart, in both directions (the
+// whole 9 x 9 window scored the same on the OSD learn frames with three times the votes:
+// docs/DESIGN.md); kLanes edge blocks are voted together.
+constexpr int kStep = 2, kReach = 4, kSide = 2 * kReach / kStep + 1, kTaps = kSide * kSide, kLanes = 8;
+
+/// The decimated frame into the vote's padded arrays (VoteBuffers): depth | label << 16 and
+/// r | g << 8 | b << 16 per block, kReach blocks of zeros on every side (zeroed when the size
+/// changes; the interior is written every frame). O(w h), parallel over rows.
+void pad_for_vote(const std::uint16_t* depth, const std::uint16_t* labels, const std::uint8_t* rgb, int w, int h,
+                  VoteBuffers& vb) {
+    const int pw = w + 2 * kReach, ph = h + 2 * kReach;
+    if (vb.padded_width != pw || vb.padded_height != ph) {
+        vb.depth_label.assign(static_cast<std::size_t>(pw) * ph, 0);
+        vb.rgb.assign(static_cast<std::size_t>(pw) * ph, 0);
+        vb.padded_width = pw;
+        vb.padded_height = ph;
+    }
+    std::uint32_t *const depth_label = vb.depth_label.data(), *const colour = vb.rgb.data();
+    const std::size_t last = static_cast<std::size_t>(w) * h - 1;
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < h; ++v) {
+        const std::size_t in = static_cast<std::size_t>(v) * w, out = static_cast<std::size_t>(v + kReach) * pw + kReach;
+        for (int u = 0; u < w; ++u)
+            depth_label[out + u] = depth[in + u] | static_cast<std::uint32_t>(labels[in + u]) << 16;
+        // A triple read as 4 bytes, the 4th masked off (little-endian); the image's last one
+        // byte by byte (nothing read past it).
+        const bool little = std::endian::native == std::endian::little;
+        const int whole = !little ? 0 : in + static_cast<std::size_t>(w) - 1 < last ? w : w - 1;
+        for (int u = 0; u < whole; ++u) {
+            std::uint32_t c;
+            std::memcpy(&c, rgb + 3 * (in + static_cast<std::size_t>(u)), 4);
+            colour[out + u] = c & 0xffffffu;  // little-endian: r | g << 8 | b << 16
+        }
+        for (int u = whole; u < w; ++u) {
+            const std::uint8_t* const c = rgb + 3 * (in + static_cast<std::size_t>(u));
+            colour[out + u] = c[0] | static_cast<std::uint32_t>(c[1]) << 8 | static_cast<std::uint32_t>(c[2]) << 16;
+        }
+    }
+}
+
+/// The votes of kLanes edge blocks at padded indices `at`, each lane as DecimatedSource's
+/// doc says, with the taps in row-major order: the same sums, in the same order, as one block
+/// at a time. winner[l]: the tap (index into `offsets`) of the block nearest in colour among
+/// the other labels where they outweigh the block's own, else -1 (and -1 for a block without
+/// depth). Branch-free and lane by lane, so that the lanes vectorize (AVX2 gathers; built
+/// for baseline x86-64 too). Cost: kTaps taps per lane.
+WUL3D_AVX2_CLONES
+void vote_lanes(const std::uint32_t* __restrict depth_label, const std::uint32_t* __restrict rgb,
+                const std::int32_t* __restrict at, const std::int32_t* __restrict offsets,
+                const float* __restrict weight, float same, float same_rel, int* __restrict winner) {
+    float z[kLanes], tolerance[kLanes], own_total[kLanes], other_total[kLanes];
+    int c0[kLanes], c1[kLanes], c2[kLanes], own[kLanes], nearest_d[kLanes], nearest[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+        const std::uint32_t x = depth_label[at[l]], c = rgb[at[l]];
+        z[l] = static_cast<float>(x & 0xffffu);
+        tolerance[l] = same + same_rel * z[l] * z[l];
+        own[l] = static_cast<int>(x >> 16);
+        c0[l] = static_cast<int>(c & 0xffu);
+        c1[l] = static_cast<int>((c >> 8) & 0xffu);
+        c2[l] = static_cast<int>(c >> 16);
+        own_total[l] = other_total[l] = 0.0f;
+        nearest_d[l] = std::numeric_limits<int>::max();
+        nearest[l] = -1;
+    }
+    for (int t = 0; t < kTaps; ++t) {
+        const std::int32_t offset = offsets[t];
+        for (int l = 0; l < kLanes; ++l) {
+            const std::int32_t q = at[l] + offset;
+            const std::uint32_t x = depth_label[q], c = rgb[q];
+            const float depth = static_cast<float>(x & 0xffffu);
+            const bool on = (depth != 0) & (std::fabs(depth - z[l]) <= tolerance[l]);
+            const int dr = c0[l] - static_cast<int>(c & 0xffu), dg = c1[l] - static_cast<int>((c >> 8) & 0xffu),
+                      db = c2[l] - static_cast<int>(c >> 16);
+            const int d = dr * dr + dg * dg + db * db;
+            const float wq = weight[std::min(d >> kWeightShift, kWeights - 1)];
+            const bool mine = static_cast<int>(x >> 16) == own[l];
+            own_total[l] += detail::pick(on & mine, wq, 0.0f);
+            other_total[l] += detail::pick(on & !mine, wq, 0.0f);
+            const int nearer = -static_cast<int>(on & !mine & (d < nearest_d[l]));
+            nearest_d[l] = (d & nearer) | (nearest_d[l] & ~nearer);
+            nearest[l] = (t & nearer) | (nearest[l] & ~nearer);
+        }
+    }
+    for (int l = 0; l < kLanes; ++l)
+        winner[l] = detail::pick((z[l] != 0) & (other_total[l] > own_total[l]), nearest[l], -1);
+}
+
+}  // namespace
+
+void DecimatedSource::vote(const std::uint16_t* labels, VoteBuffers& vb) const {
+    pad_for_vote(small_, labels, small_rgb_, w_, h_, vb);
+    const int w = w_, pw = vb.padded_width;
+    std::int32_t* const source = vb.block_source.data();
+    // The edge blocks (found by memchr, not a test per block), a whole number of lanes: the
+    // last lanes repeat the last block (their results are not kept).
+    vb.edges.clear();
+    vb.padded_edges.clear();
+    for (int bv = 0; bv < h_; ++bv) {
+        const std::uint8_t* const row = edges_ + static_cast<std::size_t>(bv) * w;
         for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(row, 1, static_cast<std::size_t>(w)));
              at != nullptr;
              at = static_cast<const std::uint8_t*>(std::memchr(at + 1, 1, static_cast<std::size_t>(row + w - at - 1)))) {
             const int bu = static_cast<int>(at - row);
-            const std::int32_t b = bv * w + bu;
-            source[b] = b;
-            if (small[b] == 0) continue;
-            const float z = small[b], tolerance = same + same_rel * z * z;
-            const std::uint8_t* const c = small_rgb + 3 * static_cast<std::size_t>(b);
-            const int c0 = c[0], c1 = c[1], c2 = c[2];
-            const std::uint16_t own = labels[b];
-            // The other labels vote together (an outline mostly parts two; counting each apart
-            // scored the same on osd_mosd), and the block nearest in colour among theirs
-            // speaks for them. Without a branch per vote (pick, masks): whether a block is on
-            // the surface or of the label follows no pattern a predictor learns. A vote off
-            // the surface adds 0, which leaves a sum as it is: the same sums as with a skip.
-            float own_total = 0, other_total = 0;
-            int nearest_d = std::numeric_limits<int>::max();
-            std::int32_t nearest = b;
-            // The grid's offsets that stay inside the image.
-            const int v_first = bv - std::min(kReach, bv / kStep * kStep);
-            const int u_first = bu - std::min(kReach, bu / kStep * kStep);
-            const int v_last = std::min(h - 1, bv + kReach), u_last = std::min(w - 1, bu + kReach);
-            for (int qv = v_first; qv <= v_last; qv += kStep)
-                for (int qu = u_first; qu <= u_last; qu += kStep) {
-                    const std::int32_t q = qv * w + qu;
-                    const float depth = small[q];
-                    const bool on = (depth != 0) & (std::fabs(depth - z) <= tolerance);
-                    const std::uint8_t* const s = small_rgb + 3 * static_cast<std::size_t>(q);
-                    const int dr = c0 - s[0], dg = c1 - s[1], db = c2 - s[2];
-                    const int d = dr * dr + dg * dg + db * db;
-                    const float wq = weight[std::min(d >> kWeightShift, kWeights - 1)];
-                    const bool mine = labels[q] == own;
-                    own_total += detail::pick(on & mine, wq, 0.0f);
-                    other_total += detail::pick(on & !mine, wq, 0.0f);
-                    const int nearer = -static_cast<int>(on & !mine & (d < nearest_d));
-                    nearest_d = (d & nearer) | (nearest_d & ~nearer);
-                    nearest = (q & nearer) | (nearest & ~nearer);
-                }
+            vb.edges.push_back(bv * w + bu);
+            vb.padded_edges.push_back((bv + kReach) * pw + bu + kReach);
+        }
+    }
+    const std::size_t n = vb.edges.size();
+    if (n == 0) return;
+    vb.edges.resize((n + kLanes - 1) / kLanes * kLanes, vb.edges.back());
+    vb.padded_edges.resize(vb.edges.size(), vb.padded_edges.back());
+    std::array<std::int32_t, kTaps> padded_offsets{}, block_offsets{};
+    for (int t = 0; t < kTaps; ++t) {
+        const int dv = (t / kSide) * kStep - kReach, du = (t % kSide) * kStep - kReach;
+        padded_offsets[static_cast<std::size_t>(t)] = dv * pw + du;
+        block_offsets[static_cast<std::size_t>(t)] = dv * w + du;
+    }
+    const float* const weight = vote_weights().data();
+    const std::int32_t *const edges = vb.edges.data(), *const padded = vb.padded_edges.data();
+    const float same = same_, same_rel = same_rel_;
+    const auto batches = static_cast<std::ptrdiff_t>(vb.edges.size() / kLanes);
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t i = 0; i < batches; ++i) {
+        int winner[kLanes];
+        vote_lanes(vb.depth_label.data(), vb.rgb.data(), padded + i * kLanes, padded_offsets.data(), weight, same,
+                   same_rel, winner);
+        for (int l = 0; l < kLanes; ++l) {
+            const std::int32_t b = edges[i * kLanes + l];
             // Another label wins only with more weight than its own.
-            if (other_total > own_total) source[b] = nearest;
+            source[b] = winner[l] < 0 ? b : b + block_offsets[static_cast<std::size_t>(winner[l])];
         }
     }
 }
@@ -333,7 +409,7 @@ struct ExpandBuffers {
     std::vector<Box> band_boxes;
     std::vector<std::uint8_t> edge_blocks;        ///< decimated pixels at an object's outline
     std::vector<std::uint16_t> edge_lo, edge_hi;  ///< their 3-wide row minima and maxima
-    std::vector<std::int32_t> block_source;       ///< each edge block's source after the colour vote
+    VoteBuffers vote;                             ///< the colour vote's
     /// One block row's results repeated over the input's columns (each block's over its
     /// factor columns), and its depth where its pixels may take it as it is: what each input
     /// row of the block row takes from its own block. One per band.
@@ -642,6 +718,46 @@ unsigned write_row(const PixelArrays& a, ExpandBuffers::BlockRow& b, std::size_t
     return active_row(code, W, a.active + row);
 }
 
+/// Input row v's searched pixels (code kSearch: in range, with depth, but not on their own
+/// block as it is; nearly all lie in edge blocks), one by one through `source`, each from the
+/// block it finds or as no point (as write_row left it). Returns the pixels it made active.
+/// O(searched pixels).
+unsigned write_searched(const PixelArrays& a, const DecimatedSource& source, const std::uint8_t* code,
+                        const std::uint16_t* depth_row, int v, int W) {
+    // The arrays as locals: through the struct, every byte stored would make the compiler
+    // load each pointer again (char aliasing).
+    const std::uint8_t *const in_active = a.in_active, *const in_rgb = a.in_rgb, *const in_classes = a.in_classes;
+    const std::uint16_t *const in_labels = a.in_labels, *const in_segments = a.in_segments,
+                        *const in_objects = a.in_objects;
+    const std::size_t row = static_cast<std::size_t>(v) * W;
+    const bool with_objects = a.with_objects;  // without, the object stages' arrays are empty
+    std::uint16_t* const labels = a.labels + row;
+    std::uint16_t* const segments = with_objects ? a.segments + row : nullptr;
+    std::uint16_t* const objects = with_objects ? a.objects + row : nullptr;
+    std::uint8_t *const colors = a.colors + 3 * row, *const active = a.active + row;
+    std::uint8_t* const classes = with_objects ? a.classes + row : nullptr;
+    const int factor = source.factor(), bv = v / factor;
+    unsigned made = 0;
+    for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(code, kSearch, static_cast<std::size_t>(W)));
+         at != nullptr;
+         at = static_cast<const std::uint8_t*>(std::memchr(at + 1, kSearch, static_cast<std::size_t>(code + W - at - 1)))) {
+        const int u = static_cast<int>(at - code), bu = factor == 2 ? u >> 1 : u / factor;  // no division at N = 2
+        std::int32_t q = source.in_block(u, v, bu, bv);
+        if (q >= 0 && !in_active[q]) q = source.nearest_in_depth(bu, bv, depth_row[u], in_active);
+        if (q < 0) continue;  // no point: written so by write_row
+        const auto sq = static_cast<std::size_t>(q);
+        labels[u] = in_labels[sq];
+        for (int c = 0; c < 3; ++c) colors[3 * u + c] = in_rgb[3 * sq + c];
+        active[u] = 1;  // q is active: the search takes no other
+        ++made;
+        if (!with_objects) continue;
+        classes[u] = in_classes[sq];
+        segments[u] = in_segments[sq];
+        objects[u] = in_objects[sq];
+    }
+    return made;
+}
+
 /// 4. Every input pixel's results, band by band of rows in parallel. Per row: each pixel's
 /// source code (source_codes: its own block, no point, or a search), then every result from
 /// the block row by code (write_row), then the searched pixels (another block or none: no
@@ -675,28 +791,8 @@ void expand_bands(const DepthRange& range, const RgbdView& frame, const Decimate
             const std::size_t row = static_cast<std::size_t>(v) * W;
             if (block_row.bv != bv) widen_block_row(a, bv, w, factor, W, block_row);
             source_codes(depth + row, block_row.depth.data(), W, test, code);
-            unsigned in_row = write_row(a, block_row, row, W);
-            // The searched pixels, one by one: in range, with depth, but not on their own
-            // block as it is.
-            const auto n_row = static_cast<std::size_t>(W);
-            for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(code, kSearch, n_row)); at != nullptr;
-                 at = static_cast<const std::uint8_t*>(
-                     std::memchr(at + 1, kSearch, static_cast<std::size_t>(code + W - at - 1)))) {
-                const int u = static_cast<int>(at - code), bu = u / factor;
-                std::int32_t q = source.in_block(u, v, bu, bv);
-                if (q >= 0 && !a.in_active[q]) q = source.nearest_in_depth(bu, bv, depth[row + u], a.in_active);
-                if (q < 0) continue;  // no point: written so by write_row
-                const std::size_t p = row + static_cast<std::size_t>(u), sq = static_cast<std::size_t>(q);
-                a.labels[p] = a.in_labels[sq];
-                for (int c = 0; c < 3; ++c) a.colors[3 * p + c] = a.in_rgb[3 * sq + c];
-                a.active[p] = 1;  // q is active: the search takes no other
-                ++in_row;
-                if (!objects) continue;
-                a.classes[p] = a.in_classes[sq];
-                a.segments[p] = a.in_segments[sq];
-                a.objects[p] = a.in_objects[sq];
-            }
-            active += in_row;
+            active += write_row(a, block_row, row, W);
+            active += write_searched(a, source, code, depth + row, v, W);
             if (!objects) continue;
             // Each run of one object id adds to its box at once. The runs' starts are found
             // by memchr in a flag per column (0: a run starts), set by a loop that
@@ -788,7 +884,7 @@ void expand_result(const ExpandParams& params, const RgbdView& frame, const Rgbd
     if (frame.has_color() && !frame.color_matches())
         throw InputError(std::string(frame.name) + ": colour and depth sizes differ");
     source.use_colour_at_edges(frame.rgb, decimated.color, buf.edge_blocks.data(), outline.labels.data(),
-                               buf.block_source);
+                               buf.vote);
     shape_result(s, W, H, objects, r);
     prepare_bands(r.object_list, W, H, outline.width, objects, buf);
     expand_bands(params.range, frame, source, outline.width, pixel_arrays(frame, decimated, s, buf, objects, r), buf);

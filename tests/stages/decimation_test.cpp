@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -165,7 +166,7 @@ TEST(DecimatedSource, AtEdgeBlocksTheColourPlacesTheOutline) {
     EXPECT_EQ(source(1, 0), 0);  // depth alone: its own block
     const std::vector<std::uint8_t> edges = {1, 1}, no_edges = {0, 0};
     const std::vector<std::uint16_t> labels = {1, 2};
-    std::vector<std::int32_t> voted;
+    VoteBuffers voted;
     source.use_colour_at_edges(rgb, small.color, edges.data(), labels.data(), voted);
     EXPECT_EQ(source(1, 0), 1);  // the blue block beside it
     EXPECT_EQ(source(0, 0), 0);
@@ -217,19 +218,19 @@ TEST(DecimatedSource, TheColourVoteGivesANotchInTheOutlineBackToItsColour) {
     const int notch = 4 * w + 3;
     labels[notch] = 2;
     const std::vector<std::uint8_t> edges(w * w, 1);  // every block votes
-    std::vector<std::int32_t> voted;
+    VoteBuffers voted;
     DecimatedSource source(flat, small.depth, 2, 0.004f, 0.0f);
     source.use_colour_at_edges(rgb, small.color, edges.data(), labels.data(), voted);
-    ASSERT_EQ(voted.size(), static_cast<std::size_t>(w * w));
+    ASSERT_EQ(voted.block_source.size(), static_cast<std::size_t>(w * w));
     auto label_of = [&](int u, int v) { return labels[static_cast<std::size_t>(source(u, v))]; };
     // The notch's red blocks on the grid around it are label 1: its pixels go back to 1.
-    EXPECT_EQ(labels[static_cast<std::size_t>(voted[notch])], 1);
+    EXPECT_EQ(labels[static_cast<std::size_t>(voted.block_source[notch])], 1);
     for (int v = 8; v < 10; ++v)
         for (int u = 6; u < 8; ++u) EXPECT_EQ(label_of(u, v), 1) << u << ", " << v;
     // Every other block keeps its own results, blue pixels label 2 and red ones label 1.
     for (int q = 0; q < w * w; ++q) {
         if (q != notch) {
-            EXPECT_EQ(voted[static_cast<std::size_t>(q)], q);
+            EXPECT_EQ(voted.block_source[static_cast<std::size_t>(q)], q);
         }
     }
     for (int v = 0; v < W; ++v)
@@ -247,7 +248,7 @@ TEST(DecimatedSource, TheColourVoteGivesANotchInTheOutlineBackToItsColour) {
     decimate_frame(g, 2, small);
     DecimatedSource on_surface(g.depth, small.depth, 2, 0.004f, 0.0f);
     on_surface.use_colour_at_edges(rgb, small.color, edges.data(), labels.data(), voted);
-    EXPECT_EQ(voted[notch], notch);
+    EXPECT_EQ(voted.block_source[notch], notch);
     EXPECT_EQ(labels[static_cast<std::size_t>(on_surface(6, 8))], 2);
 }
 
@@ -553,15 +554,9 @@ RandomExpand random_expand(unsigned seed, int W, int H, int factor, bool objects
     return e;
 }
 
-// The rules of expand_result pixel by pixel, straight from DecimatedSource (the reference
-// the row passes must equal): each input pixel's source block, its results copied, each
-// object's pixels and box counted, and the small objects dropped.
-FrameResult reference_expand(const RandomExpand& e) {
-    const RgbdFrame& f = e.frame;
-    const FrameResult& s = e.small;
-    const int W = f.width(), H = f.height(), factor = e.params.factor;
-    DecimatedSource source(f.depth, e.decimated.depth, factor, e.params.same_m, e.params.same_rel);
-    const LabelImage& outline = e.params.objects ? s.objects : s.labels;
+// The edge blocks of `outline`: another label in the 3 x 3 neighbourhood (clamped at the
+// borders), one flag per block.
+std::vector<std::uint8_t> edge_blocks(const LabelImage& outline) {
     const int w = outline.width, h = outline.height;
     std::vector<std::uint8_t> edges(outline.labels.size());
     for (int bv = 0; bv < h; ++bv)
@@ -575,7 +570,68 @@ FrameResult reference_expand(const RandomExpand& e) {
                 }
             edges[static_cast<std::size_t>(bv) * w + bu] = edge;
         }
-    std::vector<std::int32_t> voted;
+    return edges;
+}
+
+// The colour vote as DecimatedSource's doc states it, one edge block at a time over the grid's
+// blocks inside the image (-4, -2, 0, 2, 4 blocks from it each way), row by row: the reference
+// the vote's lanes must equal. Weights exp(-d2 / (2 sigma^2)) at the centre of d2's bin of 16
+// (the vote's table, the same floats).
+std::vector<std::int32_t> reference_vote(const RandomExpand& e, const std::vector<std::uint8_t>& edges,
+                                         const std::uint16_t* labels) {
+    const int w = e.decimated.width(), h = e.decimated.height();
+    const std::uint16_t* const depth = e.decimated.depth.data.data();
+    const std::uint8_t* const rgb = e.decimated.color.rgb.data();
+    const float same = e.params.same_m / e.frame.depth.scale_m_per_unit,
+                same_rel = e.params.same_rel * e.frame.depth.scale_m_per_unit;
+    const float sigma = DecimatedSource::kColourSigma, scale = -1.0f / (2.0f * sigma * sigma);
+    std::vector<std::int32_t> source(static_cast<std::size_t>(w) * h, -1);
+    for (int bv = 0; bv < h; ++bv)
+        for (int bu = 0; bu < w; ++bu) {
+            const std::int32_t b = bv * w + bu;
+            if (!edges[static_cast<std::size_t>(b)]) continue;
+            source[static_cast<std::size_t>(b)] = b;
+            const float z = depth[b];
+            if (z == 0) continue;
+            float own = 0, other = 0;
+            int nearest_d = std::numeric_limits<int>::max();
+            std::int32_t nearest = b;
+            for (int dv = -4; dv <= 4; dv += 2)
+                for (int du = -4; du <= 4; du += 2) {
+                    const int qu = bu + du, qv = bv + dv;
+                    if (qu < 0 || qu >= w || qv < 0 || qv >= h) continue;
+                    const std::int32_t q = qv * w + qu;
+                    const float dq = depth[q];
+                    if (dq == 0 || std::fabs(dq - z) > same + same_rel * z * z) continue;
+                    int d = 0;
+                    for (int c = 0; c < 3; ++c) d += (rgb[3 * b + c] - rgb[3 * q + c]) * (rgb[3 * b + c] - rgb[3 * q + c]);
+                    const float weight = std::exp(scale * static_cast<float>(std::min(d >> 4, 4095) * 16 + 8));
+                    if (labels[q] == labels[b]) {
+                        own += weight;
+                    } else {
+                        other += weight;
+                        if (d < nearest_d) {
+                            nearest_d = d;
+                            nearest = q;
+                        }
+                    }
+                }
+            if (other > own) source[static_cast<std::size_t>(b)] = nearest;
+        }
+    return source;
+}
+
+// The rules of expand_result pixel by pixel, straight from DecimatedSource (the reference
+// the row passes must equal): each input pixel's source block, its results copied, each
+// object's pixels and box counted, and the small objects dropped.
+FrameResult reference_expand(const RandomExpand& e) {
+    const RgbdFrame& f = e.frame;
+    const FrameResult& s = e.small;
+    const int W = f.width(), H = f.height(), factor = e.params.factor;
+    DecimatedSource source(f.depth, e.decimated.depth, factor, e.params.same_m, e.params.same_rel);
+    const LabelImage& outline = e.params.objects ? s.objects : s.labels;
+    const std::vector<std::uint8_t> edges = edge_blocks(outline);
+    VoteBuffers voted;
     source.use_colour_at_edges(f.color, e.decimated.color, edges.data(), outline.labels.data(), voted);
 
     FrameResult r;
@@ -689,6 +745,34 @@ TEST(ExpandResult, EqualsThePixelByPixelRulesOnRandomFrames) {
                 expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, out);
                 expect_same_pixels(out, reference_expand(e));
             }
+}
+
+// The colour vote, edge blocks a lane's worth at a time on a padded copy of the frame, gives
+// every edge block the source the grid gives it block by block: frames smaller than the
+// grid and larger, borders, holes and depths past the range, and a second frame of another
+// size through the same buffers.
+TEST(DecimatedSource, TheColourVoteEqualsTheGridBlockByBlock) {
+    VoteBuffers voted;
+    unsigned seed = 100;
+    for (const auto& [W, H] : {std::pair{97, 61}, std::pair{12, 10}, std::pair{331, 243}, std::pair{150, 9}}) {
+        SCOPED_TRACE(testing::Message() << W << " x " << H);
+        const RandomExpand e = random_expand(seed++, W, H, 2, true, true);
+        const std::vector<std::uint8_t> edges = edge_blocks(e.small.objects);
+        DecimatedSource source(e.frame.depth, e.decimated.depth, 2, e.params.same_m, e.params.same_rel);
+        source.use_colour_at_edges(e.frame.color, e.decimated.color, edges.data(), e.small.objects.labels.data(), voted);
+        const std::vector<std::int32_t> expected = reference_vote(e, edges, e.small.objects.labels.data());
+        std::size_t moved = 0, compared = 0;
+        for (std::size_t b = 0; b < expected.size(); ++b) {
+            if (expected[b] < 0) continue;  // not an edge block: no vote
+            ++compared;
+            moved += expected[b] != static_cast<std::int32_t>(b);
+            EXPECT_EQ(voted.block_source[b], expected[b]) << "block " << b;
+        }
+        EXPECT_GT(compared, 0u);
+        if (W > 20) {
+            EXPECT_GT(moved, 0u);  // the vote moved some outline: the test can tell
+        }
+    }
 }
 
 // The same bytes on 1, 2 and 3 threads (the bands' counts are reduced in a fixed order).
