@@ -738,22 +738,26 @@ unsigned write_searched(const PixelArrays& a, const DecimatedSource& source, con
     std::uint8_t* const classes = with_objects ? a.classes + row : nullptr;
     const int factor = source.factor(), bv = v / factor;
     unsigned made = 0;
-    for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(code, kSearch, static_cast<std::size_t>(W)));
-         at != nullptr;
-         at = static_cast<const std::uint8_t*>(std::memchr(at + 1, kSearch, static_cast<std::size_t>(code + W - at - 1)))) {
-        const int u = static_cast<int>(at - code), bu = factor == 2 ? u >> 1 : u / factor;  // no division at N = 2
-        std::int32_t q = source.in_block(u, v, bu, bv);
-        if (q >= 0 && !in_active[q]) q = source.nearest_in_depth(bu, bv, depth_row[u], in_active);
-        if (q < 0) continue;  // no point: written so by write_row
-        const auto sq = static_cast<std::size_t>(q);
-        labels[u] = in_labels[sq];
-        for (int c = 0; c < 3; ++c) colors[3 * u + c] = in_rgb[3 * sq + c];
-        active[u] = 1;  // q is active: the search takes no other
-        ++made;
-        if (!with_objects) continue;
-        classes[u] = in_classes[sq];
-        segments[u] = in_segments[sq];
-        objects[u] = in_objects[sq];
+    // Runs of searched pixels (an edge block's are side by side): memchr finds each run's
+    // start, the run is walked pixel by pixel.
+    for (int u = 0; u < W;) {
+        const auto* const at = static_cast<const std::uint8_t*>(std::memchr(code + u, kSearch, static_cast<std::size_t>(W - u)));
+        if (at == nullptr) break;
+        for (u = static_cast<int>(at - code); u < W && code[u] == kSearch; ++u) {
+            const int bu = factor == 2 ? u >> 1 : u / factor;  // no division at N = 2
+            std::int32_t q = source.in_block(u, v, bu, bv);
+            if (q >= 0 && !in_active[q]) q = source.nearest_in_depth(bu, bv, depth_row[u], in_active);
+            if (q < 0) continue;  // no point: written so by write_row
+            const auto sq = static_cast<std::size_t>(q);
+            labels[u] = in_labels[sq];
+            for (int c = 0; c < 3; ++c) colors[3 * u + c] = in_rgb[3 * sq + c];
+            active[u] = 1;  // q is active: the search takes no other
+            ++made;
+            if (!with_objects) continue;
+            classes[u] = in_classes[sq];
+            segments[u] = in_segments[sq];
+            objects[u] = in_objects[sq];
+        }
     }
     return made;
 }

@@ -78,6 +78,51 @@ TEST(RenderWeightColors, IsEquation9) {
     EXPECT_EQ(out.rgb[0], static_cast<std::uint8_t>(200 * 0.35f));
 }
 
+// With a sampling stride, every pixel with a label takes the eq. 9 colour of its grid
+// point's weights (u / s, v / s): along whole rows, the last cut short (a width that is
+// not a multiple of s).
+TEST(RenderWeightColors, AtAStrideEachPixelTakesItsGridPointsColour) {
+    Scene s;
+    SceneBox b;
+    b.x = 0.05f;
+    b.z = 0.9f;
+    b.w = b.h = b.d = 0.25f;
+    s.boxes = {b};
+    ClusterParams p = ClusterParams::paper();
+    p.k = 4;
+    p.stride = 3;
+    ClusterState state(p);
+    OrganizedCloud cloud;
+    NormalMap normals;
+    std::vector<std::uint8_t> active;
+    LabelImage labels;
+    ColorImage out;
+    for (int frame = 0; frame < 2; ++frame) {  // two frames: weights shared between clusters
+        s.boxes[0].x = frame == 0 ? 0.05f : -0.05f;
+        const RgbdFrame f = render_scene(s);
+        back_project(f, cloud);
+        estimate_normals(NormalParams{}, cloud, normals);
+        select_depth_range(DepthRange{}, cloud, active);
+        state.step(cloud, normals, active, labels);
+        render_weight_colors(state, labels, f, out);
+    }
+    const int W = labels.width;
+    ASSERT_NE(W % 3, 0);
+    std::size_t checked = 0;
+    for (int v : {100, 200, 301})
+        for (int u = 0; u < W; ++u) {
+            const std::size_t q = static_cast<std::size_t>(v) * W + u;
+            if (labels.labels[q] == 0) continue;
+            const PixelWeights& mu = state.weights(state.grid_index(u, v));
+            double expect[3] = {0, 0, 0};
+            for (int j = 0; j < p.k; ++j)
+                for (int c = 0; c < 3; ++c) expect[c] += mu.weight(j) * cluster_color(j)[c];
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(out.rgb[3 * q + c], expect[c], 1.0) << u << ", " << v;
+            ++checked;
+        }
+    EXPECT_GT(checked, 200u);
+}
+
 // ---- render_object_overlay ------------------------------------------------------------
 
 namespace {
