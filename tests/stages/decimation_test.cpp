@@ -110,6 +110,49 @@ TEST(DecimateFrame, WithTheDepthRangeEachBlockTakesItsFirstPixelInRange) {
     EXPECT_EQ(d.depth.data[1], 102);
 }
 
+// The rule on wide random rows (a block row longer than the pass's chunks, a last block cut
+// by the width): holes, depths out of the range, every factor.
+TEST(DecimateFrame, WideRowsTakeEachBlocksFirstPixelInRange) {
+    std::mt19937 rng(5);
+    const int W = 1103, H = 7;
+    RgbdFrame f;
+    f.intrinsics = PinholeIntrinsics{W, H, 500.0, 500.0, W / 2.0, H / 2.0};
+    f.depth.width = f.color.width = W;
+    f.depth.height = f.color.height = H;
+    f.depth.scale_m_per_unit = 0.001f;
+    f.depth.data.resize(static_cast<std::size_t>(W) * H);
+    for (auto& z : f.depth.data) {
+        const int kind = std::uniform_int_distribution<int>(0, 9)(rng);
+        z = static_cast<std::uint16_t>(kind == 0 ? 0 : kind == 1 ? 100 : std::uniform_int_distribution<int>(500, 3000)(rng));
+    }
+    f.color.rgb.resize(3 * f.depth.data.size());
+    for (auto& c : f.color.rgb) c = static_cast<std::uint8_t>(std::uniform_int_distribution<int>(0, 255)(rng));
+    DepthRange range;  // 0.2-4.5 m: the 0.1 m depths are out
+    for (int factor : {2, 3, 8}) {
+        SCOPED_TRACE(factor);
+        RgbdFrame d;
+        decimate_frame(f, factor, d, &range);
+        const int w = d.width(), h = d.height();
+        for (int bv = 0; bv < h; ++bv)
+            for (int bu = 0; bu < w; ++bu) {
+                std::size_t pick = static_cast<std::size_t>(bv) * factor * W + static_cast<std::size_t>(bu) * factor;
+                bool found_in = false, found_any = false;
+                for (int v = bv * factor; v < std::min(H, (bv + 1) * factor) && !found_in; ++v)
+                    for (int u = bu * factor; u < std::min(W, (bu + 1) * factor) && !found_in; ++u) {
+                        const std::size_t q = static_cast<std::size_t>(v) * W + u;
+                        const std::uint16_t z = f.depth.data[q];
+                        if (z == 0) continue;
+                        found_in = range.contains(static_cast<float>(z) * 0.001f);
+                        if (found_in || !found_any) pick = q;
+                        found_any = true;
+                    }
+                const std::size_t o = static_cast<std::size_t>(bv) * w + bu;
+                ASSERT_EQ(d.depth.data[o], f.depth.data[pick]) << bu << ", " << bv;
+                for (int c = 0; c < 3; ++c) ASSERT_EQ(d.color.rgb[3 * o + c], f.color.rgb[3 * pick + c]) << bu << ", " << bv;
+            }
+    }
+}
+
 TEST(DecimateFrame, RejectsBadFactorsAndMismatchedColour) {
     RgbdFrame f = small_frame({}), d;
     EXPECT_THROW(decimate_frame(f, 0, d), ParamError);
