@@ -123,7 +123,7 @@ private:
     std::vector<PixelWeights> mu_;        ///< per pixel, the kept weights over track slots
     std::vector<std::uint8_t> has_mu_;    ///< 1 where a pixel's weights are not all zero
     std::vector<float> prev_z_;           ///< last frame's depth (0 = none), for scene cuts
-    std::vector<std::uint8_t> prev_rgb_;  ///< last frame's colour, 3 bytes a pixel
+    std::vector<std::uint8_t> prev_r_, prev_g_, prev_b_;  ///< last frame's colour, a plane each
 
     // This frame's results, passed from phase to phase, reused from frame to frame
     // (objects.cpp).

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "branch_free.hpp"
 #include "param_check.hpp"
 #include "point_moments.hpp"
 #include "wul3d/error.hpp"
@@ -187,54 +188,79 @@ void ObjectTracker::allocate(int width, int height) {
     has_mu_.assign(N, 0);
     s_->slot_of.assign(N, 0);
     prev_z_.assign(N, 0.0f);
-    prev_rgb_.assign(3 * N, 0);
+    prev_r_.assign(N, 0);
+    prev_g_.assign(N, 0);
+    prev_b_.assign(N, 0);
     s_->changed.assign(N, 0);
     reset();
 }
 
-// In: the cloud, prev_z_, prev_rgb_, has_mu_. Out: s_->changed (1 where a pixel that held
-// weights now sees another surface: an object arrived, left or moved over it), prev_z_ and
-// prev_rgb_ set to this frame. Returns true on a scene cut: most surfaces moved at once.
-// Cost: one pass over N pixels, no allocation.
+namespace {
+
+/// mark_surface_changes' counts over a range of pixels.
+struct SurfaceCounts {
+    std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
+};
+
+/// mark_surface_changes on pixels [p0, p1): changed[p] and the counts, and this frame's
+/// depth and colour into the previous planes. Branch-free on planes, so that it vectorizes
+/// (built for AVX2 and baseline x86-64, no FMA either way: the same bits).
+WUL3D_AVX2_CLONES
+SurfaceCounts surface_changes(std::size_t p0, std::size_t p1, const std::uint8_t* __restrict valid,
+                              const float* __restrict cz, const std::uint8_t* __restrict cr,
+                              const std::uint8_t* __restrict cg, const std::uint8_t* __restrict cb,
+                              const std::uint8_t* __restrict has_mu, float rgb2, float change_m, float change_rel,
+                              float* __restrict prev_z, std::uint8_t* __restrict prev_r,
+                              std::uint8_t* __restrict prev_g, std::uint8_t* __restrict prev_b,
+                              std::uint8_t* __restrict changed) {
+    unsigned both = 0, moved = 0, held = 0, held_moved = 0;
+    for (std::size_t p = p0; p < p1; ++p) {
+        const float z = detail::pick(valid[p] != 0, cz[p], 0.0f), before = prev_z[p];
+        const bool seen = (z > 0) & (before > 0);  // a surface in both frames
+        const float dz = std::fabs(z - before);
+        const int dr = cr[p] - prev_r[p], dg = cg[p] - prev_g[p], db = cb[p] - prev_b[p];
+        const bool depth_moved = dz > change_m + change_rel * z * z;
+        const bool mine = seen & (has_mu[p] != 0);
+        both += seen;
+        moved += seen & (dz > 0.05f);
+        held += mine;
+        held_moved += mine & depth_moved;
+        // Reset after the votes: the old weights still say which track was here, evidence
+        // of overlap for a moving object.
+        changed[p] = mine & (depth_moved | (static_cast<float>(dr * dr + dg * dg + db * db) > rgb2));
+        prev_z[p] = z;
+        prev_r[p] = cr[p];
+        prev_g[p] = cg[p];
+        prev_b[p] = cb[p];
+    }
+    return {both, moved, held, held_moved};
+}
+
+}  // namespace
+
+// In: the cloud, prev_z_, the prev_ colour planes, has_mu_. Out: s_->changed (1 where a
+// pixel that held weights now sees another surface: an object arrived, left or moved over
+// it), prev_z_ and the colour planes set to this frame. Returns true on a scene cut: most
+// surfaces moved at once. Cost: one pass over N pixels (surface_changes), no allocation.
 bool ObjectTracker::mark_surface_changes(const OrganizedCloud& cloud) {
     const std::size_t N = cloud.size();
     std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
     const float rgb2 = params_.surface_change_rgb * params_.surface_change_rgb;
-    const float change_m = params_.surface_change_m, change_rel = params_.surface_change_rel;
-    // Raw pointers: byte stores would make the compiler reload every vector's data
-    // pointer on each pixel (a char store may alias anything).
-    const std::uint8_t* const valid = cloud.valid.data();
-    const float* const cz = cloud.z.data();
-    const std::uint8_t *const cr = cloud.r.data(), *const cg = cloud.g.data(),
-                       *const cb = cloud.b.data();
-    const std::uint8_t* const has_mu = has_mu_.data();
-    float* const prev_z = prev_z_.data();
-    std::uint8_t* const prev_rgb = prev_rgb_.data();
-    std::uint8_t* const changed = s_->changed.data();
-    const auto Nn = static_cast<std::ptrdiff_t>(N);
+    // Ranges of pixels spread over the threads; each call counts in unsigned, the sums
+    // are size_t.
+    constexpr std::size_t kRange = 4096;
+    const auto ranges = static_cast<std::ptrdiff_t>((N + kRange - 1) / kRange);
 #pragma omp parallel for schedule(static) reduction(+ : both, moved, held, held_moved)
-    for (std::ptrdiff_t i = 0; i < Nn; ++i) {
-        const std::size_t p = static_cast<std::size_t>(i);
-        const float z = valid[p] ? cz[p] : 0.0f;
-        std::uint8_t* rgb = prev_rgb + 3 * p;
-        if (z > 0 && prev_z[p] > 0) {
-            ++both;
-            const float dz = std::fabs(z - prev_z[p]);
-            moved += dz > 0.05f;
-            const int dr = cr[p] - rgb[0], dg = cg[p] - rgb[1], db = cb[p] - rgb[2];
-            const bool depth_moved = dz > change_m + change_rel * z * z;
-            held += has_mu[p];
-            held_moved += has_mu[p] && depth_moved;
-            // Reset after the votes: the old weights still say which track was here,
-            // evidence of overlap for a moving object.
-            changed[p] = has_mu[p] && (depth_moved || static_cast<float>(dr * dr + dg * dg + db * db) > rgb2);
-        } else {
-            changed[p] = 0;
-        }
-        prev_z[p] = z;
-        rgb[0] = cr[p];
-        rgb[1] = cg[p];
-        rgb[2] = cb[p];
+    for (std::ptrdiff_t i = 0; i < ranges; ++i) {
+        const std::size_t p0 = static_cast<std::size_t>(i) * kRange, p1 = std::min(N, p0 + kRange);
+        const SurfaceCounts c = surface_changes(
+            p0, p1, cloud.valid.data(), cloud.z.data(), cloud.r.data(), cloud.g.data(), cloud.b.data(),
+            has_mu_.data(), rgb2, params_.surface_change_m, params_.surface_change_rel, prev_z_.data(),
+            prev_r_.data(), prev_g_.data(), prev_b_.data(), s_->changed.data());
+        both += c.both;
+        moved += c.moved;
+        held += c.held;
+        held_moved += c.held_moved;
     }
     // Most of the surfaces the objects held moved: the objects were rearranged (a folder
     // of separate scenes), not moved along.
