@@ -30,8 +30,8 @@ HERE = pathlib.Path(__file__).resolve().parent
 KEYS = ["Overlap P", "Overlap R", "Overlap F", "Boundary F", "%>=75"]
 
 
-def score(wul3d, out, data, only=()):
-    cmd = [wul3d, "eval", str(out), str(data)]
+def score(wul3d, out, data, only=(), where_depth=False):
+    cmd = [wul3d, "eval", str(out), str(data)] + (["--where-depth"] if where_depth else [])
     for o in only:
         cmd += ["--only", o]
     res = subprocess.run(cmd, capture_output=True, text=True)

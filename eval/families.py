@@ -2,13 +2,16 @@
 """Every generated family under every sensor model: one table.
 
 Usage: eval/families.py [--set report|tune] [--seeds N] [--families a,b] [--sensors a,b]
-                        [--wul3d build/wul3d] [--work out/families] [-- RUN_FLAGS...]
+                        [--where-depth] [--wul3d build/wul3d] [--work out/families]
+                        [-- RUN_FLAGS...]
 
 For every family x sensor (eval/scenegen.py --family, --sensor) it writes the set's seeds
 (docs/EVAL.md, "Generated scenes": tabletop tune 0-99 / report 1000-1099, pile 10000-10099 /
 11000-11099, floor 20000-20099 / 21000-21099; `--seeds N` takes the first N of each range),
 runs `wul3d run GEN --out OUT -q RUN_FLAGS` and `wul3d eval OUT GEN`, and prints one row each:
-family, sensor, frames, objects, Overlap F, Boundary F, %>=75. Generated folders are written
+family, sensor, frames, objects, Overlap F, Boundary F, %>=75; with --where-depth, scored
+only where the sensor gave depth (`wul3d eval --where-depth`: the generated labels cover
+every pixel, OSD's and OCID's only those with depth). Generated folders are written
 once to WORK/gen_<family>_<sensor>_<A-B> (WORK/gen_<A-B> for tabletop under structured
 light, as eval/benchmark.py names them) and reused while their scenegen.json names the
 generator's version, family, sensor and seeds. One process at a time: rendering is about 1-1.5 s
@@ -40,6 +43,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=100, help="the first N seeds of each range (1-100)")
     ap.add_argument("--families", default=",".join(FAMILIES))
     ap.add_argument("--sensors", default=",".join(SENSORS))
+    ap.add_argument("--where-depth", action="store_true",
+                    help="score only pixels with depth, as OSD's and OCID's labels are drawn")
     ap.add_argument("--wul3d", default="build/wul3d")
     ap.add_argument("--work", default="out/families", type=pathlib.Path)
     a = ap.parse_args(argv)
@@ -62,8 +67,9 @@ def main():
             gen = generate(a.work, seeds, family, sensor)
             out = gen.with_name(f"{gen.name}.{tag}")
             run(a.wul3d, gen, out, flags)
-            rows.append((family, sensor, seeds, score(a.wul3d, out, gen)))
-    print(f"set: {a.set}, flags: {' '.join(flags) if flags else '(default)'}")
+            rows.append((family, sensor, seeds, score(a.wul3d, out, gen, where_depth=a.where_depth)))
+    print(f"set: {a.set}, flags: {' '.join(flags) if flags else '(default)'}"
+          f"{', scored where depth' if a.where_depth else ''}")
     print("| family | sensor | seeds | frames | objects | Overlap F | Boundary F | %>=75 |")
     print("|---|---|---|---|---|---|---|---|")
     for family, sensor, seeds, s in rows:

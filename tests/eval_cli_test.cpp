@@ -136,6 +136,44 @@ TEST(EvalCli, TemporalReport) {
     EXPECT_NE(r.out.find("Flicker              100.0\n"), std::string::npos) << r.out;
 }
 
+// --where-depth: pixels without depth are not scored. f1's second object lies where its depth
+// image has no reading, so the object the prediction missed is not counted: 100 where 83.3
+// over all pixels. Without a depth image beside the labels, or of another size: exit 2.
+TEST(EvalCli, WhereDepthScoresOnlyPixelsWithDepth) {
+    Fixture f;
+    auto depth = [](int hole_u0, int hole_u1, int width) {
+        wul3d::DepthImage d;
+        d.width = width;
+        d.height = 12;
+        d.data.assign(static_cast<std::size_t>(width) * 12, 1000);
+        for (int v = 1; v <= 5; ++v)
+            for (int u = hole_u0; u <= hole_u1; ++u) d.data[static_cast<std::size_t>(v) * width + u] = 0;
+        return d;
+    };
+    wul3d::write_depth_png((f.gt / "f0" / "depth.png").string(), depth(0, -1, 20));  // no hole
+    wul3d::write_depth_png((f.gt / "f1" / "depth.png").string(), depth(12, 15, 20));
+    CommandResult r = run_cli({"eval", f.pred.string(), f.gt.string()});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_NE(r.out.find("Overlap F   83.3\n"), std::string::npos) << r.out;
+    r = run_cli({"eval", f.pred.string(), f.gt.string(), "--where-depth"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_NE(r.out.find(", where depth)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Overlap F   100.0\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Boundary F  100.0\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("objects     3\n"), std::string::npos) << r.out;
+
+    wul3d::write_depth_png((f.gt / "f1" / "depth.png").string(), depth(12, 15, 21));
+    r = run_cli({"eval", f.pred.string(), f.gt.string(), "--where-depth"});
+    EXPECT_EQ(r.exit_code, 2) << describe(r);
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("21x12"), std::string::npos) << r.err;
+    fs::remove(f.gt / "f1" / "depth.png");
+    r = run_cli({"eval", f.pred.string(), f.gt.string(), "--where-depth"});
+    EXPECT_EQ(r.exit_code, 2) << describe(r);
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("--where-depth"), std::string::npos) << r.err;
+}
+
 TEST(EvalCli, MissingPrediction_ExitTwoUnlessAllowed) {
     Fixture f;
     fs::remove_all(f.pred / "f1");

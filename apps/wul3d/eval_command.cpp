@@ -38,6 +38,7 @@ struct EvalOptions {
     bool per_image = false;
     bool temporal = false;
     bool allow_missing = false;
+    bool where_depth = false;
 };
 
 /// One frame to score: its name, the ground-truth file and the prediction file (empty when
@@ -197,9 +198,35 @@ nlohmann::json score_json(const ImageScore& s) {
             {"matches", matches}};
 }
 
+/// The depth image of a frame whose labels are at `gt`: depth.png beside them (a frame
+/// folder), or depth/ with the same name in an OCID sequence (label/NAME.png). Else an
+/// InputError: --where-depth needs it.
+fs::path depth_beside(const fs::path& gt) {
+    const fs::path in_folder = gt.parent_path() / "depth.png";
+    if (is_file(in_folder)) return in_folder;
+    const fs::path ocid = gt.parent_path().parent_path() / "depth" / gt.filename();
+    if (gt.parent_path().filename() == "label" && is_file(ocid)) return ocid;
+    throw InputError(gt.string() + ": --where-depth: no depth image beside the ground truth (" +
+                     in_folder.string() + ")");
+}
+
+/// Both label images 0 where the frame's depth image has no reading: those pixels are not
+/// scored, as in OSD's and OCID's labels, which were drawn on the points.
+void keep_where_depth(const FramePair& f, LabelImage& gt, LabelImage& pred) {
+    const fs::path path = depth_beside(f.gt);
+    const DepthImage depth = read_depth_png(path.string(), 0.001f);  // only 0 or not matters
+    if (depth.width != gt.width || depth.height != gt.height)
+        throw InputError(path.string() + " is " + std::to_string(depth.width) + "x" +
+                         std::to_string(depth.height) + " but " + f.gt.string() + " is " +
+                         std::to_string(gt.width) + "x" + std::to_string(gt.height));
+    for (std::size_t p = 0; p < depth.data.size(); ++p)
+        if (depth.data[p] == 0) gt.labels[p] = pred.labels[p] = 0;
+}
+
 /// One pair's ground truth (BOP's masks combined; ids up to `bg_max` as background) and
-/// prediction (all background when there is none: `missing` counts it), of one size.
-std::pair<LabelImage, LabelImage> read_pair(const FramePair& f, int bg_max, int& missing) {
+/// prediction (all background when there is none: `missing` counts it), of one size; with
+/// `where_depth`, both kept only where the frame has depth (keep_where_depth).
+std::pair<LabelImage, LabelImage> read_pair(const FramePair& f, int bg_max, bool where_depth, int& missing) {
     LabelImage gt = f.bop ? combine_bop_masks(*f.bop) : read_label_png(f.gt.string());
     if (bg_max > 0)
         for (std::uint16_t& l : gt.labels)
@@ -217,6 +244,7 @@ std::pair<LabelImage, LabelImage> read_pair(const FramePair& f, int bg_max, int&
         throw InputError(f.pred.string() + " is " + std::to_string(pred.width) + "x" +
                          std::to_string(pred.height) + " but " + f.gt.string() + " is " +
                          std::to_string(gt.width) + "x" + std::to_string(gt.height));
+    if (where_depth) keep_where_depth(f, gt, pred);
     return {std::move(gt), std::move(pred)};
 }
 
@@ -236,6 +264,7 @@ nlohmann::json print_summary(const EvalOptions& o, const std::vector<ImageScore>
     std::cout << "wul3d eval: " << m.images << " image" << (m.images == 1 ? "" : "s") << ", "
               << m.gt_objects << " objects (" << o.pred_file << " vs " << o.gt_file
               << ", boundary tolerance " << scores.front().boundary_tolerance_px << " px"
+              << (o.where_depth ? ", where depth" : "")
               << (missing ? ", " + std::to_string(missing) + " without prediction" : "")
               << ")\n";
     std::cout << "Overlap P   " << pct(m.overlap_p) << "\n"
@@ -258,7 +287,8 @@ nlohmann::json print_summary(const EvalOptions& o, const std::vector<ImageScore>
             {"gt_objects", m.gt_objects},
             {"pred_objects", m.pred_objects},
             {"detected", m.detected},
-            {"missing_predictions", missing}};
+            {"missing_predictions", missing},
+            {"where_depth", o.where_depth}};
 }
 
 /// --temporal's table on stdout, and the same as --json's "temporal".
@@ -311,7 +341,7 @@ void run(EvalOptions o) {
     nlohmann::json images = nlohmann::json::array();
     int missing = 0;
     for (const FramePair& f : frames) {
-        const auto [gt, pred] = read_pair(f, o.gt_background_max, missing);
+        const auto [gt, pred] = read_pair(f, o.gt_background_max, o.where_depth, missing);
         ImageScore s;
         try {
             s = sequence ? sequence->add(pred, gt) : score_image(pred, gt, params);
@@ -379,6 +409,9 @@ void add_eval_command(CLI::App& app) {
                   "Frames are one sequence: also report id switches and label flicker");
     cmd->add_flag("--allow-missing", opts->allow_missing,
                   "Score a ground-truth frame without prediction as an empty prediction");
+    cmd->add_flag("--where-depth", opts->where_depth,
+                  "Score only pixels with depth (the frame's depth.png, or an OCID sequence's "
+                  "depth/): labels drawn on the points, as OSD's and OCID's were");
     cmd->callback([opts]() { run(*opts); });
 }
 
