@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdlib>
 #include <set>
 #include <utility>
@@ -23,101 +24,102 @@ TEST(ClusterColor, DistinctForManyClusters) {
     EXPECT_EQ(cluster_color(3), cluster_color(3));  // fixed
 }
 
-TEST(RenderWeightColors, IsEquation9) {
-    // Two frames: a box present, then gone. With psi = 1, its former pixels hold half the
-    // box cluster's weight and half the new winner's: their colour is the average (eq. 9).
-    Scene s;
-    SceneBox b;
-    b.x = 0.0f;
-    b.z = 0.9f;
-    b.w = b.h = b.d = 0.3f;
-    s.boxes = {b};
-    ClusterParams p = ClusterParams::paper();
-    p.k = 3;
-    ClusterState state(p);
+namespace {
+
+/// One box of side `size` at 0.9 m on the synthetic scene and the paper's clustering of k
+/// clusters at `stride` over it: each step renders the scene, clusters it and renders the
+/// eq. 9 colours into `out`.
+struct WeightColourScene {
+    Scene scene;
+    ClusterState state;
     OrganizedCloud cloud;
     NormalMap normals;
     std::vector<std::uint8_t> active;
     LabelImage labels;
     ColorImage out;
+
+    static ClusterParams params(int k, int stride) {
+        ClusterParams p = ClusterParams::paper();
+        p.k = k;
+        p.stride = stride;
+        return p;
+    }
+    WeightColourScene(float size, int k, int stride) : state(params(k, stride)) {
+        SceneBox b;
+        b.z = 0.9f;
+        b.w = b.h = b.d = size;
+        scene.boxes = {b};
+    }
+    RgbdFrame step(std::vector<int>* truth = nullptr) {
+        RgbdFrame f = render_scene(scene, truth);
+        back_project(f, cloud);
+        estimate_normals(NormalParams{}, cloud, normals);
+        select_depth_range(DepthRange{}, cloud, active);
+        state.step(cloud, normals, active, labels);
+        render_weight_colors(state, labels, f, out);
+        return f;
+    }
+    /// Eq. (9) at pixel (u, v) from its grid point's weights, in double.
+    std::array<double, 3> expected(int u, int v) const {
+        const PixelWeights& mu = state.weights(state.grid_index(u, v));
+        std::array<double, 3> c{};
+        for (int j = 0; j < state.params().k; ++j)
+            for (int q = 0; q < 3; ++q) c[static_cast<std::size_t>(q)] += mu.weight(j) * cluster_color(j)[q];
+        return c;
+    }
+};
+
+}  // namespace
+
+TEST(RenderWeightColors, IsEquation9) {
+    // Two frames: a box present, then gone. With psi = 1, its former pixels hold half the
+    // box cluster's weight and half the new winner's: their colour is the average (eq. 9).
+    WeightColourScene w(0.3f, 3, 1);
     std::vector<int> truth;
-    RgbdFrame f = render_scene(s, &truth);
-    back_project(f, cloud);
-    estimate_normals(NormalParams{}, cloud, normals);
-    select_depth_range(DepthRange{}, cloud, active);
-    state.step(cloud, normals, active, labels);
-    render_weight_colors(state, labels, f, out);
+    RgbdFrame f = w.step(&truth);
     const std::size_t centre = static_cast<std::size_t>(200) * f.width() + f.width() / 2;
     ASSERT_EQ(truth[centre], kTruthBox0);
-    const int before = labels.labels[centre];
+    const int before = w.labels.labels[centre];
     ASSERT_GT(before, 0);
-    for (int q = 0; q < 3; ++q) EXPECT_EQ(out.rgb[3 * centre + q], cluster_color(before - 1)[q]);
+    for (int q = 0; q < 3; ++q) EXPECT_EQ(w.out.rgb[3 * centre + q], cluster_color(before - 1)[q]);
 
-    s.boxes.clear();
-    f = render_scene(s);
-    back_project(f, cloud);
-    estimate_normals(NormalParams{}, cloud, normals);
-    select_depth_range(DepthRange{}, cloud, active);
-    state.step(cloud, normals, active, labels);
-    render_weight_colors(state, labels, f, out);
-    const int after = labels.labels[centre];
+    w.scene.boxes.clear();
+    f = w.step();
+    const int after = w.labels.labels[centre];
     ASSERT_GT(after, 0);
     ASSERT_NE(after, before);
-    const PixelWeights& mu = state.weights(state.grid_index(f.width() / 2, 200));
-    double expect[3] = {0, 0, 0};
-    for (int j = 0; j < 3; ++j)
-        for (int q = 0; q < 3; ++q) expect[q] += mu.weight(j) * cluster_color(j)[q];
-    for (int q = 0; q < 3; ++q) EXPECT_NEAR(out.rgb[3 * centre + q], expect[q], 1.0);
+    const std::array<double, 3> expect = w.expected(f.width() / 2, 200);
+    for (int q = 0; q < 3; ++q) EXPECT_NEAR(w.out.rgb[3 * centre + q], expect[static_cast<std::size_t>(q)], 1.0);
+    const PixelWeights& mu = w.state.weights(w.state.grid_index(f.width() / 2, 200));
     EXPECT_NEAR(mu.weight(before - 1), 0.5, 1e-4);
     EXPECT_NEAR(mu.weight(after - 1), 0.5, 1e-4);
 
     // Pixels with no point show the scene's own colour as dim grey, not a cluster colour.
     f.color.rgb.assign(f.color.rgb.size(), 200);
-    render_weight_colors(state, labels, f, out);
-    ASSERT_EQ(labels.labels[0], 0);  // top-left: no table, no box
-    EXPECT_EQ(out.rgb[0], static_cast<std::uint8_t>(200 * 0.35f));
+    render_weight_colors(w.state, w.labels, f, w.out);
+    ASSERT_EQ(w.labels.labels[0], 0);  // top-left: no table, no box
+    EXPECT_EQ(w.out.rgb[0], static_cast<std::uint8_t>(200 * 0.35f));
 }
 
 // With a sampling stride, every pixel with a label takes the eq. 9 colour of its grid
 // point's weights (u / s, v / s): along whole rows, the last cut short (a width that is
 // not a multiple of s).
 TEST(RenderWeightColors, AtAStrideEachPixelTakesItsGridPointsColour) {
-    Scene s;
-    SceneBox b;
-    b.x = 0.05f;
-    b.z = 0.9f;
-    b.w = b.h = b.d = 0.25f;
-    s.boxes = {b};
-    ClusterParams p = ClusterParams::paper();
-    p.k = 4;
-    p.stride = 3;
-    ClusterState state(p);
-    OrganizedCloud cloud;
-    NormalMap normals;
-    std::vector<std::uint8_t> active;
-    LabelImage labels;
-    ColorImage out;
-    for (int frame = 0; frame < 2; ++frame) {  // two frames: weights shared between clusters
-        s.boxes[0].x = frame == 0 ? 0.05f : -0.05f;
-        const RgbdFrame f = render_scene(s);
-        back_project(f, cloud);
-        estimate_normals(NormalParams{}, cloud, normals);
-        select_depth_range(DepthRange{}, cloud, active);
-        state.step(cloud, normals, active, labels);
-        render_weight_colors(state, labels, f, out);
+    WeightColourScene w(0.25f, 4, 3);
+    for (const float x : {0.05f, -0.05f}) {  // two frames: weights shared between clusters
+        w.scene.boxes[0].x = x;
+        w.step();
     }
-    const int W = labels.width;
+    const int W = w.labels.width;
     ASSERT_NE(W % 3, 0);
     std::size_t checked = 0;
     for (int v : {100, 200, 301})
         for (int u = 0; u < W; ++u) {
             const std::size_t q = static_cast<std::size_t>(v) * W + u;
-            if (labels.labels[q] == 0) continue;
-            const PixelWeights& mu = state.weights(state.grid_index(u, v));
-            double expect[3] = {0, 0, 0};
-            for (int j = 0; j < p.k; ++j)
-                for (int c = 0; c < 3; ++c) expect[c] += mu.weight(j) * cluster_color(j)[c];
-            for (int c = 0; c < 3; ++c) EXPECT_NEAR(out.rgb[3 * q + c], expect[c], 1.0) << u << ", " << v;
+            if (w.labels.labels[q] == 0) continue;
+            const std::array<double, 3> expect = w.expected(u, v);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(w.out.rgb[3 * q + c], expect[static_cast<std::size_t>(c)], 1.0) << u << ", " << v;
             ++checked;
         }
     EXPECT_GT(checked, 200u);
