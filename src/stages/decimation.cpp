@@ -277,10 +277,13 @@ void pad_for_vote(const std::uint16_t* depth, const std::uint16_t* labels, const
 
 /// The votes of kLanes edge blocks at padded indices `at`, each lane as DecimatedSource's
 /// doc says, with the taps in row-major order: the same sums, in the same order, as one block
-/// at a time. winner[l]: the tap (index into `offsets`) of the block nearest in colour among
-/// the other labels where they outweigh the block's own, else -1 (and -1 for a block without
-/// depth). Branch-free and lane by lane, so that the lanes vectorize (AVX2 gathers; built
-/// for baseline x86-64 too). Cost: kTaps taps per lane.
+/// at a time. The other labels vote together (an outline mostly parts two; counting each
+/// apart scored the same on osd_mosd), and the block nearest in colour among theirs speaks
+/// for them. winner[l]: the tap (index into `offsets`) of that block where they outweigh the
+/// block's own label, else -1 (and -1 for a block without depth). Branch-free (whether a tap
+/// is on the surface or of the label follows no pattern a predictor learns) and lane by lane,
+/// so that the lanes' arithmetic runs as vectors (AVX2 and baseline x86-64 clones; the taps'
+/// loads stay scalar). Cost: kTaps taps per lane.
 WUL3D_AVX2_CLONES
 void vote_lanes(const std::uint32_t* __restrict depth_label, const std::uint32_t* __restrict rgb,
                 const std::int32_t* __restrict at, const std::int32_t* __restrict offsets,
