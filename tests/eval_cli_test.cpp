@@ -172,6 +172,19 @@ TEST(EvalCli, WhereDepthScoresOnlyPixelsWithDepth) {
     EXPECT_EQ(r.exit_code, 2) << describe(r);
     EXPECT_EQ(lines(r.err), 1) << r.err;
     EXPECT_NE(r.err.find("--where-depth"), std::string::npos) << r.err;
+
+    // An OSD tree as downloaded: the depth of annotation/f1.png is disparity/f1.png.
+    const fs::path tree = f.dir / "osd";
+    fs::create_directories(tree / "image_color");
+    fs::create_directories(tree / "disparity");
+    write(tree / "annotation" / "f1.png", wul3d::read_label_png((f.gt / "f1" / "label.png").string()));
+    wul3d::write_depth_png((tree / "disparity" / "f1.png").string(), depth(12, 15, 20));
+    r = run_cli({"eval", f.pred.string(), tree.string(), "--where-depth"});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_NE(r.out.find("Overlap F   100.0\n"), std::string::npos) << r.out;
+    r = run_cli({"eval", f.pred.string(), tree.string()});
+    ASSERT_EQ(r.exit_code, 0) << describe(r);
+    EXPECT_NE(r.out.find("Overlap F   66.7\n"), std::string::npos) << r.out;
 }
 
 TEST(EvalCli, MissingPrediction_ExitTwoUnlessAllowed) {

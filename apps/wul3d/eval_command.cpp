@@ -198,22 +198,27 @@ nlohmann::json score_json(const ImageScore& s) {
             {"matches", matches}};
 }
 
-/// The depth image of a frame whose labels are at `gt`: depth.png beside them (a frame
-/// folder), or depth/ with the same name in an OCID sequence (label/NAME.png). Else an
+/// The depth image of frame `f`: depth.png beside its labels (a frame folder); in a dataset
+/// as downloaded, the same name under depth/ (an OCID sequence's label/, a BOP scene's
+/// mask_visib/) or disparity/ (an OSD tree's annotation/: depth in millimetres). Else an
 /// InputError: --where-depth needs it.
-fs::path depth_beside(const fs::path& gt) {
-    const fs::path in_folder = gt.parent_path() / "depth.png";
-    if (is_file(in_folder)) return in_folder;
-    const fs::path ocid = gt.parent_path().parent_path() / "depth" / gt.filename();
-    if (gt.parent_path().filename() == "label" && is_file(ocid)) return ocid;
-    throw InputError(gt.string() + ": --where-depth: no depth image beside the ground truth (" +
-                     in_folder.string() + ")");
+fs::path depth_of(const FramePair& f) {
+    const fs::path folder = f.gt.parent_path(), root = folder.parent_path();
+    const fs::path beside = folder / "depth.png";
+    fs::path in_dataset;
+    if (f.bop) in_dataset = root / "depth" / (f.name + ".png");
+    else if (folder.filename() == "label") in_dataset = root / "depth" / f.gt.filename();
+    else if (folder.filename() == "annotation") in_dataset = root / "disparity" / f.gt.filename();
+    if (!in_dataset.empty() && is_file(in_dataset)) return in_dataset;
+    if (is_file(beside)) return beside;
+    throw InputError(f.gt.string() + ": --where-depth: no depth image for the frame (" +
+                     (in_dataset.empty() ? beside : in_dataset).string() + ")");
 }
 
 /// Both label images 0 where the frame's depth image has no reading: those pixels are not
 /// scored, as in OSD's and OCID's labels, which were drawn on the points.
 void keep_where_depth(const FramePair& f, LabelImage& gt, LabelImage& pred) {
-    const fs::path path = depth_beside(f.gt);
+    const fs::path path = depth_of(f);
     const DepthImage depth = read_depth_png(path.string(), 0.001f);  // only 0 or not matters
     if (depth.width != gt.width || depth.height != gt.height)
         throw InputError(path.string() + " is " + std::to_string(depth.width) + "x" +
@@ -410,8 +415,8 @@ void add_eval_command(CLI::App& app) {
     cmd->add_flag("--allow-missing", opts->allow_missing,
                   "Score a ground-truth frame without prediction as an empty prediction");
     cmd->add_flag("--where-depth", opts->where_depth,
-                  "Score only pixels with depth (the frame's depth.png, or an OCID sequence's "
-                  "depth/): labels drawn on the points, as OSD's and OCID's were");
+                  "Score only pixels with depth (the frame's depth.png; a dataset's depth/ or "
+                  "OSD's disparity/): labels drawn on the points, as OSD's and OCID's were");
     cmd->callback([opts]() { run(*opts); });
 }
 
