@@ -13,7 +13,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "test_support.hpp"
@@ -101,18 +103,30 @@ std::string read_text(const fs::path& p) {
 }
 
 /// roscore on a free port of 127.0.0.1, its logs in `dir`; the environment points there.
+/// Ready when its log says the core service started. A port found free can be taken before
+/// roscore binds it (the ROS processes of a test running beside this one open ephemeral
+/// ports), and roscore then exits: up to three tries, each on a new port, each waiting at
+/// most 30 s.
 class RosCore {
 public:
     explicit RosCore(const fs::path& dir) {
-        port_ = free_port();
-        const std::string uri = "http://127.0.0.1:" + std::to_string(port_);
-        ::setenv("ROS_MASTER_URI", uri.c_str(), 1);
         ::setenv("ROS_IP", "127.0.0.1", 1);
         ::setenv("ROS_HOSTNAME", "127.0.0.1", 1);
         ::setenv("ROS_HOME", dir.c_str(), 1);
         ::setenv("ROS_LOG_DIR", dir.c_str(), 1);
-        core_.emplace(std::vector<std::string>{"roscore", "-p", std::to_string(port_)},
-                      dir / "roscore.log");
+        for (int attempt = 0; attempt < 3; ++attempt) {
+            port_ = free_port();
+            const std::string uri = "http://127.0.0.1:" + std::to_string(port_);
+            ::setenv("ROS_MASTER_URI", uri.c_str(), 1);
+            const fs::path log = dir / ("roscore" + std::to_string(attempt) + ".log");
+            core_.emplace(std::vector<std::string>{"roscore", "-p", std::to_string(port_)}, log);
+            for (int i = 0; i < 300 && core_->alive(); ++i) {
+                if (read_text(log).find("started core service") != std::string::npos) return;
+                std::this_thread::sleep_for(std::chrono::milliseconds(100));
+            }
+            core_.reset();  // ended with its group
+        }
+        throw std::runtime_error("roscore did not start in three tries (logs in " + dir.string() + ")");
     }
     int port() const { return port_; }
 
