@@ -26,6 +26,8 @@ import operator
 import os
 from collections.abc import Iterator, Sequence
 
+import numpy as np
+
 from ._wul3d import (  # noqa: F401  (re-exported)
     Frame,
     InputError,
@@ -111,7 +113,8 @@ def read(path, format="auto", tum_camera="", intrinsics=None, calibration="",
     return Reader(path, format, tum_camera, intrinsics, calibration, registration)
 
 
-def evaluate(pred, gt, boundary_fraction=0.003, boundary_tolerance_px=-1, detected_f=0.75):
+def evaluate(pred, gt, boundary_fraction=0.003, boundary_tolerance_px=-1, detected_f=0.75,
+             depth=None):
     """UOIS metrics of predicted instances against ground truth, as `wul3d eval` computes them.
 
     Args:
@@ -123,6 +126,9 @@ def evaluate(pred, gt, boundary_fraction=0.003, boundary_tolerance_px=-1, detect
         boundary_tolerance_px: >= 0 overrides boundary_fraction; -1 uses it.
         detected_f: an object counts as detected (%>=75) when its matched overlap F is above
             this.
+        depth: None, or the frames' (H, W) depth images (a list with lists): only the pixels
+            with depth (non-zero) are scored, both labels 0 elsewhere, as `wul3d eval
+            --where-depth` does.
 
     Returns:
         For one image: a dict with overlap_p/r/f, boundary_p/r/f, detected_share (%>=75),
@@ -130,18 +136,33 @@ def evaluate(pred, gt, boundary_fraction=0.003, boundary_tolerance_px=-1, detect
         Hungarian pairs). For a list: the macro average over images (docs/EVAL.md) with
         "images" and the summed counts, and "per_image", the list of the per-image dicts.
     """
+    def where_depth(p, g, d):
+        if d is None:
+            return p, g
+        d, p, g = np.asarray(d), np.array(p, copy=True), np.array(g, copy=True)
+        if d.shape != g.shape:
+            raise ValueError(f"depth is {d.shape}, gt {g.shape}: one depth image per label image")
+        p[d == 0] = 0
+        g[d == 0] = 0
+        return p, g
+
+    def score(p, g, d):
+        p, g = where_depth(p, g, d)
+        return _wul3d._score_image(p, g, boundary_fraction, boundary_tolerance_px, detected_f)
+
     if isinstance(pred, (list, tuple)) or isinstance(gt, (list, tuple)):
         if not isinstance(pred, (list, tuple)) or not isinstance(gt, (list, tuple)):
             raise TypeError("pred and gt: both lists of images, or both one image")
         if len(pred) != len(gt):
             raise ValueError(f"pred has {len(pred)} images, gt {len(gt)}")
-        scores = [_wul3d._score_image(p, g, boundary_fraction, boundary_tolerance_px, detected_f)
-                  for p, g in zip(pred, gt)]
+        if depth is not None and (not isinstance(depth, (list, tuple)) or len(depth) != len(gt)):
+            raise ValueError(f"depth: a list of {len(gt)} depth images, one per label image")
+        depths = depth if depth is not None else [None] * len(gt)
+        scores = [score(p, g, d) for p, g, d in zip(pred, gt, depths)]
         summary = _wul3d._summarize(scores)
         summary["per_image"] = scores
         return summary
-    return _wul3d._score_image(pred, gt, boundary_fraction, boundary_tolerance_px, detected_f)
-
+    return score(pred, gt, depth)
 
 
 def run(input, out, **options) -> dict:

@@ -46,6 +46,29 @@ def test_lists_equal_wul3d_eval(cli, tabletop_cli_out, tmp_path):
     assert len(ours["per_image"]) == len(frames)
 
 
+def test_where_depth_scores_only_pixels_with_depth():
+    # Object 2 lies where the depth image has no reading: not counted, as `wul3d eval
+    # --where-depth` does not count it.
+    gt = np.zeros((60, 80), np.uint16)
+    gt[10:30, 10:30] = 1
+    gt[35:55, 40:70] = 2
+    pred = np.zeros((60, 80), np.uint16)
+    pred[10:30, 10:30] = 5
+    depth = np.full((60, 80), 900, np.uint16)
+    depth[35:55, 40:70] = 0
+    assert wul3d.evaluate(pred, gt)["overlap_r"] == pytest.approx(400 / 1000)  # pixels found
+    s = wul3d.evaluate(pred, gt, depth=depth)
+    assert s["overlap_f"] == 1 and s["boundary_f"] == 1 and s["gt_objects"] == 1
+    both = wul3d.evaluate([pred, pred], [gt, gt], depth=[depth, None])
+    assert both["per_image"][0]["overlap_f"] == 1
+    assert both["per_image"][1]["overlap_r"] == pytest.approx(400 / 1000)
+    assert gt[40, 50] == 2  # the caller's arrays are left as they were
+    with pytest.raises(ValueError, match="depth is"):
+        wul3d.evaluate(pred, gt, depth=depth[:, :70])
+    with pytest.raises(ValueError, match="a list of 2 depth images"):
+        wul3d.evaluate([pred, pred], [gt, gt], depth=[depth])
+
+
 def test_bad_label_images():
     gt = np.zeros((10, 10), np.uint16)
     with pytest.raises(TypeError, match="pred: dtype float32"):
