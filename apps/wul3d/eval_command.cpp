@@ -198,6 +198,12 @@ nlohmann::json score_json(const ImageScore& s) {
             {"matches", matches}};
 }
 
+/// The one-line error for an image of `path` whose size differs from the ground truth's.
+InputError size_mismatch(const fs::path& path, int width, int height, const fs::path& gt_path, const LabelImage& gt) {
+    return InputError(path.string() + " is " + std::to_string(width) + "x" + std::to_string(height) + " but " +
+                      gt_path.string() + " is " + std::to_string(gt.width) + "x" + std::to_string(gt.height));
+}
+
 /// The depth image of frame `f`: depth.png beside its labels (a frame folder); in a dataset
 /// as downloaded, the same name under depth/ (an OCID sequence's label/, a BOP scene's
 /// mask_visib/) or disparity/ (an OSD tree's annotation/: depth in millimetres). Else an
@@ -221,9 +227,7 @@ void keep_where_depth(const FramePair& f, LabelImage& gt, LabelImage& pred) {
     const fs::path path = depth_of(f);
     const DepthImage depth = read_depth_png(path.string(), 0.001f);  // only 0 or not matters
     if (depth.width != gt.width || depth.height != gt.height)
-        throw InputError(path.string() + " is " + std::to_string(depth.width) + "x" +
-                         std::to_string(depth.height) + " but " + f.gt.string() + " is " +
-                         std::to_string(gt.width) + "x" + std::to_string(gt.height));
+        throw size_mismatch(path, depth.width, depth.height, f.gt, gt);
     for (std::size_t p = 0; p < depth.data.size(); ++p)
         if (depth.data[p] == 0) gt.labels[p] = pred.labels[p] = 0;
 }
@@ -246,9 +250,7 @@ std::pair<LabelImage, LabelImage> read_pair(const FramePair& f, int bg_max, bool
         pred = read_label_png(f.pred.string());
     }
     if (pred.width != gt.width || pred.height != gt.height)
-        throw InputError(f.pred.string() + " is " + std::to_string(pred.width) + "x" +
-                         std::to_string(pred.height) + " but " + f.gt.string() + " is " +
-                         std::to_string(gt.width) + "x" + std::to_string(gt.height));
+        throw size_mismatch(f.pred, pred.width, pred.height, f.gt, gt);
     if (where_depth) keep_where_depth(f, gt, pred);
     return {std::move(gt), std::move(pred)};
 }

@@ -19,8 +19,8 @@ struct VoteBuffers {
     /// (depth 0 there: no tap is on the surface, and a sum plus 0 is the sum): per block its
     /// depth and label (depth | label << 16), and its colour (r | g << 8 | b << 16).
     std::vector<std::uint32_t> depth_label, rgb;
-    /// The edge blocks, as block and padded indices, a lane's worth at a time.
-    std::vector<std::int32_t> edges, padded_edges;
+    /// The edge blocks' indices, a whole number of lanes.
+    std::vector<std::int32_t> edges;
     int padded_width = 0, padded_height = 0;
 };
 

@@ -334,7 +334,6 @@ void DecimatedSource::vote(const std::uint16_t* labels, VoteBuffers& vb) const {
     // The edge blocks (found by memchr, not a test per block), a whole number of lanes: the
     // last lanes repeat the last block (their results are not kept).
     vb.edges.clear();
-    vb.padded_edges.clear();
     for (int bv = 0; bv < h_; ++bv) {
         const std::uint8_t* const row = edges_ + static_cast<std::size_t>(bv) * w;
         for (const auto* at = static_cast<const std::uint8_t*>(std::memchr(row, 1, static_cast<std::size_t>(w)));
@@ -342,13 +341,11 @@ void DecimatedSource::vote(const std::uint16_t* labels, VoteBuffers& vb) const {
              at = static_cast<const std::uint8_t*>(std::memchr(at + 1, 1, static_cast<std::size_t>(row + w - at - 1)))) {
             const int bu = static_cast<int>(at - row);
             vb.edges.push_back(bv * w + bu);
-            vb.padded_edges.push_back((bv + kReach) * pw + bu + kReach);
         }
     }
     const std::size_t n = vb.edges.size();
     if (n == 0) return;
     vb.edges.resize((n + kLanes - 1) / kLanes * kLanes, vb.edges.back());
-    vb.padded_edges.resize(vb.edges.size(), vb.padded_edges.back());
     std::array<std::int32_t, kTaps> padded_offsets{}, block_offsets{};
     for (int t = 0; t < kTaps; ++t) {
         const int dv = (t / kSide) * kStep - kReach, du = (t % kSide) * kStep - kReach;
@@ -356,14 +353,19 @@ void DecimatedSource::vote(const std::uint16_t* labels, VoteBuffers& vb) const {
         block_offsets[static_cast<std::size_t>(t)] = dv * w + du;
     }
     const float* const weight = vote_weights().data();
-    const std::int32_t *const edges = vb.edges.data(), *const padded = vb.padded_edges.data();
+    const std::int32_t* const edges = vb.edges.data();
     const float same = same_, same_rel = same_rel_;
     const auto batches = static_cast<std::ptrdiff_t>(vb.edges.size() / kLanes);
 #pragma omp parallel for schedule(static)
     for (std::ptrdiff_t i = 0; i < batches; ++i) {
+        // Block b = bv w + bu in the padded copy: (bv + kReach) pw + bu + kReach.
+        std::int32_t at[kLanes];
         int winner[kLanes];
-        vote_lanes(vb.depth_label.data(), vb.rgb.data(), padded + i * kLanes, padded_offsets.data(), weight, same,
-                   same_rel, winner);
+        for (int l = 0; l < kLanes; ++l) {
+            const std::int32_t b = edges[i * kLanes + l];
+            at[l] = b + (b / w) * (pw - w) + kReach * (pw + 1);
+        }
+        vote_lanes(vb.depth_label.data(), vb.rgb.data(), at, padded_offsets.data(), weight, same, same_rel, winner);
         for (int l = 0; l < kLanes; ++l) {
             const std::int32_t b = edges[i * kLanes + l];
             // Another label wins only with more weight than its own.
