@@ -20,15 +20,16 @@ namespace wul3d {
 struct PlaneParams {
     int grid_stride_px = 4;        ///< planes are grown on every n-th pixel in u and v; [1, 32]
     float grow_angle_deg = 12.0f;  ///< a grid point joins a region when its normal is within
-                                   ///< this of the region's mean normal; (0, 90). The
-                                   ///< pipeline widens it with the depth's noise, at most
-                                   ///< 1.5 times (docs/DESIGN.md, "Support plane")
+                                   ///< this of the region's mean normal; (0, 90); widened
+                                   ///< with the depth's noise (remove_support_plane)
     float grow_dist_m = 0.012f;    ///< ... and it lies within this of the region's plane; > 0
     int min_region_points = 40;    ///< grid points of a region worth fitting; >= 3
     float merge_angle_deg = 6.0f;  ///< regions this parallel ...; (0, 90)
     float merge_dist_m = 0.02f;    ///< ... and this close in offset d are one plane; > 0
     float on_plane_m = 0.008f;     ///< height below which a point is on the plane; > 0
-    float on_plane_rel = 0.004f;   ///< plus this times z^2 (sensor noise grows with z^2); >= 0
+    float on_plane_rel = 0.004f;   ///< plus this times z^2 (sensor noise grows with z^2); >= 0;
+                                   ///< the band widened with the depth's noise
+                                   ///< (remove_support_plane)
     float inlier_angle_deg = 25.0f;  ///< an on-plane point whose normal departs more than this
                                      ///< from the plane's is a candidate foot; (0, 90)
     float min_extent = 0.04f;      ///< a support covers at least this share of the grid points
@@ -70,10 +71,13 @@ private:
 /// (PlaneClass) into `classes` (resized to W x H). With no support found every active point
 /// is kPlaneObject.
 /// `K` projects the feet of points (their foot on the plane) into the image to test them
-/// against the support's extent.
+/// against the support's extent. `noise_widening` (>= 1; the pipeline passes
+/// plane_noise_widening of the frame's measured depth noise) widens the grow angle and the
+/// on-plane band for a camera noisier than the parameters assume; a low support's layer
+/// keeps the given band (docs/DESIGN.md, "Support plane").
 PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
                                  const OrganizedCloud& cloud, const NormalMap& normals,
                                  const std::vector<std::uint8_t>& active, PlaneWorkspace& ws,
-                                 std::vector<std::uint8_t>& classes);
+                                 std::vector<std::uint8_t>& classes, float noise_widening = 1.0f);
 
 }  // namespace wul3d

@@ -287,18 +287,19 @@ void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {
 
 namespace {
 
-/// The support plane's grow angle (PlaneParams::grow_angle_deg) for a frame whose depth noise
-/// is `noise_px` (measure_depth_noise): the given one up to the noise that the least normal
-/// radius takes within max_tilt_noise_deg (normal_radius_for rounds up to radius_px + 1
-/// past it), then wider in proportion to the noise, at most 1.5 times. The noise is the
-/// frame's typical one, and a camera noisier than that tilts the normals of a far table past
-/// the given angle (active stereo, whose noise grows with z^2 from a larger base: in 1 of
-/// the 20 tabletop tune frames the table was no candidate at all). O(1).
-float plane_grow_angle(const PlaneParams& plane, const NormalParams& normals, float noise_px) {
-    if (!(normals.max_tilt_noise_deg > 0)) return plane.grow_angle_deg;
+/// How much wider the support plane's grow angle and band are for a frame whose depth noise
+/// is `noise_px` (measure_depth_noise; remove_support_plane's noise_widening): 1 up to the
+/// noise that the least normal radius takes within max_tilt_noise_deg (normal_radius_for
+/// rounds up to radius_px + 1 past it), then in proportion to the noise, at most 1.5. The
+/// noise is the frame's typical one, and a camera noisier than that tilts the normals of a
+/// far table past the given angle and scatters its points past the given band (active
+/// stereo, whose noise grows with z^2 from a larger base: in 1 of the 20 tabletop tune frames
+/// the table was no candidate at all). O(1).
+float plane_noise_widening(const NormalParams& normals, float noise_px) {
+    if (!(normals.max_tilt_noise_deg > 0)) return 1.0f;
     const float least_radius_noise = (static_cast<float>(normals.radius_px) + 0.5f) * std::sqrt(2.0f) *
                                      std::tan(normals.max_tilt_noise_deg * std::numbers::pi_v<float> / 180.0f);
-    return plane.grow_angle_deg * std::clamp(noise_px / least_radius_noise, 1.0f, 1.5f);
+    return std::clamp(noise_px / least_radius_noise, 1.0f, 1.5f);
 }
 
 }  // namespace
@@ -309,10 +310,8 @@ void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
     // clustering's mask so that labels.png keeps the paper's clusters), the rest is segmented.
     auto t = Clock::now();
     if (params.remove_plane) {
-        PlaneParams plane_params = params.plane;
-        plane_params.grow_angle_deg = plane_grow_angle(params.plane, params.normals, r.depth_noise_px);
-        r.plane = remove_support_plane(plane_params, frame.intrinsics, cloud_, normals_,
-                                       r.active, plane_ws_, r.plane_classes);
+        r.plane = remove_support_plane(params.plane, frame.intrinsics, cloud_, normals_, r.active, plane_ws_,
+                                       r.plane_classes, plane_noise_widening(params.normals, r.depth_noise_px));
     } else {
         r.plane = PlaneResult{};
         r.plane_classes.resize(r.active.size());

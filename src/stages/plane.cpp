@@ -586,16 +586,32 @@ std::size_t keep_all_active(const std::vector<std::uint8_t>& active, std::vector
     return static_cast<std::size_t>(std::count(classes.begin(), classes.end(), kPlaneObject));
 }
 
+/// The parameters for a camera `noise_widening` times noisier than `given` assume: the grow
+/// angle (below 90 degrees), the band and the regions' distance (its z^2 term) widened.
+PlaneParams widened_for_noise(const PlaneParams& given, float noise_widening) {
+    if (!(noise_widening >= 1.0f) || !std::isfinite(noise_widening)) {
+        std::ostringstream msg;
+        msg << "plane noise widening = " << noise_widening << ": must be finite and >= 1";
+        throw ParamError(msg.str());
+    }
+    PlaneParams params = given;
+    params.grow_angle_deg = std::min(given.grow_angle_deg * noise_widening, std::max(given.grow_angle_deg, 89.0f));
+    params.on_plane_m *= noise_widening;
+    params.on_plane_rel *= noise_widening;
+    return params;
+}
+
 }  // namespace
 
 bool detail::fit_grid_points(const InlierTest& grid, int min_points, const std::uint8_t* take, Plane& out) {
     return fit_grid_subset(grid, min_points, [=](int g) { return take[g] != 0; }, out);
 }
 
-PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrinsics& K,
+PlaneResult remove_support_plane(const PlaneParams& given, const PinholeIntrinsics& K,
                                  const OrganizedCloud& cloud, const NormalMap& normals,
                                  const std::vector<std::uint8_t>& active, PlaneWorkspace& workspace,
-                                 std::vector<std::uint8_t>& classes) {
+                                 std::vector<std::uint8_t>& classes, float noise_widening) {
+    const PlaneParams params = widened_for_noise(given, noise_widening);
     PlaneBuffers& ws = workspace.buffers();
     classes.resize(cloud.size());
     PlaneResult result;
@@ -635,8 +651,12 @@ PlaneResult remove_support_plane(const PlaneParams& params, const PinholeIntrins
     kept += detail::restore_islands(params, cloud, active, pl, ws, classes);
 
     // 8: a board or tray lying on the support, the objects on it: background, as the support is.
+    // Its layer keeps the given band: a board's top stands 1-5 cm over the support, within
+    // the band of a noisy camera (an active-stereo one at 1.5 m: 2.5 cm).
+    InlierTest given_band = inliers;
+    given_band.band = Band{given.on_plane_m, given.on_plane_rel};
     const std::size_t low_removed =
-        detail::remove_low_support(params, grid, cloud, normals, inliers, pl, ws, classes, result.low_support);
+        detail::remove_low_support(params, grid, cloud, normals, given_band, pl, ws, classes, result.low_support);
     result.low_found = low_removed > 0;
     result.kept = kept - low_removed;
     return result;
