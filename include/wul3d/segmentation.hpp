@@ -127,9 +127,6 @@ struct ContainerParams {
     float inside_share = 0.95f;     ///< share of the inside's feet within the circle (radius
                                     ///< + 10 % + 1 cm); (0, 1]
     float height_tol_m = 0.01f;     ///< the inside's top within this of the rim's height; > 0
-    bool islands = true;            ///< object regions no segment reached (a small cup's
-                                    ///< inside at --decimate 2, every pixel on a crease) are
-                                    ///< candidates too; those joined to nothing are dropped
     bool far_rim = true;            ///< a second candidate circle per pair, fitted to the
                                     ///< front's edge and the inside's far outline at the
                                     ///< rim's height (its far rim), when the front spans a

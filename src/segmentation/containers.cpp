@@ -3,7 +3,7 @@
 // a depth step, where neither the crease test nor the merge can join them. Where the front
 // segment's edge along the step is a level circular arc on the support (circle_fit.hpp) and
 // the back segment stands inside that circle and reaches up to it, the back is the front's
-// inside and joins it. Regions no segment reached take part as islands (islands.cpp).
+// inside and joins it.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -340,7 +340,7 @@ int join_insides(const Ctx& x, SegmentBuffers& ws, int n) {
 }
 
 /// The rim test over segments 1..n (with gaps): candidates, their circles, their insides,
-/// the joins. Returns the joins. Cost: as join_containers', less the islands.
+/// the joins. Returns the joins. Cost: as join_containers'.
 int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     if (n < 2) return 0;
     collect_boundary_steps(x, ws, n);
@@ -355,20 +355,14 @@ int join_rims(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 
 /// The container rule (SegmentParams, "Containers"), on a support: a segment seen over
 /// another's circular, level edge across a depth step, lying inside that circle and reaching
-/// up to it, is the other's inside (a bowl's or a cup's) and joins it. With containers.islands the
-/// regions no segment reached take part as segments n + 1, ... (add_islands), and after the
-/// joins those that joined no segment are unlabelled again (drop_islands): the root of a
-/// joined set is its smallest label, so what is left above n joined only islands. In:
-/// ws.label (1..n with gaps). Out: ws.label with the insides joined. Cost: one pass over the
-/// pixels and a sort of the boundary pairs; then per candidate a few passes over its
-/// boundary, and one over the rows of the candidates' insides; with islands, add_islands and
-/// drop_islands.
+/// up to it, is the other's inside (a bowl's or a cup's) and joins it. In: ws.label (1..n
+/// with gaps). Out: ws.label with the insides joined. Cost: one pass over the pixels and a
+/// sort of the boundary pairs; then per candidate a few passes over its boundary, and one
+/// over the rows of the candidates' insides.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     ws.rim_joined.clear();
     if (!support || x.prm.containers.min_boundary <= 0 || n < 1) return;
-    const int islands = x.prm.containers.islands ? add_islands(x, ws, n) : 0;
-    stats.containers.joins = join_rims(x, *support, ws, n + islands);
-    if (islands > 0) drop_islands(x, ws, n);
+    stats.containers.joins = join_rims(x, *support, ws, n);
 }
 
 }  // namespace wul3d::detail

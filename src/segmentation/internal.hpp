@@ -37,8 +37,7 @@ struct LabelRun {
 struct SegmentWorkspace::Buffers {
     NormalMap smooth;                  ///< smoothed normals (cuts.normal_smooth_px)
     std::vector<float> smooth_scratch;
-    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component; once the seeds are
-                                       ///< spent, the container rule's open pixels (islands)
+    std::vector<std::uint8_t> cut;     ///< 1 = may seed a component
     std::vector<std::uint8_t> crease;  ///< bit 0: (p, p + s) concave along u; bit 1: along v
     std::vector<int> label;    ///< 0 none, 1..n
     std::vector<LabelRun> runs;        ///< pieces: the runs of equal labels, row by row
@@ -149,14 +148,6 @@ inline bool row_has_label(const int* row, int from, int to) {
     return any != 0;
 }
 
-/// Whether any of row[from, to) holds a label over n (an island, in the container rule): the
-/// same OR over the row as row_has_label.
-inline bool row_has_label_over(const int* row, int from, int to, int n) {
-    int any = 0;
-    for (int u = from; u < to; ++u) any |= row[u] > n;
-    return any != 0;
-}
-
 /// The 4-neighbours of pixel p = v W + u in a W x H image (left, right, up, down); -1 where
 /// one lies past the frame.
 inline std::array<int, 4> four_neighbours(int p, int u, int v, int W, int H) {
@@ -254,7 +245,7 @@ auto on_plane(const Ctx& x, const PlaneAxes& plane_xy, const Eigen::Vector2d& me
 /// One region by breadth-first search from `seed` (the caller has marked it): every
 /// 4-neighbour q of a region pixel with is_open(q) and continuous depth is marked (mark(q))
 /// and joins. The region's pixels land in queue[0, size); returns the size. Shared by the
-/// components that seed segments and the container rule's islands. Cost: O(region).
+/// components that seed segments. Cost: O(region).
 template <class IsOpen, class Mark>
 int flood_region(const Ctx& x, std::vector<int>& queue, int seed, IsOpen&& is_open, Mark&& mark) {
     const int W = x.W, H = x.H;
@@ -353,8 +344,7 @@ using Rule = void (*)(const Ctx& x, const Plane* support, SegmentBuffers& ws, in
 void merge_segments(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Containers (containers.cpp; SegmentParams, "Containers"): joins a container's inside,
-/// seen over its rim, to the container; with containers.islands, the regions no segment reached
-/// take part (islands.cpp). Nothing without a support. stats.containers.
+/// seen over its rim, to the container. Nothing without a support. stats.containers.
 void join_containers(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// The colour cue (colour_cue.cpp; hybrid): splits segments in two by colour.
@@ -381,16 +371,5 @@ void join_occluded(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& 
 /// Scope::Support (scope.cpp; docs/DESIGN.md, "Scope"; `support` not null): clears the
 /// labels of the segments the support does not hold. stats.support_scope, out_of_scope.
 void restrict_to_support(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
-
-// ---- islands (islands.cpp), for the container rule -----------------------------------------
-
-/// Islands: connected components (4-neighbours, depth-continuous) of object pixels that no
-/// segment reached, of cuts.min_seed_points or more, become segments n + 1, ... for the rim
-/// test. Returns the islands added.
-int add_islands(const Ctx& x, SegmentBuffers& ws, int n);
-
-/// The islands above label n that the rim test joined to nothing are unlabelled. Cost: a
-/// vectorized test per row, and a pass over the rows that hold islands.
-void drop_islands(const Ctx& x, SegmentBuffers& ws, int n);
 
 }  // namespace wul3d::detail
