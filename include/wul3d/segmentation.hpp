@@ -41,7 +41,8 @@ const char* scope_name(Scope s);
 /// The crease cuts and the components (cuts.cpp, components.cpp): a pixel seeds a component
 /// unless a concave crease or a depth jump runs through it; cut pixels and feet re-attach.
 struct CutParams {
-    int crease_step_px = 5;    ///< normals compared this many pixels apart; [1, 16]
+    int crease_step_px = 5;    ///< normals compared this many pixels apart; [1, 16]; the
+                               ///< pipeline widens it to the normals' radius when wider
     int normal_smooth_px = 3;  ///< the crease tests use normals averaged over a window of
                                ///< this radius (sensor noise); [0, 16], 0 = raw normals
     float concavity = 0.3f;    ///< (n_p - n_q) . (X_q - X_p) / |X_q - X_p| above this is a

@@ -302,6 +302,15 @@ float plane_noise_widening(const NormalParams& normals, float noise_px) {
     return std::clamp(noise_px / least_radius_noise, 1.0f, 1.5f);
 }
 
+/// How far apart the segmentation's crease tests compare normals (CutParams::crease_step_px)
+/// for normals estimated `normal_radius_px` either side (normal_radius_for): the given step,
+/// or the radius when wider, at most 16. Two normals closer than the radius share most of
+/// their neighbourhoods, and a crease between them fades: a noisy camera's wide normals (an
+/// active-stereo one far away, radius 6-10) ran a pile's objects into one. O(1).
+int crease_step_for(const CutParams& cuts, int normal_radius_px) {
+    return std::max(cuts.crease_step_px, std::min(normal_radius_px, 16));
+}
+
 }  // namespace
 
 void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
@@ -323,7 +332,9 @@ void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
     throw_if_stop_requested("the plane removal");
 
     t = Clock::now();
-    r.segment_stats = segment_objects(params.segmentation, cloud_, normals_, r.plane_classes,
+    SegmentParams segmentation = params.segmentation;
+    segmentation.cuts.crease_step_px = crease_step_for(params.segmentation.cuts, r.normal_radius_px);
+    r.segment_stats = segment_objects(segmentation, cloud_, normals_, r.plane_classes,
                                       r.plane.found ? &r.plane.support : nullptr, r.labels,
                                       segment_ws_, r.segments);
     r.times.segmentation = ms_since(t);

@@ -336,9 +336,10 @@ struct GeneratedFrame {
     LabelImage truth;
 };
 
-GeneratedFrame render_generated(const TempDir& dir, int seed, const std::string& sensor = "structured_light") {
+GeneratedFrame render_generated(const TempDir& dir, int seed, const std::string& sensor = "structured_light",
+                                const std::string& family = "tabletop") {
     const CommandResult gen = run_command({WUL3D_PYTHON3, WUL3D_SCENEGEN, "--out", dir.path().string(), "--seeds",
-                                           std::to_string(seed), "--sensor", sensor});
+                                           std::to_string(seed), "--sensor", sensor, "--family", family});
     EXPECT_EQ(gen.exit_code, 0) << gen.err;
     char name[32];
     std::snprintf(name, sizeof name, "scene_%05d", seed);
@@ -449,6 +450,37 @@ TEST(GeneratedScene, NoisyActiveStereoDepth_TheGrowAngleWidensAndTheFarTableIsTh
     std::size_t found = 0;  // objects that one predicted object holds the most of
     for (const int t : truth_objects) found += dominant_object(r.objects, g.truth, t).second > 0.5;
     EXPECT_GE(found, truth_objects.size() - 2);
+}
+
+// A generated pile (eval/scenegen.py pile tune seed 10005, eleven objects) seen by the
+// active-stereo camera from afar: the measured noise chooses normals of radius 8 or more, and
+// the crease tests, comparing normals 5 pixels apart, compared two normals of nearly the same
+// neighbourhood: no crease, and the pile came out as three objects, two of them whole. The
+// crease step widens to the normals' radius (crease_step_for), and two more come out whole.
+TEST(GeneratedScene, NoisyActiveStereoPile_TheCreaseStepWidensWithTheNormalsRadius) {
+    TempDir dir;
+    const GeneratedFrame g = render_generated(dir, 10005, "active_stereo", "pile");
+    std::set<int> truth_objects;
+    for (const std::uint16_t t : g.truth.labels)
+        if (t != 0) truth_objects.insert(t);
+    ASSERT_EQ(truth_objects.size(), 11u);
+    Pipeline pipeline{PipelineParams{}};
+    const FrameResult& r = pipeline.process(g.frame);
+    ASSERT_GE(r.normal_radius_px, 8) << "premise: normals wider than the given crease step";
+    // Found: one object holds most of it, and most of that object is it.
+    int found = 0;
+    for (const int t : truth_objects) {
+        const auto [id, share] = dominant_object(r.objects, g.truth, t);
+        if (share <= 0.5) continue;
+        std::size_t in_object = 0, of_t = 0;
+        for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
+            if (r.objects.labels[p] != id) continue;
+            ++in_object;
+            of_t += g.truth.labels[p] == t;
+        }
+        found += 2 * of_t > in_object;
+    }
+    EXPECT_GE(found, 4);  // 2 with the step of 5 pixels
 }
 
 // A generated scene (eval/scenegen.py tune seed 23): two plain boxes flush side by side, one
