@@ -29,18 +29,26 @@ struct Prepared {
     NormalMap normals;
     std::vector<std::uint8_t> active;
 
-    PlaneResult remove_plane(const PlaneParams& params, PlaneWorkspace& ws,
-                             std::vector<std::uint8_t>& classes) const {
-        return remove_support_plane(params, frame.intrinsics, cloud, normals, active, ws, classes);
+    PlaneResult remove_plane(const PlaneParams& params, PlaneWorkspace& ws, std::vector<std::uint8_t>& classes,
+                             float noise_widening = 1.0f) const {
+        return remove_support_plane(params, frame.intrinsics, cloud, normals, active, ws, classes, noise_widening);
     }
 };
 
-/// The frame back-projected, with its normals and depth-range mask (the pipeline's defaults).
-Prepared prepared(RgbdFrame frame) {
+/// The frame back-projected, with its normals and depth-range mask (the pipeline's defaults;
+/// with `radius_from_noise` the normals' radius chosen by the measured noise, as the pipeline
+/// chooses it).
+Prepared prepared(RgbdFrame frame, bool radius_from_noise = false) {
     Prepared f;
     f.frame = std::move(frame);
     back_project(f.frame, f.cloud);
-    estimate_normals(NormalParams{}, f.cloud, f.normals);
+    NormalParams normal_params;
+    if (radius_from_noise) {
+        std::vector<float> scratch;
+        const float noise = measure_depth_noise(f.cloud, static_cast<float>(f.frame.intrinsics.fx), scratch);
+        normal_params.radius_px = normal_radius_for(normal_params, noise);
+    }
+    estimate_normals(normal_params, f.cloud, f.normals);
     select_depth_range(DepthRange{}, f.cloud, f.active);
     return f;
 }
@@ -724,19 +732,11 @@ TEST(RemoveSupportPlane, NoisyDepth_TheWidenedBandHoldsTheTable_ALowSupportKeeps
         const float z = static_cast<float>(d) * 0.001f;
         d = static_cast<std::uint16_t>(std::lround(1000.0f * (z + 0.001f * z * z * unit(rng))));
     }
-    Prepared f;
-    f.frame = std::move(frame);
-    back_project(f.frame, f.cloud);
-    std::vector<float> scratch;
-    NormalParams normal_params;
-    normal_params.radius_px = normal_radius_for(normal_params, measure_depth_noise(f.cloud, static_cast<float>(f.frame.intrinsics.fx), scratch));
-    estimate_normals(normal_params, f.cloud, f.normals);
-    select_depth_range(DepthRange{}, f.cloud, f.active);
+    const Prepared f = prepared(std::move(frame), true);
     auto table_kept = [&](float widening) {
         PlaneWorkspace ws;
         std::vector<std::uint8_t> classes;
-        const PlaneResult r = remove_support_plane(PlaneParams{}, f.frame.intrinsics, f.cloud, f.normals, f.active, ws,
-                                                   classes, widening);
+        const PlaneResult r = f.remove_plane(PlaneParams{}, ws, classes, widening);
         EXPECT_TRUE(r.found) << "widening " << widening;
         KeptCount k;  // the table's points left as objects (feet go to the segmentation)
         for (std::size_t p = 0; p < truth.size(); ++p) {
@@ -754,8 +754,7 @@ TEST(RemoveSupportPlane, NoisyDepth_TheWidenedBandHoldsTheTable_ALowSupportKeeps
     const Prepared board = prepared(render_scene(board_on_table_scene(0.6f, 0.45f), &truth));
     PlaneWorkspace ws;
     std::vector<std::uint8_t> classes;
-    const PlaneResult r = remove_support_plane(PlaneParams{}, board.frame.intrinsics, board.cloud, board.normals,
-                                               board.active, ws, classes, 1.5f);
+    const PlaneResult r = board.remove_plane(PlaneParams{}, ws, classes, 1.5f);
     ASSERT_TRUE(r.found);
     EXPECT_TRUE(r.low_found);
     std::size_t board_pixels = 0, board_object = 0;
@@ -767,7 +766,5 @@ TEST(RemoveSupportPlane, NoisyDepth_TheWidenedBandHoldsTheTable_ALowSupportKeeps
     ASSERT_GT(board_pixels, 5000u);
     EXPECT_LT(static_cast<double>(board_object) / static_cast<double>(board_pixels), 0.03);
 
-    EXPECT_THROW(remove_support_plane(PlaneParams{}, board.frame.intrinsics, board.cloud, board.normals, board.active,
-                                      ws, classes, 0.5f),
-                 ParamError);
+    EXPECT_THROW(board.remove_plane(PlaneParams{}, ws, classes, 0.5f), ParamError);
 }
