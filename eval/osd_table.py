@@ -22,7 +22,9 @@ def run(cmd):
 
 
 def score(wul3d, pred, gt, prefix, pred_file, extra=()):
-    out = pred / f"eval-{pred_file}-{prefix or 'all'}.json"
+    # Beside the predictions, not in them: wul3d eval writes no file inside its inputs.
+    out = pred.parent / "scores" / f"{pred.name}-{pred_file}-{prefix or 'all'}.json"
+    out.parent.mkdir(parents=True, exist_ok=True)
     cmd = [wul3d, "eval", str(pred), str(gt), "--pred-file", pred_file, "--json", str(out), *extra]
     if prefix:
         cmd += ["--only", prefix]

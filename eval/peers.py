@@ -116,7 +116,9 @@ def run_peer(name, fn, data_dir, out):
 
 
 def score(wul3d, pred, gt, prefix):
-    out = pred / f"eval-{prefix or 'all'}.json"
+    # Beside the predictions, not in them: wul3d eval writes no file inside its inputs.
+    out = pred.parent / "scores" / f"{pred.name}-{prefix or 'all'}.json"
+    out.parent.mkdir(parents=True, exist_ok=True)
     cmd = [wul3d, "eval", pred, gt, "--json", out]
     if prefix:
         cmd += ["--only", prefix]
