@@ -289,15 +289,17 @@ namespace {
 
 /// How much wider the support plane's grow angle and band are for a frame whose depth noise
 /// is `noise_px` (measure_depth_noise; remove_support_plane's noise_widening): 1 up to the
-/// noise that the least normal radius takes within max_tilt_noise_deg (normal_radius_for
-/// rounds up to radius_px + 1 past it), then in proportion to the noise, at most 1.5. The
-/// noise is the frame's typical one, and a camera noisier than that tilts the normals of a
-/// far table past the given angle and scatters its points past the given band (active
+/// noise that tilts normals of the least radius by max_tilt_noise_deg, then in proportion to
+/// the noise, at most 1.5. From that noise, not from the one where normal_radius_for rounds
+/// up to radius_px + 1 (a quarter more): between the two the normals keep the least radius
+/// and tilt past their angle, and generated piles lost their table there (docs/ABLATION.md).
+/// The noise is the frame's typical one, and a camera noisier than that tilts the normals of
+/// a far table past the given angle and scatters its points past the given band (active
 /// stereo, whose noise grows with z^2 from a larger base: in 1 of the 20 tabletop tune frames
 /// the table was no candidate at all). O(1).
 float plane_noise_widening(const NormalParams& normals, float noise_px) {
     if (!(normals.max_tilt_noise_deg > 0)) return 1.0f;
-    const float least_radius_noise = (static_cast<float>(normals.radius_px) + 0.5f) * std::sqrt(2.0f) *
+    const float least_radius_noise = static_cast<float>(normals.radius_px) * std::sqrt(2.0f) *
                                      std::tan(normals.max_tilt_noise_deg * std::numbers::pi_v<float> / 180.0f);
     return std::clamp(noise_px / least_radius_noise, 1.0f, 1.5f);
 }
