@@ -25,6 +25,12 @@ constexpr float kMinAreaM2 = 0.1f;
 /// A tray's rim stands round its bottom: up to kMaxHeightM over the bottom, within this many
 /// grid cells outside the convex hull of the bottom's visible piece (a rim is 1-2 cm wide).
 constexpr int kRimCells = 2;
+/// The layer counts points from this share of the support's band over it, not from the band
+/// itself: the band is the noise's tolerance at a point's depth (17 mm at 1.5 m), and a board
+/// 1.5-2 cm thick seen that far has its top in the band's upper part, too few of its points
+/// over the band to make a layer (generated floor tune seeds: 0.75 scored above 0.5 and 1;
+/// docs/ABLATION.md, "Low supports in the plane stage").
+constexpr float kLayerFromBand = 0.75f;
 /// The layer's histogram: bins of 2 mm over (0, kMaxHeightM], windows of 5 bins.
 constexpr float kBinM = 0.002f;
 constexpr int kBins = static_cast<int>(kMaxHeightM / kBinM), kWindow = 2;
@@ -103,13 +109,14 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
                                PlaneWorkspace::Buffers& ws, std::vector<std::uint8_t>& classes, Plane& low) {
     const int G = grid.size();
     const auto& gp = ws.grid;
-    // 1. The layer: grid points facing like the support, over its band, up to kMaxHeightM.
+    // 1. The layer: grid points facing like the support, over kLayerFromBand of its band, up
+    // to kMaxHeightM.
     ws.layer_t.resize(static_cast<std::size_t>(G));
     float* const h = ws.layer_t.data();
     for (int g = 0; g < G; ++g) {
         const float height = pl.height(gp.x[g], gp.y[g], gp.z[g]);
         const bool facing = gp.nx[g] * pl.nx + gp.ny[g] * pl.ny + gp.nz[g] * pl.nz >= inliers.cos_inlier;
-        h[g] = facing && gp.usable[g] && height > inliers.band(gp.z[g]) ? height : std::nanf("");
+        h[g] = facing && gp.usable[g] && height > kLayerFromBand * inliers.band(gp.z[g]) ? height : std::nanf("");
     }
     const float layer = densest_layer(h, G, params.min_region_points);
     if (std::isnan(layer)) return 0;
@@ -151,7 +158,10 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     if (standing < params.min_region_points) return 0;
     // 5. Every object pixel over that extent that is not above the low support's band: its
     // top (facing like it), its sides and what lies between it and the support are removed;
-    // on its band but facing otherwise, a candidate foot, as on the support.
+    // on its band but facing otherwise, a candidate foot, as on the support. So is every
+    // pixel the support's classes took for a container's inside there: a board whose top
+    // lies in the support's band, enclosed by its own edge, looks like one, and the
+    // segmentation would join it to that edge, the objects on it with it.
     const int W = cloud.width, H = cloud.height;
     std::size_t removed = 0;
     for (int v = 0; v < H; ++v) {
@@ -159,7 +169,7 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
         const std::uint8_t* const hull_row = hull.ptr<std::uint8_t>(v / grid.s);
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            if (classes[p] != kPlaneObject || !cell_row[u / grid.s]) continue;
+            if ((classes[p] != kPlaneObject && classes[p] != kPlaneInside) || !cell_row[u / grid.s]) continue;
             const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z), band = inliers.band(z);
             const bool rim = !hull_row[u / grid.s] && hl <= kMaxHeightM;  // round the bottom: a tray's rim
             if (hl > band && !rim) continue;
