@@ -652,11 +652,12 @@ PlaneResult remove_support_plane(const PlaneParams& given, const PinholeIntrinsi
 
     // 8: a board or tray lying on the support, the objects on it: background, as the support is.
     // Its layer keeps the given band: a board's top stands 1-5 cm over the support, within
-    // the band of a noisy camera (an active-stereo one at 1.5 m: 2.5 cm).
+    // the band of a noisy camera (an active-stereo one at 1.5 m: 2.5 cm). Its pixels take the
+    // frame's band, as the support's do: that camera scatters them past the given one.
     InlierTest given_band = inliers;
     given_band.band = Band{given.on_plane_m, given.on_plane_rel};
     const std::size_t low_removed =
-        detail::remove_low_support(params, grid, cloud, normals, given_band, pl, ws, classes, result.low_support);
+        detail::remove_low_support(params, grid, cloud, normals, given_band, pl, ws, classes, result.low_support, band);
     result.low_found = low_removed > 0;
     result.kept = kept - low_removed;
     return result;

@@ -106,7 +106,8 @@ double area_on_plane(const PlaneWorkspace::Buffers::GridPoints& gp, const std::v
 
 std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, const OrganizedCloud& cloud,
                                const NormalMap& normals, const InlierTest& inliers, const Plane& pl,
-                               PlaneWorkspace::Buffers& ws, std::vector<std::uint8_t>& classes, Plane& low) {
+                               PlaneWorkspace::Buffers& ws, std::vector<std::uint8_t>& classes, Plane& low,
+                               const Band& removal_band) {
     const int G = grid.size();
     const auto& gp = ws.grid;
     // 1. The layer: grid points facing like the support, over kLayerFromBand of its band, up
@@ -158,7 +159,11 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     if (standing < params.min_region_points) return 0;
     // 5. Every object pixel over that extent that is not above the low support's band: its
     // top (facing like it), its sides and what lies between it and the support are removed;
-    // on its band but facing otherwise, a candidate foot, as on the support. So is every
+    // on its band but facing otherwise, a candidate foot, as on the support. The band is the
+    // frame's, widened with its noise as the support's pixels' is (`removal_band`): the
+    // layer and its plane were found on the given band, but a noisy camera scatters the
+    // board's points past it, and those left as objects grew into one with the objects on
+    // the board (a tray under active stereo at 1.5 m). So is every
     // pixel the support's classes took for a container's inside there: a board whose top
     // lies in the support's band, enclosed by its own edge, looks like one, and the
     // segmentation would join it to that edge, the objects on it with it.
@@ -170,7 +175,7 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if ((classes[p] != kPlaneObject && classes[p] != kPlaneInside) || !cell_row[u / grid.s]) continue;
-            const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z), band = inliers.band(z);
+            const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z), band = removal_band(z);
             const bool rim = !hull_row[u / grid.s] && hl <= kMaxHeightM;  // round the bottom: a tray's rim
             if (hl > band && !rim) continue;
             const bool facing = normals.valid[p] &&
