@@ -170,7 +170,10 @@ struct ScopeParams {
                                  ///< stands on it (so does one whose foot the camera cannot
                                  ///< see: its sides unseen); > 0
     float max_height_m = 0.5f;   ///< a segment with over 2 % of its points higher than this
-                                 ///< over the support is not held by it; > 0
+                                 ///< over the support, or spanning more than this on it (its
+                                 ///< widest extent, the outer 5 % of its points left out at
+                                 ///< either end: a cabinet, a chair, a wall), is not held by
+                                 ///< it; > 0
     float max_outside = 0.1f;    ///< largest share of a segment's outline that continues into
                                  ///< removed points above the support, or into the frame's
                                  ///< edge beyond the support's middle; [0, 1]

@@ -18,13 +18,7 @@
 
 namespace wul3d::detail {
 
-namespace {
-
-/// Counting sort of the segments' pixels by segment (background left out): segment l's
-/// pixels are ws.order[ws.offsets[l], ws.offsets[l + 1]), in raster order. Per fixed band of
-/// rows in parallel: counts per band, then each band writes from its own start (segment by
-/// segment, bands in order). In: ws.label (0..n). Cost: two parallel passes over the pixels,
-/// O(8 n) between them.
+// Declared in internal.hpp: the scope sorts the pixels again for their spans.
 void sort_pixels_by_segment(const Ctx& x, SegmentBuffers& ws, int n) {
     const int W = x.W;
     constexpr int kSortBands = 8;
@@ -61,6 +55,8 @@ void sort_pixels_by_segment(const Ctx& x, SegmentBuffers& ws, int n) {
         }
     }
 }
+
+namespace {
 
 int segment_size(const SegmentBuffers& ws, int l) {
     return ws.offsets[static_cast<std::size_t>(l) + 1] - ws.offsets[static_cast<std::size_t>(l)];

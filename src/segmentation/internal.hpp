@@ -97,6 +97,9 @@ struct SegmentWorkspace::Buffers {
                                                   ///< bottom; pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
     std::vector<int> scope_held;  ///< per segment, the kept segments it holds (low supports)
+    std::vector<float> scope_span;  ///< per segment, its widest span on the support (m)
+    std::vector<float> scope_along; ///< its pixels' positions on the support, four directions
+                                    ///< after one another, each in `order`'s order
     /// What the scope counts of one segment in one strip of rows (scope_lo, hi, ...).
     struct ScopeCounts {
         float lo, hi;
@@ -295,6 +298,13 @@ void relabel_to_roots(SegmentBuffers& ws);
 /// thread, of 8 rows at least (fewer cost more in joining than they save); 1 inside another
 /// parallel region, or on one thread. What the passes compute does not depend on it.
 int row_strips(int rows);
+
+/// Counting sort of the segments' pixels by segment (background left out): segment l's
+/// pixels are ws.order[ws.offsets[l], ws.offsets[l + 1]), in raster order. Per fixed band of
+/// rows in parallel: counts per band, then each band writes from its own start (segment by
+/// segment, bands in order). In: ws.label (0..n). Cost: two parallel passes over the pixels,
+/// O(8 n) between them (colour_cue.cpp).
+void sort_pixels_by_segment(const Ctx& x, SegmentBuffers& ws, int n);
 
 // ---- the phases before the rules ---------------------------------------------------------
 

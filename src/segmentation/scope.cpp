@@ -1,8 +1,8 @@
 // The scope (Scope::Support, the default): whole frames show the floor, walls and furniture
 // besides the table, and their segments are objects to the rules but not to the user, who
 // asked what the table holds. A segment is kept when it lies within the support's volume
-// (under the height limit, not running on past the support's hull or out of view beyond
-// its middle) and stands on the support, or hides its foot from the camera, or rests on a
+// (under the height limit, spanning no more than it on the support, not running on past the
+// support's hull or out of view beyond its middle) and stands on the support, or hides its foot from the camera, or rests on a
 // segment that is kept, unless it is a low support: a board or tray on the floor that holds
 // other kept segments (docs/DESIGN.md, "Scope").
 #include <algorithm>
@@ -339,9 +339,53 @@ bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::s
     return x.c.z[f] < fzw - x.depth_step(fzw);
 }
 
-/// ws.scope_keep per segment, from measure_scope's counts: bit 0 inside the volume, bit 1
-/// kept. Inside: under the height limit (2 % of the points may be noise) and not running on
-/// past the hull or out of view. Kept: stands (the lowest point touches the support, or the
+/// Each end of a direction leaves out this share of a segment's positions when its span is
+/// measured: pixels mixed across a depth edge lie metres behind an object in a RealSense
+/// frame, and with them a canister 10 cm wide spanned 0.83 m.
+constexpr float kSpanTrim = 0.05f;
+
+/// ws.scope_span per segment: how far it spans on the support, the widest of four directions
+/// 45 degrees apart (within 8 % of its diameter), each from the kSpanTrim quantile to the
+/// 1 - kSpanTrim one and scaled back to the whole. 0 for a segment under 20 pixels. Cost: a
+/// counting sort of the segments' pixels, a pass over them, and a selection per segment and
+/// direction; no allocation once sized.
+void measure_spans(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    sort_pixels_by_segment(x, ws, n);
+    const auto M = static_cast<std::size_t>(ws.offsets[L]);
+    ws.scope_along.resize(4 * M);
+    float* const along[4] = {ws.scope_along.data(), ws.scope_along.data() + M, ws.scope_along.data() + 2 * M,
+                             ws.scope_along.data() + 3 * M};
+    const PlaneAxes axes(pl);
+    constexpr float kHalfRoot2 = 0.70710678f;
+    for (std::size_t i = 0; i < M; ++i) {
+        const Eigen::Vector2d q = axes(x.c, static_cast<std::size_t>(ws.order[i]));
+        const auto a = static_cast<float>(q.x()), b = static_cast<float>(q.y());
+        along[0][i] = a;
+        along[1][i] = b;
+        along[2][i] = kHalfRoot2 * (a + b);
+        along[3][i] = kHalfRoot2 * (a - b);
+    }
+    ws.scope_span.assign(L, 0.0f);
+    for (std::size_t l = 1; l < L; ++l) {
+        const int first = ws.offsets[l], m = ws.offsets[l + 1] - first;
+        if (m < 20) continue;
+        const int cut = static_cast<int>(kSpanTrim * static_cast<float>(m));
+        for (float* const positions : along) {
+            float* const begin = positions + first;
+            std::nth_element(begin, begin + cut, begin + m);
+            const float lo = begin[cut];
+            std::nth_element(begin, begin + (m - 1 - cut), begin + m);
+            const float hi = begin[m - 1 - cut];
+            ws.scope_span[l] = std::max(ws.scope_span[l], (hi - lo) / (1.0f - 2.0f * kSpanTrim));
+        }
+    }
+}
+
+/// ws.scope_keep per segment, from measure_scope's counts and measure_spans: bit 0 inside the
+/// volume, bit 1 kept. Inside: under the height limit (2 % of the points may be noise),
+/// spanning no more than that limit on the support (a cabinet, a chair, a wall the frame cuts
+/// before it rises past the limit), and not running on past the hull or out of view. Kept: stands (the lowest point touches the support, or the
 /// camera cannot see the support under the segment's middle: foot_hidden), or
 /// rests on a kept segment: touches it in the image (a box on a box, a lid on a tin, an
 /// object behind another with its foot hidden). No height test: a supported object's visible
@@ -360,7 +404,7 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
         const bool upright =
             static_cast<float>(ws.scope_upright[l]) >= prm.scope.upright_share * static_cast<float>(ws.sizes[l]);
         const int outside = ws.scope_outside[l] + (upright ? ws.scope_frame[l] : 0);
-        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] &&
+        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] && ws.scope_span[l] <= prm.scope.max_height_m &&
                             static_cast<float>(outside) <=
                                 prm.scope.max_outside * static_cast<float>(ws.scope_outline[l]);
         const bool stands = ws.scope_lo[l] <= prm.scope.contact_m ||
@@ -437,13 +481,15 @@ int clear_out_of_scope(const SegmentParams& prm, SegmentBuffers& ws, int n) {
 /// Scope::Support (docs/DESIGN.md, "Scope"): keeps the segments the support holds and
 /// clears the others' labels in ws.label. In: ws.label (1..n with gaps), the support, the
 /// plane's classes. Out: the number of segments of min_points or more left out. Cost: one
-/// pass over the pixels (heights, outlines, touching pairs) and one over the depths, then a
-/// few passes over the touching pairs until "rests on" stops spreading.
+/// pass over the pixels (heights, outlines, touching pairs) and one over the depths, the
+/// spans (measure_spans), then a few passes over the touching pairs until "rests on" stops
+/// spreading.
 int keep_held(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const FrameEdge edge = find_frame_edge(x);
     const float far_z = support_middle_depth(x, pl);
     measure_scope(x, pl, edge, far_z, ws, n);
     count_upright(x, pl, ws, n);
+    measure_spans(x, pl, ws, n);
     decide_scope(x, pl, ws, n);
     drop_low_supports(x, pl, ws, n);
     return clear_out_of_scope(x.prm, ws, n);

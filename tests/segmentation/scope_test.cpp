@@ -157,11 +157,52 @@ TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
     EXPECT_EQ(stats.scope.out_of_scope, 0);
 }
 
+// A cabinet-like box 60 cm wide, 25 cm tall and 30 cm deep standing on the table behind a
+// 12 cm box: under the height limit (0.5 m), but spanning more than it on the support, so
+// it is furniture, not something the support holds; the box stays. With the limit at 1 m the
+// cabinet is an object as any box (the premise).
+TEST(SegmentObjects, Scope_SpanningMoreThanTheHeightLimitIsNoObject) {
+    Scene s = pitched_tabletop_scene();
+    SceneBox cabinet;
+    cabinet.x = -0.05f;
+    cabinet.z = 1.1f;
+    cabinet.w = 0.6f;
+    cabinet.h = 0.25f;
+    cabinet.d = 0.3f;
+    cabinet.r = 90; cabinet.g = 60; cabinet.b = 40;
+    SceneBox box;
+    box.x = 0.1f;
+    box.z = 0.75f;
+    box.w = box.h = box.d = 0.12f;
+    box.r = 30; box.g = 60; box.b = 220;
+    s.boxes = {cabinet, box};
+    const PlaneStage st = up_to_the_plane(s);
+    auto run = [&](float max_height_m, SegmentStats* stats = nullptr) {
+        SegmentParams params;
+        params.scope.max_height_m = max_height_m;
+        return segment(st, params, stats);
+    };
+    int cabinet_id = 0, box_id = 0;
+    const LabelImage wide_limit = run(1.0f);
+    ASSERT_GT(dominant_share(wide_limit.labels, st.truth, kTruthBox0, &cabinet_id), 0.8);
+    ASSERT_NE(cabinet_id, 0) << "under a 1 m limit the cabinet should be an object (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = run(SegmentParams{}.scope.max_height_m, &stats);
+    dominant_share(out.labels, st.truth, kTruthBox0, &cabinet_id);
+    EXPECT_EQ(cabinet_id, 0) << "the cabinet is an object";
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0 + 1, &box_id), 0.9);
+    EXPECT_NE(box_id, 0) << "the box beside it was left out";
+    EXPECT_EQ(stats.scope.out_of_scope, 1);
+}
+
 // A board 6 cm thick lying on the table, 60 x 40 cm, with two boxes standing on it, and a
 // book (30 x 22 cm, 3 cm thick) with nothing on it: the board lies low, covers 0.24 m^2 and
 // holds two segments that rise over it, so it is a second support, background; the boxes on
 // it stay objects, and so does the book, which holds nothing. (A board of 5 cm or less the
-// plane stage would remove first, as a low support: DESIGN.md, "Support plane".)
+// plane stage would remove first, as a low support: DESIGN.md, "Support plane". Spanning
+// 0.6 m, the board also leaves the volume by its span: the height limit that bounds the span
+// is raised here to 1 m, so that this rule alone decides.)
 TEST(SegmentObjects, Scope_BoardHoldingObjectsIsASupportNotAnObject) {
     Scene s = pitched_tabletop_scene();
     SceneBox board;
@@ -191,6 +232,7 @@ TEST(SegmentObjects, Scope_BoardHoldingObjectsIsASupportNotAnObject) {
     const PlaneStage st = up_to_the_plane(s);
     auto run = [&](float low_support_max_m) {
         SegmentParams params;
+        params.scope.max_height_m = 1.0f;
         params.scope.low_support_max_m = low_support_max_m;
         return segment(st, params);
     };
