@@ -2,9 +2,9 @@
 // besides the table, and their segments are objects to the rules but not to the user, who
 // asked what the table holds. A segment is kept when it lies within the support's volume
 // (under the height limit, spanning no more than it on the support, not running on past the
-// support's hull or out of view beyond its middle) and stands on the support, or hides its foot from the camera, or rests on a
-// segment that is kept, unless it is a low support: a board or tray on the floor that holds
-// other kept segments (docs/DESIGN.md, "Scope").
+// support's hull or out of view beyond its middle) and stands on the support, or hides its
+// foot from the camera, or rests on a segment that is kept, unless it is a low support: a
+// board or tray on the floor that holds other kept segments (docs/DESIGN.md, "Scope").
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -385,8 +385,9 @@ void measure_spans(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
 /// ws.scope_keep per segment, from measure_scope's counts and measure_spans: bit 0 inside the
 /// volume, bit 1 kept. Inside: under the height limit (2 % of the points may be noise),
 /// spanning no more than that limit on the support (a cabinet, a chair, a wall the frame cuts
-/// before it rises past the limit), and not running on past the hull or out of view. Kept: stands (the lowest point touches the support, or the
-/// camera cannot see the support under the segment's middle: foot_hidden), or
+/// before it rises past the limit), and not running on past the hull or out of view. Kept:
+/// stands (the lowest point touches the support, or the camera cannot see the support under
+/// the segment's middle: foot_hidden), or
 /// rests on a kept segment: touches it in the image (a box on a box, a lid on a tin, an
 /// object behind another with its foot hidden). No height test: a supported object's visible
 /// bottom can lie well above its supporter's visible top (a tin's lid overhangs what it

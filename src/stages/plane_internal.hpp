@@ -184,13 +184,14 @@ bool fit_grid_points(const InlierTest& grid, int min_points, const std::uint8_t*
 
 /// 8. A low support (plane_low_support.cpp): a board or tray lying on the support `pl`, the
 /// objects on it. Its top is the densest layer of grid points facing like `pl` over three
-/// quarters of its band and at most 5 cm above it, whose largest 8-connected piece spans 0.1 m^2 on the
-/// plane (more than any object lying flat). Over that piece's extent in the image, every
-/// object pixel not above the low support's band is removed (its top, its sides, what lies
-/// under it), but those on its band facing otherwise, which become candidate feet. The
-/// layer and its plane take `inliers`' band (the given one); the pixels take `removal_band`
-/// (the frame's, widened with its noise as the support's pixels' is). Out:
-/// `classes`, `low` (its plane, when found); returns the pixels removed (0: none found).
+/// quarters of its band and at most 5 cm above it, whose largest 8-connected piece spans
+/// 0.1 m^2 on the plane (more than any object lying flat). Over that piece's extent in the
+/// image, every object pixel (or container's inside) not above the low support's band is
+/// removed (its top, its sides, what lies under it), but those on its band facing otherwise,
+/// which become candidate feet. The layer and its plane take `inliers`' band (the given
+/// one); the pixels take `removal_band` (the frame's, widened with its noise as the
+/// support's pixels' is). Out: `classes`, `low` (its plane, when found); returns the pixels
+/// removed (0: none found).
 /// O(G) for the layer and its pieces, O(N) for the pixels; OpenCV allocates the hull.
 std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, const OrganizedCloud& cloud,
                                const NormalMap& normals, const InlierTest& inliers, const Plane& pl,

@@ -163,10 +163,10 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     // frame's, widened with its noise as the support's pixels' is (`removal_band`): the
     // layer and its plane were found on the given band, but a noisy camera scatters the
     // board's points past it, and those left as objects grew into one with the objects on
-    // the board (a tray under active stereo at 1.5 m). So is every
-    // pixel the support's classes took for a container's inside there: a board whose top
-    // lies in the support's band, enclosed by its own edge, looks like one, and the
-    // segmentation would join it to that edge, the objects on it with it.
+    // the board (a tray under active stereo at 1.5 m). So is every pixel the support's
+    // classes took for a container's inside there: a board whose top lies in the support's
+    // band, enclosed by its own edge, looks like one, and the segmentation would join it to
+    // that edge, the objects on it with it.
     const int W = cloud.width, H = cloud.height;
     std::size_t removed = 0;
     for (int v = 0; v < H; ++v) {
