@@ -97,9 +97,11 @@ struct SegmentWorkspace::Buffers {
                                                   ///< bottom; pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
     std::vector<int> scope_held;  ///< per segment, the kept segments it holds (low supports)
-    std::vector<float> scope_span;  ///< per segment, its widest span on the support (m)
-    std::vector<float> scope_along; ///< its pixels' positions on the support, four directions
-                                    ///< after one another, each in `order`'s order
+    std::vector<std::uint8_t> scope_wide;  ///< per segment, 1 = spans past the height limit
+    std::vector<int> scope_span_pixels;    ///< per segment, its pixels (measure_spans)
+    std::vector<float> scope_span_range;   ///< per segment, its least and greatest positions
+                                           ///< along four directions on the support
+    std::vector<float> scope_along;  ///< one wide segment's positions, direction by direction
     /// What the scope counts of one segment in one strip of rows (scope_lo, hi, ...).
     struct ScopeCounts {
         float lo, hi;

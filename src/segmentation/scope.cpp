@@ -344,41 +344,84 @@ bool foot_hidden(const Ctx& x, const Plane& pl, const SegmentBuffers& ws, std::s
 /// frame, and with them a canister 10 cm wide spanned 0.83 m.
 constexpr float kSpanTrim = 0.05f;
 
-/// ws.scope_span per segment: how far it spans on the support, the widest of four directions
-/// 45 degrees apart (within 8 % of its diameter), each from the kSpanTrim quantile to the
-/// 1 - kSpanTrim one and scaled back to the whole. 0 for a segment under 20 pixels. Cost: a
-/// counting sort of the segments' pixels, a pass over them, and a selection per segment and
-/// direction; no allocation once sized.
-void measure_spans(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
-    const std::size_t L = static_cast<std::size_t>(n) + 1;
-    sort_pixels_by_segment(x, ws, n);
-    const auto M = static_cast<std::size_t>(ws.offsets[L]);
-    ws.scope_along.resize(4 * M);
-    float* const along[4] = {ws.scope_along.data(), ws.scope_along.data() + M, ws.scope_along.data() + 2 * M,
-                             ws.scope_along.data() + 3 * M};
-    const PlaneAxes axes(pl);
+/// Pixel p's positions on the support along four directions 45 degrees apart, metres.
+void positions_along(const Ctx& x, const PlaneAxes& axes, std::size_t p, float (&along)[4]) {
     constexpr float kHalfRoot2 = 0.70710678f;
-    for (std::size_t i = 0; i < M; ++i) {
-        const Eigen::Vector2d q = axes(x.c, static_cast<std::size_t>(ws.order[i]));
-        const auto a = static_cast<float>(q.x()), b = static_cast<float>(q.y());
-        along[0][i] = a;
-        along[1][i] = b;
-        along[2][i] = kHalfRoot2 * (a + b);
-        along[3][i] = kHalfRoot2 * (a - b);
-    }
-    ws.scope_span.assign(L, 0.0f);
-    for (std::size_t l = 1; l < L; ++l) {
-        const int first = ws.offsets[l], m = ws.offsets[l + 1] - first;
-        if (m < 20) continue;
-        const int cut = static_cast<int>(kSpanTrim * static_cast<float>(m));
-        for (float* const positions : along) {
-            float* const begin = positions + first;
-            std::nth_element(begin, begin + cut, begin + m);
-            const float lo = begin[cut];
-            std::nth_element(begin, begin + (m - 1 - cut), begin + m);
-            const float hi = begin[m - 1 - cut];
-            ws.scope_span[l] = std::max(ws.scope_span[l], (hi - lo) / (1.0f - 2.0f * kSpanTrim));
+    const Eigen::Vector2d q = axes(x.c, p);
+    const auto a = static_cast<float>(q.x()), b = static_cast<float>(q.y());
+    along[0] = a;
+    along[1] = b;
+    along[2] = kHalfRoot2 * (a + b);
+    along[3] = kHalfRoot2 * (a - b);
+}
+
+/// ws.scope_wide per segment: 1 when it spans more than `limit` on the support, its span the
+/// widest of four directions 45 degrees apart (within 8 % of its diameter), each from the
+/// kSpanTrim quantile to the 1 - kSpanTrim one and scaled back to the whole; never for a
+/// segment under 20 pixels. The trimmed range is within the whole range, so only a segment
+/// whose whole range, scaled alike, passes the limit is sorted out and selected on (few: a
+/// wall, furniture). Cost: a pass over the rows with segments; for those few, a counting sort
+/// of the pixels and a selection per direction. No allocation once sized.
+void measure_spans(const Ctx& x, const Plane& pl, float limit, SegmentBuffers& ws, int n) {
+    const std::size_t L = static_cast<std::size_t>(n) + 1;
+    const PlaneAxes axes(pl);
+    constexpr float kKept = 1.0f - 2.0f * kSpanTrim;
+    // 1. Each segment's pixels and its whole range along each direction.
+    ws.scope_span_pixels.assign(L, 0);
+    ws.scope_span_range.assign(8 * L, 0.0f);
+    float* const range = ws.scope_span_range.data();  // per segment: lo[4], hi[4]
+    for (int v = 0; v < x.H; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * static_cast<std::size_t>(x.W);
+        if (!row_has_label(ws.label.data() + row, 0, x.W)) continue;
+        for (std::size_t p = row; p < row + static_cast<std::size_t>(x.W); ++p) {
+            const auto l = static_cast<std::size_t>(ws.label[p]);
+            if (l == 0) continue;
+            float along[4];
+            positions_along(x, axes, p, along);
+            float* const lo = range + 8 * l;
+            float* const hi = lo + 4;
+            const bool first = ws.scope_span_pixels[l]++ == 0;
+            for (int k = 0; k < 4; ++k) {
+                lo[k] = first ? along[k] : std::min(lo[k], along[k]);
+                hi[k] = first ? along[k] : std::max(hi[k], along[k]);
+            }
         }
+    }
+    // 2. The candidates: 20 pixels or more, a whole range over the limit once scaled.
+    ws.scope_wide.assign(L, 0);
+    bool any = false;
+    for (std::size_t l = 1; l < L; ++l) {
+        if (ws.scope_span_pixels[l] < 20) continue;
+        for (int k = 0; k < 4; ++k)
+            if ((range[8 * l + 4 + static_cast<std::size_t>(k)] - range[8 * l + static_cast<std::size_t>(k)]) / kKept >
+                limit) {
+                ws.scope_wide[l] = 1;  // a candidate, decided below
+                any = true;
+            }
+    }
+    if (!any) return;
+    // 3. Their trimmed spans, from their pixels sorted out.
+    sort_pixels_by_segment(x, ws, n);
+    for (std::size_t l = 1; l < L; ++l) {
+        if (!ws.scope_wide[l]) continue;
+        const int first = ws.offsets[l], m = ws.offsets[l + 1] - first;
+        ws.scope_along.resize(4 * static_cast<std::size_t>(m));
+        float* const along[4] = {ws.scope_along.data(), ws.scope_along.data() + m, ws.scope_along.data() + 2 * m,
+                                 ws.scope_along.data() + 3 * m};
+        for (int i = 0; i < m; ++i) {
+            float at[4];
+            positions_along(x, axes, static_cast<std::size_t>(ws.order[static_cast<std::size_t>(first + i)]), at);
+            for (int k = 0; k < 4; ++k) along[k][i] = at[k];
+        }
+        const int cut = static_cast<int>(kSpanTrim * static_cast<float>(m));
+        float span = 0.0f;
+        for (float* const positions : along) {
+            std::nth_element(positions, positions + cut, positions + m);
+            const float lo = positions[cut];
+            std::nth_element(positions, positions + (m - 1 - cut), positions + m);
+            span = std::max(span, (positions[m - 1 - cut] - lo) / kKept);
+        }
+        ws.scope_wide[l] = span > limit;
     }
 }
 
@@ -405,7 +448,7 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
         const bool upright =
             static_cast<float>(ws.scope_upright[l]) >= prm.scope.upright_share * static_cast<float>(ws.sizes[l]);
         const int outside = ws.scope_outside[l] + (upright ? ws.scope_frame[l] : 0);
-        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] && ws.scope_span[l] <= prm.scope.max_height_m &&
+        const bool inside = 50 * ws.scope_high[l] <= ws.sizes[l] && !ws.scope_wide[l] &&
                             static_cast<float>(outside) <=
                                 prm.scope.max_outside * static_cast<float>(ws.scope_outline[l]);
         const bool stands = ws.scope_lo[l] <= prm.scope.contact_m ||
@@ -490,7 +533,7 @@ int keep_held(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     const float far_z = support_middle_depth(x, pl);
     measure_scope(x, pl, edge, far_z, ws, n);
     count_upright(x, pl, ws, n);
-    measure_spans(x, pl, ws, n);
+    measure_spans(x, pl, x.prm.scope.max_height_m, ws, n);
     decide_scope(x, pl, ws, n);
     drop_low_supports(x, pl, ws, n);
     return clear_out_of_scope(x.prm, ws, n);

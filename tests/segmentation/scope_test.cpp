@@ -163,18 +163,8 @@ TEST(SegmentObjects, Scope_BoxTouchingAHeldBoxStays) {
 // cabinet is an object as any box (the premise).
 TEST(SegmentObjects, Scope_SpanningMoreThanTheHeightLimitIsNoObject) {
     Scene s = pitched_tabletop_scene();
-    SceneBox cabinet;
-    cabinet.x = -0.05f;
-    cabinet.z = 1.1f;
-    cabinet.w = 0.6f;
-    cabinet.h = 0.25f;
-    cabinet.d = 0.3f;
-    cabinet.r = 90; cabinet.g = 60; cabinet.b = 40;
-    SceneBox box;
-    box.x = 0.1f;
-    box.z = 0.75f;
-    box.w = box.h = box.d = 0.12f;
-    box.r = 30; box.g = 60; box.b = 220;
+    const SceneBox cabinet{.x = -0.05f, .z = 1.1f, .w = 0.6f, .h = 0.25f, .d = 0.3f, .r = 90, .g = 60, .b = 40};
+    const SceneBox box{.x = 0.1f, .z = 0.75f, .w = 0.12f, .h = 0.12f, .d = 0.12f, .r = 30, .g = 60, .b = 220};
     s.boxes = {cabinet, box};
     const PlaneStage st = up_to_the_plane(s);
     auto run = [&](float max_height_m, SegmentStats* stats = nullptr) {

@@ -371,6 +371,33 @@ std::pair<int, double> dominant_object(const LabelImage& objects, const LabelIma
     return {best.first, total > 0 ? static_cast<double>(best.second) / total : 0.0};
 }
 
+/// The ids of g's true objects (its truth labels other than 0).
+std::set<int> truth_objects(const GeneratedFrame& g) {
+    std::set<int> ids;
+    for (const std::uint16_t t : g.truth.labels)
+        if (t != 0) ids.insert(t);
+    return ids;
+}
+
+/// The share of g's background (truth 0: the support, the room, what is not an object) that
+/// lies in an object of `objects`.
+double background_in_objects(const LabelImage& objects, const GeneratedFrame& g) {
+    std::size_t background = 0, in_object = 0;
+    for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
+        if (g.truth.labels[p] != 0) continue;
+        ++background;
+        in_object += objects.labels[p] != 0;
+    }
+    return static_cast<double>(in_object) / static_cast<double>(background);
+}
+
+/// How many of g's true objects one predicted object holds the most of (more than half).
+std::size_t objects_found(const LabelImage& objects, const GeneratedFrame& g) {
+    std::size_t found = 0;
+    for (const int t : truth_objects(g)) found += dominant_object(objects, g.truth, t).second > 0.5;
+    return found;
+}
+
 /// g's frame through a pipeline whose default segmentation parameters `set` changed.
 template <class Set>
 FrameResult process_with(const GeneratedFrame& g, Set&& set) {
@@ -404,13 +431,7 @@ TEST(GeneratedScene, NoisyActiveStereoDepth_TheMeasuredNoiseWidensTheNormalsAndF
     EXPECT_GE(r.normal_radius_px, 4);
     EXPECT_TRUE(r.plane.found);
     // The table is background: hardly any of its pixels lie in an object.
-    std::size_t table = 0, in_object = 0;
-    for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
-        if (g.truth.labels[p] != 0) continue;  // 0: the table and what is not an object
-        ++table;
-        in_object += r.objects.labels[p] != 0;
-    }
-    EXPECT_LT(static_cast<double>(in_object), 0.05 * static_cast<double>(table));
+    EXPECT_LT(background_in_objects(r.objects, g), 0.05);
 }
 
 // A generated tabletop (eval/scenegen.py tune seed 13) under the active-stereo camera, the
@@ -423,36 +444,22 @@ TEST(GeneratedScene, NoisyActiveStereoDepth_TheMeasuredNoiseWidensTheNormalsAndF
 TEST(GeneratedScene, NoisyActiveStereoDepth_TheGrowAngleWidensAndTheFarTableIsTheSupport) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 13, "active_stereo");
-    std::set<int> truth_objects;
-    for (const std::uint16_t t : g.truth.labels)
-        if (t != 0) truth_objects.insert(t);
-    ASSERT_GE(truth_objects.size(), 5u);
+    const std::size_t n_objects = truth_objects(g).size();
+    ASSERT_GE(n_objects, 5u);
     auto run = [&](float grow_angle_deg) {
         PipelineParams params;
         params.plane.grow_angle_deg = grow_angle_deg;
         Pipeline pipeline(params);
         return pipeline.process(g.frame);
     };
-    // The share of the table's pixels (truth 0: the table and what is not an object) in objects.
-    auto table_in_objects = [&](const FrameResult& r) {
-        std::size_t table = 0, in_object = 0;
-        for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
-            if (g.truth.labels[p] != 0) continue;
-            ++table;
-            in_object += r.objects.labels[p] != 0;
-        }
-        return static_cast<double>(in_object) / static_cast<double>(table);
-    };
     const FrameResult narrow = run(PlaneParams{}.grow_angle_deg / 1.5f);
     ASSERT_FALSE(narrow.plane.found) << "12 degrees should miss the table (test premise)";
-    ASSERT_GT(table_in_objects(narrow), 0.5);
+    ASSERT_GT(background_in_objects(narrow.objects, g), 0.5);
     const FrameResult r = run(PlaneParams{}.grow_angle_deg);
     EXPECT_GT(r.depth_noise_px, 0.52f);  // 1.5 times the noise that tilts the least radius by 7 degrees
     ASSERT_TRUE(r.plane.found);
-    EXPECT_LT(table_in_objects(r), 0.05);
-    std::size_t found = 0;  // objects that one predicted object holds the most of
-    for (const int t : truth_objects) found += dominant_object(r.objects, g.truth, t).second > 0.5;
-    EXPECT_GE(found, truth_objects.size() - 2);
+    EXPECT_LT(background_in_objects(r.objects, g), 0.05);
+    EXPECT_GE(objects_found(r.objects, g), n_objects - 2);
 }
 
 // A generated pile (eval/scenegen.py pile tune seed 10039) under the structured-light camera:
@@ -474,20 +481,9 @@ TEST(GeneratedScene, PileUnderStructuredLight_ThePlaneWidensOnceTheLeastRadiusTi
     ASSERT_LT(r.depth_noise_px, (static_cast<float>(normals.radius_px) + 0.5f) * std::sqrt(2.0f) * tilt)
         << "premise: under the noise where the radius rounds up";
     ASSERT_TRUE(r.plane.found);
-    std::set<int> truth_objects;
-    std::size_t table = 0, in_object = 0;  // truth 0: the table and what is not an object
-    for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
-        if (g.truth.labels[p] != 0) {
-            truth_objects.insert(g.truth.labels[p]);
-            continue;
-        }
-        ++table;
-        in_object += r.objects.labels[p] != 0;
-    }
-    EXPECT_LT(static_cast<double>(in_object), 0.05 * static_cast<double>(table));
-    std::size_t found = 0;  // objects that one predicted object holds the most of
-    for (const int t : truth_objects) found += dominant_object(r.objects, g.truth, t).second > 0.5;
-    EXPECT_GE(found, truth_objects.size() - 2) << found << " of " << truth_objects.size();
+    EXPECT_LT(background_in_objects(r.objects, g), 0.05);
+    const std::size_t found = objects_found(r.objects, g), n_objects = truth_objects(g).size();
+    EXPECT_GE(found, n_objects - 2) << found << " of " << n_objects;
 }
 
 // A generated floor scene (eval/scenegen.py floor tune seed 20024) under the ToF camera: a
@@ -505,24 +501,15 @@ TEST(GeneratedScene, BoardWithinTheSupportsBand_IsALowSupportNotAContainer) {
     const FrameResult& r = pipeline.process(g.frame);
     ASSERT_TRUE(r.plane.found);
     EXPECT_TRUE(r.plane.low_found);
-    std::set<int> truth_objects;
-    std::size_t background = 0, in_object = 0;  // truth 0: the floor, the board, what is not an object
-    for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
-        if (g.truth.labels[p] != 0) {
-            truth_objects.insert(g.truth.labels[p]);
-            continue;
-        }
-        ++background;
-        in_object += r.objects.labels[p] != 0;
-    }
     // Objects apart: the predicted objects that hold the most of each true one, counted once.
+    const std::set<int> objects = truth_objects(g);
     std::set<int> holders;
-    for (const int t : truth_objects) {
+    for (const int t : objects) {
         const auto [id, share] = dominant_object(r.objects, g.truth, t);
         if (share > 0.5) holders.insert(id);
     }
-    EXPECT_LT(static_cast<double>(in_object), 0.01 * static_cast<double>(background));  // 5.8 % before
-    EXPECT_GE(holders.size(), 8u) << "of " << truth_objects.size();                        // 5 before
+    EXPECT_LT(background_in_objects(r.objects, g), 0.01);  // 5.8 % before
+    EXPECT_GE(holders.size(), 8u) << "of " << objects.size();  // 5 before
 }
 
 // A generated floor scene (eval/scenegen.py floor tune seed 20008) under the active-stereo
@@ -539,13 +526,7 @@ TEST(GeneratedScene, NoisyTray_ItsBottomRemovedOnTheFramesBand) {
     const FrameResult& r = pipeline.process(g.frame);
     ASSERT_GT(r.depth_noise_px, 1.0f) << "premise: a noisy camera, a band widened 1.5 times";
     ASSERT_TRUE(r.plane.low_found);
-    std::size_t background = 0, in_object = 0;  // truth 0: the floor, the carpet, the tray
-    for (std::size_t p = 0; p < g.truth.labels.size(); ++p) {
-        if (g.truth.labels[p] != 0) continue;
-        ++background;
-        in_object += r.objects.labels[p] != 0;
-    }
-    EXPECT_LT(static_cast<double>(in_object), 0.04 * static_cast<double>(background));  // 10.2 % before, 1.7 %
+    EXPECT_LT(background_in_objects(r.objects, g), 0.04);  // 10.2 % before, 1.7 %
 }
 
 // A generated pile (eval/scenegen.py pile tune seed 10005, eleven objects) seen by the
@@ -556,16 +537,14 @@ TEST(GeneratedScene, NoisyTray_ItsBottomRemovedOnTheFramesBand) {
 TEST(GeneratedScene, NoisyActiveStereoPile_TheCreaseStepWidensWithTheNormalsRadius) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 10005, "active_stereo", "pile");
-    std::set<int> truth_objects;
-    for (const std::uint16_t t : g.truth.labels)
-        if (t != 0) truth_objects.insert(t);
-    ASSERT_EQ(truth_objects.size(), 11u);
+    const std::set<int> objects = truth_objects(g);
+    ASSERT_EQ(objects.size(), 11u);
     Pipeline pipeline{PipelineParams{}};
     const FrameResult& r = pipeline.process(g.frame);
     ASSERT_GE(r.normal_radius_px, 8) << "premise: normals wider than the given crease step";
     // Found: one object holds most of it, and most of that object is it.
     int found = 0;
-    for (const int t : truth_objects) {
+    for (const int t : objects) {
         const auto [id, share] = dominant_object(r.objects, g.truth, t);
         if (share <= 0.5) continue;
         std::size_t in_object = 0, of_t = 0;
