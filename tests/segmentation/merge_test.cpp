@@ -1,8 +1,10 @@
 // The convexity merge (src/segmentation/merge.cpp), run alone on labels the test sets: two
 // segments that meet along a convex edge (a box's top and its front face, as noise cuts
-// them) are joined; two objects that meet at a concave fold are not.
+// them) are joined; two objects that meet at a concave fold are not, nor (with colour) two
+// whose boundary steps in depth and changes colour: one's outline over the other.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <set>
 #include <vector>
@@ -36,6 +38,32 @@ std::set<int> labels_of(const std::vector<int>& labels, const std::vector<int>& 
     return found;
 }
 
+/// The box's top (1) and front face (2) as two segments, from the normals; their sizes in
+/// `top` and `front`.
+std::vector<int> top_and_front(const PlaneStage& st, int& top, int& front) {
+    std::vector<int> labels(st.truth.size(), 0);
+    top = front = 0;
+    for (std::size_t p = 0; p < labels.size(); ++p) {
+        if (st.truth[p] != kTruthBox0 || !st.normals.valid[p]) continue;
+        const bool up = st.normals.ny[p] < -0.7f;  // camera y points down
+        labels[p] = up ? 1 : 2;
+        (up ? top : front) += 1;
+    }
+    return labels;
+}
+
+/// Paints segment 2 of `labels` red and the rest of the cloud green.
+void two_colours(PlaneStage& st, const std::vector<int>& labels) {
+    OrganizedCloud& c = st.cloud;
+    for (std::size_t p = 0; p < labels.size(); ++p) {
+        const bool two = labels[p] == 2;
+        c.r[p] = two ? 200 : 40;
+        c.g[p] = two ? 40 : 200;
+        c.b[p] = 40;
+    }
+    c.has_color = true;
+}
+
 /// A box of 20 x 12 x 15 cm before the camera, which looks down on the table.
 SceneBox front_box() {
     SceneBox box;
@@ -52,14 +80,8 @@ TEST(Merge, BoxTopAndFrontFace_Joined) {
     Scene s = pitched_tabletop_scene();
     s.boxes = {front_box()};
     const PlaneStage st = up_to_the_plane(s);
-    std::vector<int> labels(st.truth.size(), 0);
     int top = 0, front = 0;
-    for (std::size_t p = 0; p < labels.size(); ++p) {
-        if (st.truth[p] != kTruthBox0 || !st.normals.valid[p]) continue;
-        const bool up = st.normals.ny[p] < -0.7f;  // camera y points down
-        labels[p] = up ? 1 : 2;
-        (up ? top : front) += 1;
-    }
+    const std::vector<int> labels = top_and_front(st, top, front);
     ASSERT_GT(top, 300) << "the camera should see the box's top (test premise)";
     ASSERT_GT(front, 300) << "the camera should see the box's front (test premise)";
     int joins = 0;
@@ -96,4 +118,50 @@ TEST(Merge, BoxesAtAConcaveFold_StayApart) {
     any_share.merge.max_concave = 1;
     merged(st, any_share, labels, 2, joins);
     EXPECT_EQ(joins, 1) << "the boxes' boundary should hold tested pairs (test premise)";
+}
+
+// The box's top and front in two colours. The camera looks down on the front face nearly
+// edge-on, so depth steps between neighbours across the boundary as it does where one
+// object's outline lies over another it touches (a ball against a lying can): with colour
+// (hybrid) the merge reads a silhouette and keeps them apart; without (geometric) the convex
+// boundary joins them. The box's top cut into a left and a right half of two colours (print
+// on one face) steps no more than the top's slope along the cut, and is joined.
+TEST(Merge, TwoColoursAcrossADepthStep_AreASilhouette_NotJoined) {
+    Scene s = pitched_tabletop_scene();
+    s.boxes = {front_box()};
+    const PlaneStage plain = up_to_the_plane(s);
+    int top = 0, front = 0;
+    const std::vector<int> labels = top_and_front(plain, top, front);
+    ASSERT_GT(top, 300);
+    ASSERT_GT(front, 300);
+    const SegmentParams hybrid;
+    ASSERT_EQ(hybrid.segmenter, Segmenter::Hybrid);
+    SegmentParams geometric;
+    geometric.segmenter = Segmenter::Geometric;
+    int joins = -1;
+
+    PlaneStage coloured = plain;
+    two_colours(coloured, labels);
+    merged(coloured, hybrid, labels, 2, joins);
+    EXPECT_EQ(joins, 0) << "two colours across a depth step: a silhouette";
+    merged(coloured, geometric, labels, 2, joins);
+    EXPECT_EQ(joins, 1) << "without colour the convex boundary joins (test premise)";
+
+    // The top alone, its left and right halves.
+    std::vector<int> halves(labels.size(), 0);
+    int u_min = plain.cloud.width, u_max = -1;
+    for (std::size_t p = 0; p < labels.size(); ++p)
+        if (labels[p] == 1) {
+            const int u = static_cast<int>(p % static_cast<std::size_t>(plain.cloud.width));
+            u_min = std::min(u_min, u);
+            u_max = std::max(u_max, u);
+        }
+    const int u_mid = (u_min + u_max) / 2;
+    for (std::size_t p = 0; p < labels.size(); ++p)
+        if (labels[p] == 1)
+            halves[p] = static_cast<int>(p % static_cast<std::size_t>(plain.cloud.width)) < u_mid ? 1 : 2;
+    PlaneStage printed = plain;
+    two_colours(printed, halves);
+    merged(printed, hybrid, halves, 2, joins);
+    EXPECT_EQ(joins, 1) << "print on one face: two colours without a step";
 }
