@@ -55,11 +55,12 @@ struct CutParams {
 /// Merge (merge.cpp; LCCP's merge on segments): two segments that meet, with continuous
 /// depth, along a boundary that is mostly not concave were split by noise or a thin convex
 /// edge (a bowl's rim, a box's front edge), not by a junction of two objects. With colour
-/// (hybrid), a boundary that mostly steps a little in depth and changes colour is one
-/// object's outline over another's (they touch in a pile): not merged.
+/// (hybrid), a pair that steps a little in depth and changes colour is a junction too: one
+/// object's outline over another's (they touch in a pile).
 struct MergeParams {
-    float max_concave = 0.3f;  ///< largest share of concave pairs on such a boundary;
-                               ///< [0, 1], 0 = never merge
+    float max_concave = 0.3f;  ///< largest share of junction pairs (concave; with colour, or
+                               ///< silhouette pairs) on such a boundary; [0, 1], 0 = never
+                               ///< merge
     int min_boundary = 6;      ///< boundary pairs with a crease test at least; >= 1
 };
 

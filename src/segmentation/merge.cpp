@@ -1,7 +1,8 @@
 // The convexity merge (LCCP's): segments that meet along a depth-continuous boundary that
 // is mostly not concave are one object. Noise cuts an object along creases it does not have
 // (a box's front face from its top, a tin's rim); two objects meet at a concave fold, or
-// (with colour, the hybrid segmenter) where one's outline lies over the other.
+// (with colour, the hybrid segmenter) where one's outline lies over the other: either is a
+// junction pair, and a boundary of more than merge.max_concave junction pairs stays.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,17 +19,16 @@ namespace {
 /// blocks smear below a full one. A noise cut through one surface, or print on one face,
 /// steps no more than the surface's slope between neighbours. What it cannot tell: a face
 /// seen nearly edge-on steps as much, so a box whose top and front differ in colour, seen
-/// steeply, keeps them apart. Smaller shares gained the generated families a little more, but
-/// parted `ocid_sample`'s coffee can from its lid; a step measured against each side's own
-/// slope gained less (docs/ABLATION.md, "Merge", has the variants).
+/// steeply, keeps them apart. A smaller share gained the generated families no more and parted
+/// `ocid_sample`'s coffee can from its lid; a larger one, or a step measured against each
+/// side's own slope, gained less (docs/ABLATION.md, "Merge", has the variants).
 constexpr float kSilhouetteStep = 0.25f;
 
 /// The boundary pairs of rows [v0, v1) into `edges`: each 4-neighbour pair (p, q) of two
-/// segments a, b with continuous depth, q right of or below p, keyed (lo, hi, silhouette,
-/// tested, concave): whether the pixels a crease step away on either side, inside their own
-/// segments, were tested for a crease and found concave, and whether with colour
-/// (`colour`) the pair is a silhouette pair (kSilhouetteStep). Reads only: strips run in
-/// parallel.
+/// segments a, b with continuous depth, q right of or below p, keyed (lo, hi, tested,
+/// junction): whether the pixels a crease step away on either side, inside their own
+/// segments, were tested, and found concave or (with colour, `colour`) a silhouette pair
+/// (kSilhouetteStep): where two objects meet. Reads only: strips run in parallel.
 void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, bool colour, std::vector<std::uint64_t>& edges) {
     const SegmentParams& prm = x.prm;
     const int W = x.W, H = x.H, s = prm.cuts.crease_step_px;
@@ -39,27 +39,27 @@ void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, bool colour,
         if (!x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q))) return;
         const int pu = u - s * d[0], pv = v - s * d[1];
         const int qu = u + d[0] + s * d[0], qv = v + d[1] + s * d[1];
-        std::uint64_t tested = 0, concave = 0, silhouette = 0;
+        std::uint64_t tested = 0, junction = 0;
         if (pu >= 0 && pv >= 0 && qu < W && qv < H) {
             const std::size_t pp = static_cast<std::size_t>(pv) * W + pu;
             const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
             if (label[pp] == a && label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
                 tested = 1;
-                concave = x.concavity(pp, qq) > prm.cuts.concavity;
-                if (colour) {
+                junction = x.concavity(pp, qq) > prm.cuts.concavity;
+                if (colour && !junction) {
                     const float z = x.c.z[p];
                     float ca[3], cb[3];
                     chromaticity(x.c, pp, ca);
                     chromaticity(x.c, qq, cb);
                     const float d0 = ca[0] - cb[0], d1 = ca[1] - cb[1], d2 = ca[2] - cb[2];
-                    silhouette = std::fabs(z - x.c.z[q]) > kSilhouetteStep * x.depth_step(z) &&
-                                 d0 * d0 + d1 * d1 + d2 * d2 > min_distance2;
+                    junction = std::fabs(z - x.c.z[q]) > kSilhouetteStep * x.depth_step(z) &&
+                               d0 * d0 + d1 * d1 + d2 * d2 > min_distance2;
                 }
             }
         }
         const auto lo = static_cast<std::uint64_t>(std::min(a, b));
         const auto hi = static_cast<std::uint64_t>(std::max(a, b));
-        edges.push_back((lo << 34) | (hi << 4) | (silhouette << 2) | (tested << 1) | concave);
+        edges.push_back((lo << 34) | (hi << 4) | (tested << 1) | junction);
     };
     static constexpr int kRight[2] = {1, 0}, kDown[2] = {0, 1};
     for (int v = v0; v < v1; ++v) {
@@ -75,9 +75,9 @@ void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, bool colour,
     }
 }
 
-/// Joins segments that touch along a boundary that is mostly not concave: the segments (a,
-/// b) of the boundary pairs (boundary_pairs) merge when enough pairs were tested, few were
-/// concave, no more than half were silhouette pairs, and may_join(a, b). Returns the
+/// Joins segments that touch along a boundary that is mostly not a junction: the segments
+/// (a, b) of the boundary pairs (boundary_pairs) merge when enough pairs were tested, few
+/// were junction pairs (concave, or silhouette pairs), and may_join(a, b). Returns the
 /// merges. Cost: one pass over the pixels in strips of rows (in parallel), a sort of the
 /// boundary pairs (the order they come in does not matter), one more parallel pass to
 /// relabel when anything merged.
@@ -106,16 +106,14 @@ int merge_convex(const Ctx& x, SegmentBuffers& ws, int n, MayJoin&& may_join) {
     int merges = 0;
     for (std::size_t i = 0; i < ws.edges.size();) {
         const std::uint64_t key = ws.edges[i] >> 4;
-        int tested = 0, concave = 0, silhouette = 0;
+        int tested = 0, junction = 0;
         for (; i < ws.edges.size() && (ws.edges[i] >> 4) == key; ++i) {
-            silhouette += static_cast<int>((ws.edges[i] >> 2) & 1);
             tested += static_cast<int>((ws.edges[i] >> 1) & 1);
-            concave += static_cast<int>(ws.edges[i] & 1);
+            junction += static_cast<int>(ws.edges[i] & 1);
         }
         const int a = static_cast<int>(key >> 30), b = static_cast<int>(key & ((1u << 30) - 1));
         if (tested < prm.merge.min_boundary ||
-            static_cast<float>(concave) > prm.merge.max_concave * static_cast<float>(tested) || 2 * silhouette > tested ||
-            !may_join(a, b))
+            static_cast<float>(junction) > prm.merge.max_concave * static_cast<float>(tested) || !may_join(a, b))
             continue;
         merges += join_sets(ws.parent, a, b);
     }

@@ -537,8 +537,8 @@ TEST(GeneratedScene, NoisyTray_ItsBottomRemovedOnTheFramesBand) {
 // camera, 1.6-1.9 m away: beside a tray, objects on the carpet touch in two groups (a lying
 // can against a box, a standing can behind it; a box against a stack). Where one's outline
 // lies over the other, the convexity merge found the boundary not concave and joined them.
-// Those boundaries step in depth and change colour: silhouette pairs, and a boundary that is
-// mostly silhouette pairs is not merged.
+// Those boundaries step in depth and change colour: silhouette pairs, junction pairs as
+// concave ones are, and a boundary of more than merge.max_concave of them is not merged.
 TEST(GeneratedScene, ObjectsTouchingOnTheCarpet_ASilhouetteIsNoMerge) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 20001, "tof", "floor");
