@@ -64,22 +64,23 @@ void two_colours(PlaneStage& st, const std::vector<int>& labels) {
     c.has_color = true;
 }
 
-/// A box of 20 x 12 x 15 cm before the camera, which looks down on the table.
-SceneBox front_box() {
+/// A box of 20 x 12 x 15 cm on the pitched tabletop before the camera, which looks down on
+/// it; up to the plane stage.
+PlaneStage front_box_on_the_table() {
     SceneBox box;
     box.z = 0.9f;
     box.w = 0.2f;
     box.h = 0.12f;
-    return box;
+    Scene s = pitched_tabletop_scene();
+    s.boxes = {box};
+    return up_to_the_plane(s);
 }
 
 }  // namespace
 
 // The box's top (normals up) and its front face, two segments: a convex edge, one object.
 TEST(Merge, BoxTopAndFrontFace_Joined) {
-    Scene s = pitched_tabletop_scene();
-    s.boxes = {front_box()};
-    const PlaneStage st = up_to_the_plane(s);
+    const PlaneStage st = front_box_on_the_table();
     int top = 0, front = 0;
     const std::vector<int> labels = top_and_front(st, top, front);
     ASSERT_GT(top, 300) << "the camera should see the box's top (test premise)";
@@ -127,9 +128,7 @@ TEST(Merge, BoxesAtAConcaveFold_StayApart) {
 // boundary joins them. The box's top cut into a left and a right half of two colours (print
 // on one face) steps no more than the top's slope along the cut, and is joined.
 TEST(Merge, TwoColoursAcrossADepthStep_AreASilhouette_NotJoined) {
-    Scene s = pitched_tabletop_scene();
-    s.boxes = {front_box()};
-    const PlaneStage plain = up_to_the_plane(s);
+    const PlaneStage plain = front_box_on_the_table();
     int top = 0, front = 0;
     const std::vector<int> labels = top_and_front(plain, top, front);
     ASSERT_GT(top, 300);

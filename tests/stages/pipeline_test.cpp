@@ -409,6 +409,12 @@ std::size_t objects_apart(const LabelImage& objects, const GeneratedFrame& g) {
     return holders.size();
 }
 
+/// g's frame through a pipeline with the default parameters.
+FrameResult process_default(const GeneratedFrame& g) {
+    Pipeline pipeline{PipelineParams{}};
+    return pipeline.process(g.frame);
+}
+
 /// g's frame through a pipeline whose default segmentation parameters `set` changed.
 template <class Set>
 FrameResult process_with(const GeneratedFrame& g, Set&& set) {
@@ -482,8 +488,7 @@ TEST(GeneratedScene, NoisyActiveStereoDepth_TheGrowAngleWidensAndTheFarTableIsTh
 TEST(GeneratedScene, PileUnderStructuredLight_ThePlaneWidensOnceTheLeastRadiusTiltsPastItsAngle) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 10039, "structured_light", "pile");
-    Pipeline pipeline{PipelineParams{}};
-    const FrameResult& r = pipeline.process(g.frame);
+    const FrameResult r = process_default(g);
     const NormalParams normals;
     const float tilt = std::tan(normals.max_tilt_noise_deg * std::numbers::pi_v<float> / 180.0f);
     ASSERT_EQ(r.normal_radius_px, normals.radius_px) << "premise: the least radius";
@@ -508,8 +513,7 @@ TEST(GeneratedScene, PileUnderStructuredLight_ThePlaneWidensOnceTheLeastRadiusTi
 TEST(GeneratedScene, BoardWithinTheSupportsBand_IsALowSupportNotAContainer) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 20024, "tof", "floor");
-    Pipeline pipeline{PipelineParams{}};
-    const FrameResult& r = pipeline.process(g.frame);
+    const FrameResult r = process_default(g);
     ASSERT_TRUE(r.plane.found);
     EXPECT_TRUE(r.plane.low_found);
     EXPECT_LT(background_in_objects(r.objects, g), 0.01);  // 5.8 % before
@@ -526,8 +530,7 @@ TEST(GeneratedScene, BoardWithinTheSupportsBand_IsALowSupportNotAContainer) {
 TEST(GeneratedScene, NoisyTray_ItsBottomRemovedOnTheFramesBand) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 20008, "active_stereo", "floor");
-    Pipeline pipeline{PipelineParams{}};
-    const FrameResult& r = pipeline.process(g.frame);
+    const FrameResult r = process_default(g);
     ASSERT_GT(r.depth_noise_px, 1.0f) << "premise: a noisy camera, a band widened 1.5 times";
     ASSERT_TRUE(r.plane.low_found);
     EXPECT_LT(background_in_objects(r.objects, g), 0.04);  // 10.2 % before, 1.7 %
@@ -542,8 +545,7 @@ TEST(GeneratedScene, NoisyTray_ItsBottomRemovedOnTheFramesBand) {
 TEST(GeneratedScene, ObjectsTouchingOnTheCarpet_ASilhouetteIsNoMerge) {
     TempDir dir;
     const GeneratedFrame g = render_generated(dir, 20001, "tof", "floor");
-    Pipeline pipeline{PipelineParams{}};
-    const FrameResult& r = pipeline.process(g.frame);
+    const FrameResult r = process_default(g);
     ASSERT_TRUE(r.plane.found);
     EXPECT_GE(objects_apart(r.objects, g), 10u) << "of " << truth_objects(g).size();  // 7 before
 }
@@ -558,8 +560,7 @@ TEST(GeneratedScene, NoisyActiveStereoPile_TheCreaseStepWidensWithTheNormalsRadi
     const GeneratedFrame g = render_generated(dir, 10005, "active_stereo", "pile");
     const std::set<int> objects = truth_objects(g);
     ASSERT_EQ(objects.size(), 11u);
-    Pipeline pipeline{PipelineParams{}};
-    const FrameResult& r = pipeline.process(g.frame);
+    const FrameResult r = process_default(g);
     ASSERT_GE(r.normal_radius_px, 8) << "premise: normals wider than the given crease step";
     // Found: one object holds most of it, and most of that object is it.
     int found = 0;
