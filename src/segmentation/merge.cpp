@@ -24,6 +24,20 @@ namespace {
 /// side's own slope, gained less (docs/ABLATION.md, "Merge", has the variants).
 constexpr float kSilhouetteStep = 0.25f;
 
+/// Whether the boundary pair (p, q), tested at pp and qq a crease step either side, is a
+/// silhouette pair (kSilhouetteStep). The depth step first: the chromaticities only for a
+/// pair that steps.
+bool silhouette_pair(const Ctx& x, std::size_t p, std::size_t q, std::size_t pp, std::size_t qq,
+                     float min_distance2) {
+    const float z = x.c.z[p];
+    if (!(std::fabs(z - x.c.z[q]) > kSilhouetteStep * x.depth_step(z))) return false;
+    float ca[3], cb[3];
+    chromaticity(x.c, pp, ca);
+    chromaticity(x.c, qq, cb);
+    const float d0 = ca[0] - cb[0], d1 = ca[1] - cb[1], d2 = ca[2] - cb[2];
+    return d0 * d0 + d1 * d1 + d2 * d2 > min_distance2;
+}
+
 /// The boundary pairs of rows [v0, v1) into `edges`: each 4-neighbour pair (p, q) of two
 /// segments a, b with continuous depth, q right of or below p, keyed (lo, hi, tested,
 /// junction): whether the pixels a crease step away on either side, inside their own
@@ -45,16 +59,9 @@ void boundary_pairs(const Ctx& x, const int* label, int v0, int v1, bool colour,
             const std::size_t qq = static_cast<std::size_t>(qv) * W + qu;
             if (label[pp] == a && label[qq] == b && x.n.valid[pp] && x.n.valid[qq]) {
                 tested = 1;
-                junction = x.concavity(pp, qq) > prm.cuts.concavity;
-                if (colour && !junction) {
-                    const float z = x.c.z[p];
-                    float ca[3], cb[3];
-                    chromaticity(x.c, pp, ca);
-                    chromaticity(x.c, qq, cb);
-                    const float d0 = ca[0] - cb[0], d1 = ca[1] - cb[1], d2 = ca[2] - cb[2];
-                    junction = std::fabs(z - x.c.z[q]) > kSilhouetteStep * x.depth_step(z) &&
-                               d0 * d0 + d1 * d1 + d2 * d2 > min_distance2;
-                }
+                junction = x.concavity(pp, qq) > prm.cuts.concavity ||
+                           (colour && silhouette_pair(x, static_cast<std::size_t>(p), static_cast<std::size_t>(q),
+                                                      pp, qq, min_distance2));
             }
         }
         const auto lo = static_cast<std::uint64_t>(std::min(a, b));
