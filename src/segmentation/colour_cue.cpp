@@ -551,7 +551,8 @@ bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int*
         if (const int ra = find(a), rb = find(b); ra != rb) root[rb] = ra, --materials;
     };
     // A colour too small for an object (mixed pixels along an edge, a sticker) is part of
-    // the material it touches most.
+    // the material it touches most; so is one that no pixel took (a segment of fewer clean
+    // colours than kTextureColours).
     auto tiny = [&](int k) { return count[k] < prm.min_points; };
     for (int k = 0; k < K; ++k) {
         if (!tiny(k)) continue;
@@ -586,8 +587,6 @@ bool split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, 
     float colour[kTextureColours][6];
     int colour_count[kTextureColours];
     texture_colours(f, m, cen, side, colour, colour_count);
-    for (const int c : colour_count)
-        if (c == 0) return false;
     std::uint8_t* const part = ws.part.data();
     for (int i = 0; i < m; ++i) part[px[i]] = side[i];
     std::uint8_t material[kTextureColours];
