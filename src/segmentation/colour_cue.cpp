@@ -525,10 +525,11 @@ void texture_colours(const float* const* f, int m, const float (&two)[2][6], std
 /// The materials of segment l's colours (ws.part at its pixels px[0, m), sizes `count`):
 /// per pair of colours their contact, the 4-neighbour pairs between them, over the square
 /// root of the smaller's size. Above colour.max_compact (longer than the outline of any
-/// compact piece) they interleave: one material. At most colour.max_boundary x that (one side
-/// of a compact piece) they lie apart. Between the two the pair is neither: no split. True,
-/// with `material` (0 or 1 per colour), when the colours make exactly two materials. Cost:
-/// one pass over the segment's pixels.
+/// compact piece) they interleave: one material; else they lie apart. True, with `material`
+/// (0 or 1 per colour), when the colours make two materials or more: two are the split; of
+/// more (a pile of objects in one segment) the one that touches the others least for its
+/// size, the likeliest to be an object of its own, is part 0 and the rest part 1, which the
+/// next round may split again. Cost: one pass over the segment's pixels.
 bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m,
                        const int (&count)[kTextureColours], std::uint8_t (&material)[kTextureColours]) {
     constexpr int K = kTextureColours;
@@ -564,17 +565,26 @@ bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int*
     for (int a = 0; a < K; ++a)
         for (int b = a + 1; b < K; ++b) {
             if (tiny(a) || tiny(b)) continue;
-            const double c = contact[a][b];
             const double unit = std::sqrt(static_cast<double>(std::min(count[a], count[b])));
-            if (c > prm.colour.max_compact * unit) {
-                join(a, b);
-            } else if (c > prm.colour.max_boundary * prm.colour.max_compact * unit) {
-                return false;
-            }
+            if (contact[a][b] > prm.colour.max_compact * unit) join(a, b);
         }
-    if (materials != 2) return false;
-    const int first = find(0);
-    for (int k = 0; k < K; ++k) material[k] = find(k) == first ? 0 : 1;
+    if (materials < 2) return false;
+    int apart = find(0);
+    if (materials > 2) {
+        int size[K] = {};      // per material (at its root): pixels
+        double touch[K] = {};  // ... and contact with the other materials
+        for (int k = 0; k < K; ++k) size[find(k)] += count[k];
+        for (int a = 0; a < K; ++a)
+            for (int b = 0; b < K; ++b)
+                if (find(a) != find(b)) touch[find(a)] += contact[a][b];
+        double least = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < K; ++k) {
+            if (find(k) != k || size[k] == 0) continue;
+            const double per_size = touch[k] / std::sqrt(static_cast<double>(size[k]));
+            if (per_size < least) least = per_size, apart = k;
+        }
+    }
+    for (int k = 0; k < K; ++k) material[k] = find(k) == apart ? 0 : 1;
     return true;
 }
 

@@ -257,6 +257,24 @@ TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
     EXPECT_EQ(stats.colour.texture_splits, 1);
 }
 
+// Three flush boxes, plain red, striped (blue and yellow, 2 cm) and plain green: the four
+// colours make three materials (the stripes' two interleave). The one that touches the
+// others least for its size is split off, then the rest in the second round: three objects.
+TEST(SegmentObjects, ThreeFlushBoxesOneStriped_EachItsOwnMaterial) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    s.boxes = {SceneBox{.x = -0.15f, .z = 1.0f}, SceneBox{.x = 0.0f, .z = 1.0f},
+               SceneBox{.x = 0.15f, .z = 1.0f, .r = 40, .g = 170, .b = 60}};
+    PlaneStage in = up_to_the_plane(s);
+    paint_stripes(in, kTruthBox0 + 1, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the red box stayed with the striped one");
+    expect_separate(out, in.truth, kTruthBox0 + 1, kTruthBox0 + 2, 0.9, "the green box stayed with the striped one");
+    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 2, 0.9, "the red and green boxes stayed one");
+    EXPECT_GE(stats.colour.texture_splits, 1);
+}
+
 // One striped box on its own: its stripes are one material, whatever four colours k-means
 // finds in them; nothing is split.
 TEST(SegmentObjects, StripedBox_StaysOneObject) {
