@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "segment_scene.hpp"
@@ -46,28 +47,16 @@ void blur_depth(DepthImage& d) {
         }
 }
 
-/// `s` rendered, its depth blurred (blur_depth), then normals, depth range and support plane.
-PlaneStage up_to_the_plane_blurred(const Scene& s) {
-    PlaneStage st;
-    RgbdFrame f = render_scene(s, &st.truth);
-    blur_depth(f.depth);
-    std::vector<std::uint8_t> active;
-    back_project(f, st.cloud);
-    estimate_normals(NormalParams{}, st.cloud, st.normals);
-    select_depth_range(DepthRange{}, st.cloud, active);
-    PlaneWorkspace pws;
-    st.plane = remove_support_plane(PlaneParams{}, f.intrinsics, st.cloud, st.normals, active, pws, st.classes);
-    EXPECT_TRUE(st.plane.found);
-    return st;
-}
-
 }  // namespace
 
 // Seen from above, the blurred edge of a flat box steps down to the table in a ramp whose
 // pixels lie on the support's band with tilted normals: foot candidates. They are table,
 // not the box's feet, and most stay out of it; the box itself is whole.
 TEST(SegmentObjects, FlatBoxFromAbove_BlurredEdgeIsNoFoot) {
-    const PlaneStage in = up_to_the_plane_blurred(flat_box_from_above());
+    std::vector<int> truth;
+    RgbdFrame f = render_scene(flat_box_from_above(), &truth);
+    blur_depth(f.depth);
+    const PlaneStage in = up_to_the_plane(f, std::move(truth));
     std::size_t feet = 0;
     for (std::size_t p = 0; p < in.classes.size(); ++p)
         feet += in.truth[p] == kTruthTable && in.classes[p] == kPlaneFoot;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "synthetic_scene.hpp"
@@ -24,10 +25,11 @@ struct PlaneStage {
     PlaneResult plane;
 };
 
-/// Renders `s` and runs normals, depth range and support-plane removal.
-inline PlaneStage up_to_the_plane(const Scene& s) {
+/// Runs normals, depth range and support-plane removal on a rendered frame `f` whose truth
+/// ids are `truth` (render_scene's; a test may change the frame in between).
+inline PlaneStage up_to_the_plane(const RgbdFrame& f, std::vector<int> truth) {
     PlaneStage st;
-    const RgbdFrame f = render_scene(s, &st.truth);
+    st.truth = std::move(truth);
     std::vector<std::uint8_t> active;
     back_project(f, st.cloud);
     estimate_normals(NormalParams{}, st.cloud, st.normals);
@@ -37,6 +39,13 @@ inline PlaneStage up_to_the_plane(const Scene& s) {
                                     st.classes);
     EXPECT_TRUE(st.plane.found);
     return st;
+}
+
+/// Renders `s` and runs normals, depth range and support-plane removal.
+inline PlaneStage up_to_the_plane(const Scene& s) {
+    std::vector<int> truth;
+    const RgbdFrame f = render_scene(s, &truth);
+    return up_to_the_plane(f, std::move(truth));
 }
 
 /// Segments a scene up to the plane stage.
