@@ -35,6 +35,7 @@ struct PlaneWorkspace::Buffers {
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
     std::vector<int> low_piece;         ///< grid points of a low support's top (remove_low_support)
     std::vector<std::uint8_t> low_mask; ///< per grid point: in the low support's layer, piece or plane
+    std::vector<double> low_sums;       ///< per piece of low_mask: count, summed height and band
     /// Runs of on-band pixels, row by row, and their union-find components (islands).
     struct Run {
         int row, begin, end;  ///< pixels [begin, end) of the row

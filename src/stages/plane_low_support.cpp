@@ -31,6 +31,12 @@ constexpr int kRimCells = 2;
 /// over the band to make a layer (generated floor tune seeds: 0.75 scored above 0.5 and 1;
 /// docs/ABLATION.md, "Low supports in the plane stage").
 constexpr float kLayerFromBand = 0.75f;
+/// A piece of the low plane's inliers lies on it when its points' mean height over it is
+/// within this share of their mean band. A board's pieces straddle the plane (means of
+/// 0.00-0.04 band on the floor family's boards); another surface's sit off it: the floor's
+/// noise over a thin board's band (-0.5 to -0.8), a book of another thickness (0.4 and more,
+/// `osd_mosd` test58).
+constexpr float kOnPlaneShare = 0.25f;
 /// The layer's histogram: bins of 2 mm over (0, kMaxHeightM], windows of 5 bins.
 constexpr float kBinM = 0.002f;
 constexpr int kBins = static_cast<int>(kMaxHeightM / kBinM), kWindow = 2;
@@ -55,7 +61,7 @@ float densest_layer(const float* h, int G, int min_points) {
 }
 
 /// The largest 8-connected piece of the grid points with in[g] != 0: its points' indices
-/// into `piece`. `label` (G) and `stack` are scratch. O(G).
+/// into `piece`. `label` (G): each point's piece, -1 outside `in`; `stack` is scratch. O(G).
 void largest_piece(const Grid& grid, const std::vector<std::uint8_t>& in, std::vector<int>& label,
                    std::vector<int>& stack, std::vector<int>& piece) {
     const int G = grid.size();
@@ -81,6 +87,56 @@ void largest_piece(const Grid& grid, const std::vector<std::uint8_t>& in, std::v
         }
         if (current.size() > piece.size()) piece = current;
         ++id;
+    }
+}
+
+/// A board's top, parted in the image by the objects standing on it: adds to `piece` (one of
+/// the pieces of `in`, as largest_piece labelled them in `label`) every other piece that it
+/// reaches across points for which `stands(g)` holds, and that lies on `low` (kOnPlaneShare).
+/// `sums` (3 per piece) and `stack` are scratch; `label` is spent. O(G).
+template <class Stands>
+void join_across_objects(const Grid& grid, const PlaneWorkspace::Buffers::GridPoints& gp,
+                         const InlierTest& inliers, const Plane& low, Stands&& stands, std::vector<int>& label,
+                         std::vector<double>& sums, std::vector<int>& stack, std::vector<int>& piece) {
+    const int G = grid.size();
+    if (piece.empty()) return;
+    // Each piece's count, summed height over `low` and summed band.
+    int pieces = 0;
+    for (int g = 0; g < G; ++g) pieces = std::max(pieces, label[g] + 1);
+    sums.assign(3 * static_cast<std::size_t>(pieces), 0.0);
+    for (int g = 0; g < G; ++g) {
+        if (label[g] < 0) continue;
+        double* const s = &sums[3 * static_cast<std::size_t>(label[g])];
+        s[0] += 1;
+        s[1] += low.height(gp.x[g], gp.y[g], gp.z[g]);
+        s[2] += inliers.band(gp.z[g]);
+    }
+    const auto on_plane = [&](int id) {
+        const double* const s = &sums[3 * static_cast<std::size_t>(id)];
+        return std::fabs(s[1]) <= kOnPlaneShare * s[2];
+    };
+    // A flood from the piece over standing points and the pieces on the plane; a point seen
+    // is labelled -2.
+    const int own = label[piece.front()];
+    stack.clear();
+    for (const int g : piece) {
+        label[g] = -2;
+        stack.push_back(g);
+    }
+    for (std::size_t k = 0; k < stack.size(); ++k) {
+        const int g = stack[k], gu = g % grid.w, gv = g / grid.w;
+        for (int dv = -1; dv <= 1; ++dv)
+            for (int du = -1; du <= 1; ++du) {
+                const int u = gu + du, v = gv + dv;
+                if (u < 0 || v < 0 || u >= grid.w || v >= grid.h) continue;
+                const int q = v * grid.w + u, id = label[q];
+                if (id == -2) continue;
+                const bool joins = id >= 0 && (id == own || on_plane(id));
+                if (!joins && !(id == -1 && stands(q))) continue;
+                label[q] = -2;
+                stack.push_back(q);
+                if (joins) piece.push_back(q);
+            }
     }
 }
 
@@ -121,24 +177,36 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     }
     const float layer = densest_layer(h, G, params.min_region_points);
     if (std::isnan(layer)) return 0;
-    // 2. Its largest piece, large enough on the plane.
+    // 2. Its largest piece, with the pieces of the layer that it reaches across the objects
+    // standing on it (they part a board's top in the image), large enough on the plane.
+    // Until its own plane is fitted, `board` is the layer's: parallel to the support.
+    Plane board = pl;
+    board.d -= layer;
+    const auto stands = [&](int g) {  // a grid point of an object standing on `board`
+        const float hl = board.height(gp.x[g], gp.y[g], gp.z[g]);
+        return gp.active[g] && hl > 2.0f * inliers.band(gp.z[g]) && hl <= params.max_object_height_m;
+    };
     ws.low_mask.assign(static_cast<std::size_t>(G), 0);
     for (int g = 0; g < G; ++g)
         ws.low_mask[static_cast<std::size_t>(g)] = std::fabs(h[g] - layer) <= inliers.band(gp.z[g]);
     largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
+    join_across_objects(grid, gp, inliers, board, stands, ws.region, ws.low_sums, ws.stack, ws.low_piece);
     if (static_cast<int>(ws.low_piece.size()) < params.min_region_points ||
         area_on_plane(gp, ws.low_piece, pl) < kMinAreaM2)
         return 0;
     // 3. Its plane, fitted to the piece, then again to the largest piece of that plane's
-    // inliers (the layer's heights were over the support, which need not be quite parallel).
+    // inliers (the layer's heights were over the support, which need not be quite parallel)
+    // with the pieces of them that it reaches as above.
     for (int round = 0; round < 2; ++round) {
         ws.low_mask.assign(static_cast<std::size_t>(G), 0);
         for (const int g : ws.low_piece) ws.low_mask[static_cast<std::size_t>(g)] = 1;
-        if (!fit_grid_points(inliers, params.min_region_points, ws.low_mask.data(), low)) return 0;
+        if (!fit_grid_points(inliers, params.min_region_points, ws.low_mask.data(), board)) return 0;
         if (round == 1) break;
-        for (int g = 0; g < G; ++g) ws.low_mask[static_cast<std::size_t>(g)] = gp.usable[g] && inliers(low, g);
+        for (int g = 0; g < G; ++g) ws.low_mask[static_cast<std::size_t>(g)] = gp.usable[g] && inliers(board, g);
         largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
+        join_across_objects(grid, gp, inliers, board, stands, ws.region, ws.low_sums, ws.stack, ws.low_piece);
     }
+    low = board;
     // Its extent in the image: the piece's convex hull on the grid, a cell wider.
     std::vector<cv::Point> cells;
     cells.reserve(ws.low_piece.size());
@@ -151,11 +219,7 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     // 4. It holds objects: min_region_points grid points stand over its extent, clear of its
     // band (books lying side by side, with nothing on them, are objects, not a support).
     int standing = 0;
-    for (int g = 0; g < G; ++g) {
-        if (!gp.active[g] || !extent.data[g]) continue;
-        const float hl = low.height(gp.x[g], gp.y[g], gp.z[g]);
-        standing += hl > 2.0f * inliers.band(gp.z[g]) && hl <= params.max_object_height_m;
-    }
+    for (int g = 0; g < G; ++g) standing += extent.data[g] && stands(g);
     if (standing < params.min_region_points) return 0;
     // 5. Every object pixel over that extent that is not above the low support's band: its
     // top (facing like it), its sides and what lies between it and the support are removed;

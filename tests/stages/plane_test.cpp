@@ -716,6 +716,35 @@ TEST(RemoveSupportPlane, BoardOnTheTable_RemovedAsALowSupport_ItsBoxesKept) {
     EXPECT_GT(kept_of(small, s.classes, truth, kTruthBox0).share(), 0.9);
 }
 
+// A board parted in the image by what stands on it: a long box across its middle, end to end,
+// leaves two halves of its top, each under the 0.1 m^2 of a low support (a book's size). The
+// halves are one board: the piece reaches the other across the box and both lie on its plane.
+TEST(RemoveSupportPlane, BoardPartedByABoxAcrossIt_OneLowSupport) {
+    Scene scene = board_on_table_scene(0.5f, 0.32f);
+    const SceneBox& board = scene.boxes[0];
+    const SceneBox across{.x = board.x, .z = board.z, .w = 0.08f, .h = 0.1f, .d = board.d, .lift = board.h,
+                          .g = 120};
+    scene.boxes = {board, across};
+    std::vector<int> truth;
+    const Prepared f = prepared(render_scene(scene, &truth));
+    const Removal r = remove_with_defaults(f);
+    ASSERT_TRUE(r.result.found);
+    ASSERT_TRUE(r.result.low_found);
+    for (const bool left : {true, false}) {  // each half of the board's top, removed
+        std::size_t half = 0, half_object = 0;
+        for (std::size_t p = 0; p < truth.size(); ++p) {
+            if (truth[p] != kTruthBox0 || !f.active[p] || (f.cloud.x[p] < board.x) != left) continue;
+            ++half;
+            half_object += r.classes[p] == kPlaneObject;
+        }
+        ASSERT_GT(half, 1500u) << (left ? "left" : "right");
+        EXPECT_LT(static_cast<double>(half_object) / static_cast<double>(half), 0.05) << (left ? "left" : "right");
+    }
+    const KeptCount k = kept_of(f, r.classes, truth, kTruthBox0 + 1);
+    ASSERT_GT(k.points, 1000u);
+    EXPECT_GT(k.share(), 0.9);
+}
+
 // A noisy camera: the tilted table and boxes of the first test with depth noise growing with
 // z^2 (1 mm at 1 m, 2.6 mm at 1.6 m; normals at the radius that noise chooses, 6 px), more
 // than the band of the defaults takes. Given a widening of 1.5 (what the pipeline passes for
