@@ -721,7 +721,7 @@ TEST(RemoveSupportPlane, BoardOnTheTable_RemovedAsALowSupport_ItsBoxesKept) {
 // halves are one board: the piece reaches the other across the box and both lie on its plane.
 TEST(RemoveSupportPlane, BoardPartedByABoxAcrossIt_OneLowSupport) {
     Scene scene = board_on_table_scene(0.5f, 0.32f);
-    const SceneBox& board = scene.boxes[0];
+    const SceneBox board = scene.boxes[0];
     const SceneBox across{.x = board.x, .z = board.z, .w = 0.08f, .h = 0.1f, .d = board.d, .lift = board.h,
                           .g = 120};
     scene.boxes = {board, across};
