@@ -60,49 +60,54 @@ float densest_layer(const float* h, int G, int min_points) {
     return best < 0 ? std::nanf("") : (static_cast<float>(best) + 0.5f) * kBinM;
 }
 
+/// Calls f(q) for each of grid point g's 8 neighbours q inside the grid.
+template <class F>
+void for_each_neighbour(const Grid& grid, int g, F&& f) {
+    const int gu = g % grid.w, gv = g / grid.w;
+    for (int v = std::max(0, gv - 1); v <= std::min(grid.h - 1, gv + 1); ++v)
+        for (int u = std::max(0, gu - 1); u <= std::min(grid.w - 1, gu + 1); ++u)
+            if (u != gu || v != gv) f(v * grid.w + u);
+}
+
 /// The largest 8-connected piece of the grid points with in[g] != 0: its points' indices
-/// into `piece`. `label` (G): each point's piece, -1 outside `in`; `stack` is scratch. O(G).
-void largest_piece(const Grid& grid, const std::vector<std::uint8_t>& in, std::vector<int>& label,
-                   std::vector<int>& stack, std::vector<int>& piece) {
+/// into `piece`. `label` (G): each point's piece, -1 outside `in`; `stack` is scratch.
+/// Returns the number of pieces. O(G).
+int largest_piece(const Grid& grid, const std::vector<std::uint8_t>& in, std::vector<int>& label,
+                  std::vector<int>& stack, std::vector<int>& piece) {
     const int G = grid.size();
     label.assign(static_cast<std::size_t>(G), -1);
     piece.clear();
     std::vector<int>& current = stack;  // reused: the flood's stack holds each piece's points
-    for (int seed = 0, id = 0; seed < G; ++seed) {
+    int id = 0;
+    for (int seed = 0; seed < G; ++seed) {
         if (!in[seed] || label[seed] >= 0) continue;
         current.clear();
         current.push_back(seed);
         label[seed] = id;
-        for (std::size_t k = 0; k < current.size(); ++k) {
-            const int g = current[k], gu = g % grid.w, gv = g / grid.w;
-            for (int dv = -1; dv <= 1; ++dv)
-                for (int du = -1; du <= 1; ++du) {
-                    const int u = gu + du, v = gv + dv;
-                    if (u < 0 || v < 0 || u >= grid.w || v >= grid.h) continue;
-                    const int q = v * grid.w + u;
-                    if (!in[q] || label[q] >= 0) continue;
-                    label[q] = id;
-                    current.push_back(q);
-                }
-        }
+        for (std::size_t k = 0; k < current.size(); ++k)
+            for_each_neighbour(grid, current[k], [&](int q) {
+                if (!in[q] || label[q] >= 0) return;
+                label[q] = id;
+                current.push_back(q);
+            });
         if (current.size() > piece.size()) piece = current;
         ++id;
     }
+    return id;
 }
 
 /// A board's top, parted in the image by the objects standing on it: adds to `piece` (one of
-/// the pieces of `in`, as largest_piece labelled them in `label`) every other piece that it
-/// reaches across points for which `stands(g)` holds, and that lies on `low` (kOnPlaneShare).
-/// `sums` (3 per piece) and `stack` are scratch; `label` is spent. O(G).
+/// the `pieces` pieces of `in`, as largest_piece labelled them in `label`) every other piece
+/// that it reaches across points for which `stands(g)` holds, and that lies on `low`
+/// (kOnPlaneShare). `sums` (3 per piece) and `stack` are scratch; `label` is spent. O(G).
 template <class Stands>
 void join_across_objects(const Grid& grid, const PlaneWorkspace::Buffers::GridPoints& gp,
-                         const InlierTest& inliers, const Plane& low, Stands&& stands, std::vector<int>& label,
-                         std::vector<double>& sums, std::vector<int>& stack, std::vector<int>& piece) {
+                         const InlierTest& inliers, const Plane& low, Stands&& stands, int pieces,
+                         std::vector<int>& label, std::vector<double>& sums, std::vector<int>& stack,
+                         std::vector<int>& piece) {
     const int G = grid.size();
     if (piece.empty()) return;
     // Each piece's count, summed height over `low` and summed band.
-    int pieces = 0;
-    for (int g = 0; g < G; ++g) pieces = std::max(pieces, label[g] + 1);
     sums.assign(3 * static_cast<std::size_t>(pieces), 0.0);
     for (int g = 0; g < G; ++g) {
         if (label[g] < 0) continue;
@@ -123,21 +128,16 @@ void join_across_objects(const Grid& grid, const PlaneWorkspace::Buffers::GridPo
         label[g] = -2;
         stack.push_back(g);
     }
-    for (std::size_t k = 0; k < stack.size(); ++k) {
-        const int g = stack[k], gu = g % grid.w, gv = g / grid.w;
-        for (int dv = -1; dv <= 1; ++dv)
-            for (int du = -1; du <= 1; ++du) {
-                const int u = gu + du, v = gv + dv;
-                if (u < 0 || v < 0 || u >= grid.w || v >= grid.h) continue;
-                const int q = v * grid.w + u, id = label[q];
-                if (id == -2) continue;
-                const bool joins = id >= 0 && (id == own || on_plane(id));
-                if (!joins && !(id == -1 && stands(q))) continue;
-                label[q] = -2;
-                stack.push_back(q);
-                if (joins) piece.push_back(q);
-            }
-    }
+    for (std::size_t k = 0; k < stack.size(); ++k)
+        for_each_neighbour(grid, stack[k], [&](int q) {
+            const int id = label[q];
+            if (id == -2) return;
+            const bool joins = id >= 0 && (id == own || on_plane(id));
+            if (!joins && !(id == -1 && stands(q))) return;
+            label[q] = -2;
+            stack.push_back(q);
+            if (joins) piece.push_back(q);
+        });
 }
 
 /// The area of the convex hull of `piece`'s points moved onto the plane `pl`, in m^2.
@@ -189,8 +189,8 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     ws.low_mask.assign(static_cast<std::size_t>(G), 0);
     for (int g = 0; g < G; ++g)
         ws.low_mask[static_cast<std::size_t>(g)] = std::fabs(h[g] - layer) <= inliers.band(gp.z[g]);
-    largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
-    join_across_objects(grid, gp, inliers, board, stands, ws.region, ws.low_sums, ws.stack, ws.low_piece);
+    int pieces = largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
+    join_across_objects(grid, gp, inliers, board, stands, pieces, ws.region, ws.low_sums, ws.stack, ws.low_piece);
     if (static_cast<int>(ws.low_piece.size()) < params.min_region_points ||
         area_on_plane(gp, ws.low_piece, pl) < kMinAreaM2)
         return 0;
@@ -203,8 +203,9 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
         if (!fit_grid_points(inliers, params.min_region_points, ws.low_mask.data(), board)) return 0;
         if (round == 1) break;
         for (int g = 0; g < G; ++g) ws.low_mask[static_cast<std::size_t>(g)] = gp.usable[g] && inliers(board, g);
-        largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
-        join_across_objects(grid, gp, inliers, board, stands, ws.region, ws.low_sums, ws.stack, ws.low_piece);
+        pieces = largest_piece(grid, ws.low_mask, ws.region, ws.stack, ws.low_piece);
+        join_across_objects(grid, gp, inliers, board, stands, pieces, ws.region, ws.low_sums, ws.stack,
+                            ws.low_piece);
     }
     low = board;
     // Its extent in the image: the piece's convex hull on the grid, a cell wider.
