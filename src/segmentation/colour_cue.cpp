@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 
+#include "../branch_free.hpp"
 #include "../circle_fit.hpp"
 #include "internal.hpp"
 #include "wul3d/clustering.hpp"  // ClusterParams: the colour cue's alpha and delta
@@ -193,9 +194,9 @@ bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2
 /// iteration's; a part may be empty). `total`: the planes' sums (seed_centres'); part 0's
 /// sums are the totals minus part 1's. Cost: at most 6 passes over the 6 planes, stopping
 /// when no pixel changes part; float sums per block of 1024, added up in double; no
-/// allocation.
-void two_means(const float* const* planes, int m, const double (&total)[6], std::uint8_t* side, float (&cen)[2][6],
-               int (&count)[2]) {
+/// allocation. Built for AVX2 and baseline x86-64 (the sides' loop vectorizes either way).
+WUL3D_AVX2_CLONES void two_means(const float* const* planes, int m, const double (&total)[6], std::uint8_t* side,
+                                 float (&cen)[2][6], int (&count)[2]) {
     const float* f[6];  // a local copy: the stores to `side` cannot alias it
     for (int q = 0; q < 6; ++q) f[q] = planes[q];
     for (int it = 0; it < 6; ++it) {
@@ -253,6 +254,7 @@ struct SplitBoundary {
     int steps[2] = {0, 0};  ///< ... of those, where part 0's side (steps[0]) or part 1's
                             ///< is colour.min_step times brighter a crease step away
     int small_outline = 0;  ///< 4-neighbour pairs from the smaller part to anything else
+    int convex = 0;         ///< pairs with normals across a convex fold (a box's edge); only when asked
 };
 
 /// Calls visit(q, du, dv) for each 4-neighbour q of pixel p to its right (du = 1) or below
@@ -267,10 +269,11 @@ void for_part_boundary_pairs(const Ctx& x, const SegmentBuffers& ws, int l, int 
 }
 
 /// The boundary between the parts of segment l (pixels px[0, m), parts in ws.part), its
-/// brightness steps on one plane, and the smaller part's outline. Cost: one pass over the
-/// segment's pixels and their neighbours.
+/// brightness steps on one plane, its convex folds (with `folds`, else none counted), and
+/// the smaller part's outline. Cost: one pass over the segment's pixels and their
+/// neighbours.
 SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m,
-                             std::uint8_t small_part, float cos_crease) {
+                             std::uint8_t small_part, float cos_crease, bool folds) {
     const int W = x.W, s = x.prm.cuts.crease_step_px;
     const std::uint8_t* const part = ws.part.data();
     // One plane: within kStepPlaneDeg, and smooth whatever colour.max_crease_deg says.
@@ -294,6 +297,11 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, cons
             const float cos_ab = x.n.nx[a] * x.n.nx[b] + x.n.ny[a] * x.n.ny[b] + x.n.nz[a] * x.n.nz[b];
             sb.smooth += cos_ab >= cos_crease;
             ++sb.with_normals;
+            // A fold whose normals turn away from each other (the crease test's concavity,
+            // negated) on one surface: two faces of one solid.
+            const auto pa = static_cast<std::size_t>(a), pb = static_cast<std::size_t>(b);
+            if (folds && cos_ab < cos_crease && x.connected(pa, pb, static_cast<float>(2 * s + 1)))
+                sb.convex += x.concavity(pa, pb) < -x.prm.cuts.concavity;
             // A step in brightness counts on one plane only (a lies on p's side, b on q's):
             // light falls alike there, while a curved surface turns from it (a bowl's lit
             // and shaded sides).
@@ -358,6 +366,35 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
 /// merge tests.
 constexpr int kMinStepPairs = 6;
 
+// A split between the materials of kMoreTextureColours is weaker evidence than one of four
+// colours (eight clusters find more in one object's print): more_colours_like_objects keeps
+// it only where its parts meet as two objects of a pile do, by the three constants below.
+
+/// At most this share of the split's boundary pairs with normals cross a convex fold: one
+/// box printed otherwise on two faces (`osd_mosd` learn24) does, where the objects of a pile
+/// meet across a concave fold or a smooth surface (generated tune seeds: 0.4-0.6 alike, 0.3
+/// lower, 0.7 costs `osd_mosd` 0.1 Overlap F).
+constexpr float kMaxConvexShare = 0.5f;
+/// The smaller part holds at least this share of the segment (colour.min_share, three times
+/// over) ...
+constexpr float kMoreColoursMinShare = 0.15f;
+/// ... and at least this times its outline squared in pixels: a square has 1/16, a 1:6
+/// rectangle 1/33, a band of the table's colour round an object whose depth the sensor took
+/// in far less (the shipped RealSense frames: 0.0034). These two were chosen on those
+/// frames, whose table bands came apart as objects without them; the generated tune seeds
+/// score the same with or without them, and lower at 0.2 and 0.006.
+constexpr float kMinRoundness = 0.005f;
+
+/// Whether the parts of a split between the materials of kMoreTextureColours meet as two
+/// objects of a pile do (the three constants above): `small` pixels of the segment's `m` in
+/// the smaller part. Cost: O(1).
+bool more_colours_like_objects(const SplitBoundary& sb, int small, int m) {
+    const auto outline = static_cast<float>(sb.small_outline);
+    return static_cast<float>(sb.convex) <= kMaxConvexShare * static_cast<float>(sb.with_normals) &&
+           static_cast<float>(small) >= kMoreColoursMinShare * static_cast<float>(m) &&
+           static_cast<float>(small) >= kMinRoundness * outline * outline;
+}
+
 /// What the colour cue's tests say of a split.
 enum class Verdict {
     kKept,
@@ -366,12 +403,13 @@ enum class Verdict {
 };
 
 /// The colour cue's tests (SegmentParams, "Colour cue") of a split of segment l: pixels
-/// px[0, m), parts in ws.part, part sizes `count` and means `cen` (feature units). Cost: one
-/// pass over the segment's pixels for the boundary; the round test's three more, on a
-/// support, when every other test passed.
+/// px[0, m), parts in ws.part, part sizes `count` and means `cen` (feature units).
+/// `more_colours`: a split between the materials of kMoreTextureColours, which must also
+/// pass more_colours_like_objects. Cost: one pass over the segment's pixels for the
+/// boundary; the round test's three more, on a support, when every other test passed.
 Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ClusterParams& cp,
                     float cos_crease, const SegmentBuffers& ws, int l, const int* px, int m, const int (&count)[2],
-                    const float (&cen)[2][6]) {
+                    const float (&cen)[2][6], bool more_colours = false) {
     const SegmentParams& prm = x.prm;
     const int small = std::min(count[0], count[1]);
     if (small < prm.min_points || static_cast<float>(small) < prm.colour.min_share * static_cast<float>(m))
@@ -383,7 +421,7 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
     // Boundary: 4-neighbour pairs inside the segment with different parts; the normals a
     // crease step away on either side tell a smooth surface from a fold.
     const std::uint8_t small_part = count[0] < count[1] ? 0 : 1;
-    const SplitBoundary sb = split_boundary(x, ws, l, px, m, small_part, cos_crease);
+    const SplitBoundary sb = split_boundary(x, ws, l, px, m, small_part, cos_crease, more_colours);
     // A contact between two objects is one side of the smaller one's outline, or, where the
     // larger one encloses it in view (a box lying on a box, seen from above), the whole
     // outline of a compact piece: 4 sqrt(pixels) for a square, 6 for a 6:1 rectangle. A
@@ -408,6 +446,7 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
                                  10 * std::max(sb.steps[0], sb.steps[1]) >= 7 * sb.on_plane;
     if (!far_in_colour && !brightness_step) return Verdict::kRejected;
     const bool across_smooth = sb.with_normals > 0 && 10 * sb.smooth >= 7 * sb.with_normals;
+    if (more_colours && !more_colours_like_objects(sb, small, m)) return Verdict::kRejected;
     if (!across_smooth && !brightness_step) {
         const float r0 = cen[0][3], g0 = cen[0][4], b0c = cen[0][5];
         const float r1 = cen[1][3], g1 = cen[1][4], b1c = cen[1][5];
@@ -426,7 +465,8 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
 // colours beside a plain box put the stripes in two parts and the box with one of them.
 // More colours then: the texture's two, the plain one's, and one for the rest. Two colours
 // whose contact is far longer than any two objects' (they interleave) are one material; the
-// split is between the materials.
+// split is between the materials. Where the four make one material, the segment holds more
+// textures than four colours can tell apart, and eight are tried.
 
 /// Colours per segment when 2-means followed a texture: a textured object's two, a plain
 /// one's beside it, and one more for what fits none (mixed pixels along edges, a third
@@ -434,41 +474,81 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
 /// every pixel (docs/ABLATION.md, "Colour cue").
 constexpr int kTextureColours = 4;
 
-/// k-means learns the colours from at most this many pixels per colour (every stride-th
-/// pixel), then gives every pixel its nearest once: FAISS's Clustering subsamples its
-/// training set the same way (max_points_per_centroid, 256 by default).
+/// Colours per segment where kTextureColours make one material: textured objects touching
+/// in a pile show more colours than four, and each of the four then spans several objects,
+/// so every pair interleaves. Generated tune seeds: 6 and 8 alike, 6 costing `osd_mosd` 0.1
+/// Overlap F; tried only there, since 5 or 6 colours everywhere split real prints
+/// (docs/ABLATION.md, "Colour cue").
+constexpr int kMoreTextureColours = 8;
+
+/// k-means learns the colours from at most this many pixels per colour of kTextureColours
+/// (every stride-th pixel), then gives every pixel its nearest once: FAISS's Clustering
+/// subsamples its training set the same way (max_points_per_centroid, 256 by default). The
+/// eight colours learn from the same 1,024 pixels: 2,048 scored the same on the generated
+/// tune seeds at twice the cost, 512 cost `osd_mosd` 0.2 Overlap F.
 constexpr int kSamplesPerColour = 256;
 
-/// The centre nearest pixel i's features (eq. 4 squared): |f - c_k|^2 less |f|^2, i.e.
-/// |c_k|^2 - 2 f . c_k, from `w` = 2 c_k and `bias` = |c_k|^2. Branch-free, so that a loop
-/// over pixels vectorizes.
-inline std::uint8_t nearest_colour(const float* const* f, int i, const float (&w)[kTextureColours][6],
-                                   const float (&bias)[kTextureColours]) {
-    std::uint8_t best = 0;
-    float best_d = 0;
-    for (int k = 0; k < kTextureColours; ++k) {
-        float d = bias[k];
-        for (int q = 0; q < 6; ++q) d -= w[k][q] * f[q][i];
-        const bool nearer = k == 0 || d < best_d;
-        best_d = nearer ? d : best_d;
-        best = nearer ? static_cast<std::uint8_t>(k) : best;
+/// Each pixel's nearest centre (eq. 4 squared) for pixels [0, n) of the planes `f`, into
+/// out[0, n): |f - c_k|^2 less |f|^2, i.e. |c_k|^2 - 2 f . c_k, from `w` = 2 c_k and `bias`
+/// = |c_k|^2; the first of equals. A block of pixels at a time, the centres in the outer loop
+/// (as FAISS orders its distances): the distances, then the nearest, in loops over
+/// contiguous floats that vectorize at any K (a loop over the centres inside one over the
+/// pixels did not at eight). Inlined into texture_colours, so built for AVX2 with it. Cost:
+/// K + 1 passes over each block; 5 KB of stack at K = 8.
+template <int K>
+[[gnu::always_inline]] inline void nearest_colours(const float* const* f, int n, const float (&w)[K][6],
+                                                   const float (&bias)[K], std::uint8_t* out) {
+    const float *const f0 = f[0], *const f1 = f[1], *const f2 = f[2], *const f3 = f[3], *const f4 = f[4],
+                      *const f5 = f[5];
+    constexpr int kBlock = 128;
+    float dist[K][kBlock], best[kBlock];
+    int nearest[kBlock];
+    for (int i0 = 0; i0 < n; i0 += kBlock) {
+        const int b = std::min(kBlock, n - i0);
+        for (int k = 0; k < K; ++k) {
+            const float w0 = w[k][0], w1 = w[k][1], w2 = w[k][2], w3 = w[k][3], w4 = w[k][4], w5 = w[k][5];
+            const float c = bias[k];
+            float* const dk = dist[k];
+            for (int i = 0; i < b; ++i) {
+                const int j = i0 + i;
+                float d = c;
+                d -= w0 * f0[j];
+                d -= w1 * f1[j];
+                d -= w2 * f2[j];
+                d -= w3 * f3[j];
+                d -= w4 * f4[j];
+                d -= w5 * f5[j];
+                dk[i] = d;
+            }
+        }
+        for (int i = 0; i < b; ++i) best[i] = dist[0][i], nearest[i] = 0;
+        for (int k = 1; k < K; ++k) {
+            const float* const dk = dist[k];
+            for (int i = 0; i < b; ++i) {
+                const bool nearer = dk[i] < best[i];
+                best[i] = nearer ? dk[i] : best[i];
+                nearest[i] = nearer ? k : nearest[i];
+            }
+        }
+        for (int i = 0; i < b; ++i) out[i0 + i] = static_cast<std::uint8_t>(nearest[i]);
     }
-    return best;
 }
 
-/// k-means (eq. 4 squared, on the 2-means features `f` of the m pixels) with
-/// kTextureColours centres, seeded at the two 2-means parts' means `two` and then, one by
-/// one, at the colour farthest from the centres so far; learnt from every stride-th pixel
-/// (at most kSamplesPerColour per colour, copied together). cluster[i] gets pixel i's
-/// colour, `cen` and `count` the colours' means (of the samples) and sizes (of all pixels).
-/// Cost: at most 8 passes over the samples (the nearest colours vectorized), then one over
-/// the m pixels; 28 KB of stack, no allocation.
-void texture_colours(const float* const* f, int m, const float (&two)[2][6], std::uint8_t* cluster,
-                     float (&cen)[kTextureColours][6], int (&count)[kTextureColours]) {
-    constexpr int K = kTextureColours, kMaxSamples = kSamplesPerColour * kTextureColours;
+/// k-means (eq. 4 squared, on the 2-means features `f` of the m pixels) with K centres
+/// (kTextureColours, or kMoreTextureColours), seeded at the two 2-means parts' means `two`
+/// and then, one by one, at the colour farthest from the centres so far; learnt from every
+/// stride-th pixel (at most kSamplesPerColour x kTextureColours, copied together).
+/// cluster[i] gets pixel i's colour, `cen` and `count` the colours' means (of the samples)
+/// and sizes (of all pixels). Cost: at most 8 passes over the samples (the nearest colours
+/// vectorized), then one over the m pixels; about 35 KB of stack, no allocation. Inlined into
+/// the two texture_colours below (target_clones takes no template).
+template <int K>
+[[gnu::always_inline]] inline void texture_colours_of(const float* const* f, int m, const float (&two)[2][6],
+                                                      std::uint8_t* cluster, float (&cen)[K][6], int (&count)[K]) {
+    constexpr int kMaxSamples = kSamplesPerColour * kTextureColours;
     const int stride = (m + kMaxSamples - 1) / kMaxSamples;
     float samples[6][kMaxSamples];
-    std::uint8_t nearest[kMaxSamples];
+    std::uint8_t nearest[kMaxSamples], before[kMaxSamples];
     int n = 0;
     for (int i = 0; i < m; i += stride, ++n)
         for (int q = 0; q < 6; ++q) samples[q][n] = f[q][i];
@@ -495,11 +575,12 @@ void texture_colours(const float* const* f, int m, const float (&two)[2][6], std
     };
     for (int it = 0; it < 8; ++it) {
         set_weights();
-        int changed = 0;
-        for (int j = 0; j < n; ++j) {
-            const std::uint8_t k = nearest_colour(s, j, w, bias);
-            changed += it == 0 || nearest[j] != k;
-            nearest[j] = k;
+        if (it > 0) std::copy(nearest, nearest + n, before);
+        nearest_colours(s, n, w, bias, nearest);
+        int changed = n;  // every sample on the first pass
+        if (it > 0) {
+            changed = 0;
+            for (int j = 0; j < n; ++j) changed += nearest[j] != before[j];
         }
         float sum[K][6] = {};
         int n_k[K] = {};
@@ -514,25 +595,33 @@ void texture_colours(const float* const* f, int m, const float (&two)[2][6], std
         if (changed == 0) break;
     }
     set_weights();
-    // Local copies of the plane pointers: a byte store may alias anything, and the loop
-    // would load them again for every pixel instead of vectorizing.
-    const float* const planes[6] = {f[0], f[1], f[2], f[3], f[4], f[5]};
-    for (int i = 0; i < m; ++i) cluster[i] = nearest_colour(planes, i, w, bias);
+    nearest_colours(f, m, w, bias, cluster);
     for (int k = 0; k < K; ++k) count[k] = 0;
     for (int i = 0; i < m; ++i) ++count[cluster[i]];
+}
+
+/// texture_colours_of at kTextureColours and at kMoreTextureColours, each built for AVX2 and
+/// baseline x86-64.
+WUL3D_AVX2_CLONES void texture_colours(const float* const* f, int m, const float (&two)[2][6], std::uint8_t* cluster,
+                                       float (&cen)[kTextureColours][6], int (&count)[kTextureColours]) {
+    texture_colours_of(f, m, two, cluster, cen, count);
+}
+WUL3D_AVX2_CLONES void texture_colours(const float* const* f, int m, const float (&two)[2][6], std::uint8_t* cluster,
+                                       float (&cen)[kMoreTextureColours][6], int (&count)[kMoreTextureColours]) {
+    texture_colours_of(f, m, two, cluster, cen, count);
 }
 
 /// The materials of segment l's colours (ws.part at its pixels px[0, m), sizes `count`):
 /// per pair of colours their contact, the 4-neighbour pairs between them, over the square
 /// root of the smaller's size. Above colour.max_compact (longer than the outline of any
-/// compact piece) they interleave: one material; else they lie apart. True, with `material`
-/// (0 or 1 per colour), when the colours make two materials or more: two are the split; of
-/// more (a pile of objects in one segment) the one that touches the others least for its
-/// size, the likeliest to be an object of its own, is part 0 and the rest part 1, which the
-/// next round may split again. Cost: one pass over the segment's pixels.
-bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m,
-                       const int (&count)[kTextureColours], std::uint8_t (&material)[kTextureColours]) {
-    constexpr int K = kTextureColours;
+/// compact piece) they interleave: one material; else they lie apart. Returns the number of
+/// materials; where two or more, `material` (0 or 1 per colour): two are the split; of more
+/// (a pile of objects in one segment) the one that touches the others least for its size,
+/// the likeliest to be an object of its own, is part 0 and the rest part 1, which the next
+/// round may split again. Cost: one pass over the segment's pixels.
+template <int K>
+int texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int* px, int m, const int (&count)[K],
+                      std::uint8_t (&material)[K]) {
     const SegmentParams& prm = x.prm;
     const std::uint8_t* const part = ws.part.data();
     int contact[K][K] = {};  // symmetric
@@ -553,7 +642,7 @@ bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int*
     };
     // A colour too small for an object (mixed pixels along an edge, a sticker) is part of
     // the material it touches most; so is one that no pixel took (a segment of fewer clean
-    // colours than kTextureColours).
+    // colours than K).
     auto tiny = [&](int k) { return count[k] < prm.min_points; };
     for (int k = 0; k < K; ++k) {
         if (!tiny(k)) continue;
@@ -568,7 +657,7 @@ bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int*
             const double unit = std::sqrt(static_cast<double>(std::min(count[a], count[b])));
             if (contact[a][b] > prm.colour.max_compact * unit) join(a, b);
         }
-    if (materials < 2) return false;
+    if (materials < 2) return materials;
     int apart = find(0);
     if (materials > 2) {
         int size[K] = {};      // per material (at its root): pixels
@@ -585,22 +674,31 @@ bool texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int*
         }
     }
     for (int k = 0; k < K; ++k) material[k] = find(k) == apart ? 0 : 1;
-    return true;
+    return materials;
 }
 
-/// Segment l's split into two materials, when 2-means followed a texture: texture_colours,
-/// texture_materials, then ws.part, side, `count` and `cen` say the materials (cen: their
-/// means). False, and ws.part not a split, when the colours are not two materials. Cost:
-/// texture_colours' passes and two more over the segment's pixels.
-bool split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, const float* const* f, int m,
-                        std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
-    float colour[kTextureColours][6];
-    int colour_count[kTextureColours];
+/// What split_by_materials found.
+enum class Materials {
+    kSplit,  ///< two materials, each large enough: ws.part, side, count and cen say them
+    kOne,    ///< the colours make one material
+    kSmall,  ///< two or more, one of them too small to be tried again
+};
+
+/// Segment l's split into two materials of K colours, when 2-means (parts in `side`, means
+/// in `cen`) followed a texture: texture_colours, texture_materials, then ws.part, side,
+/// `count` and `cen` say the materials (cen: their means) where it returns kSplit; else
+/// ws.part and side are not a split, and `cen` is as it came. Cost: texture_colours' passes
+/// and two more over the segment's pixels.
+template <int K>
+Materials split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, const float* const* f, int m,
+                             std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+    float colour[K][6];
+    int colour_count[K];
     texture_colours(f, m, cen, side, colour, colour_count);
     std::uint8_t* const part = ws.part.data();
     for (int i = 0; i < m; ++i) part[px[i]] = side[i];
-    std::uint8_t material[kTextureColours];
-    if (!texture_materials(x, ws, l, px, m, colour_count, material)) return false;
+    std::uint8_t material[K];
+    if (texture_materials(x, ws, l, px, m, colour_count, material) < 2) return Materials::kOne;
     double sum[2][6] = {};
     count[0] = count[1] = 0;
     for (int i = 0; i < m; ++i) {
@@ -614,21 +712,23 @@ bool split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, 
     // grouping colours is weaker evidence than 2-means' own parts, and a print's block of
     // min_points split off a box seen in two pieces on osd_mosd's learn18 (docs/ABLATION.md,
     // "Textures").
-    if (std::min(count[0], count[1]) < 2 * x.prm.min_points) return false;
+    if (std::min(count[0], count[1]) < 2 * x.prm.min_points) return Materials::kSmall;
     for (int j = 0; j < 2; ++j)
         for (int q = 0; q < 6; ++q) cen[j][q] = static_cast<float>(sum[j][q] / count[j]);
-    return true;
+    return Materials::kSplit;
 }
 
 /// How a segment was split by the colour cue (ws.split).
 enum Split : std::uint8_t { kNotSplit = 0, kSplitByColour = 1, kSplitByMaterial = 2 };
 
 /// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
-/// "Colour cue"); where 2-means followed a texture, the segment's materials
-/// (split_by_materials) and the same tests. Writes ws.part at the segment's pixels once
-/// 2-means ran. Cost: O(segment pixels) per 2-means iteration and for the boundary, the
-/// materials' passes when 2-means followed a texture; no allocation (called in parallel, one
-/// segment per call).
+/// "Colour cue"); where 2-means followed a texture, the segment's materials of
+/// kTextureColours (split_by_materials) and the same tests, or, where those colours make one
+/// material, of kMoreTextureColours and the same tests with more_colours_like_objects.
+/// Writes ws.part at the segment's pixels once 2-means ran. Cost: O(segment pixels) per
+/// 2-means iteration and for the boundary, the materials' passes when 2-means followed a
+/// texture (twice where four colours make one material); no allocation (called in parallel,
+/// one segment per call).
 Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
                        const ClusterParams& cp, float cos_crease, SegmentBuffers& ws, int l) {
     const SegmentParams& prm = x.prm;
@@ -648,9 +748,13 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
     const Verdict verdict = judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen);
     if (verdict == Verdict::kKept) return kSplitByColour;
     // kTexture: both parts passed the share test, so both hold pixels.
-    if (verdict != Verdict::kTexture || !prm.colour.textures || !split_by_materials(x, ws, l, px, f, m, side, cen, count))
-        return kNotSplit;
-    return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen) == Verdict::kKept
+    if (verdict != Verdict::kTexture || !prm.colour.textures) return kNotSplit;
+    Materials found = split_by_materials<kTextureColours>(x, ws, l, px, f, m, side, cen, count);
+    // Two materials of 2 x min_points each (split_by_materials) need 4 x min_points.
+    const bool more_colours = found == Materials::kOne && m >= 4 * prm.min_points;
+    if (more_colours) found = split_by_materials<kMoreTextureColours>(x, ws, l, px, f, m, side, cen, count);
+    if (found != Materials::kSplit) return kNotSplit;
+    return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen, more_colours) == Verdict::kKept
                ? kSplitByMaterial
                : kNotSplit;
 }

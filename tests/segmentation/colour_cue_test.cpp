@@ -213,15 +213,42 @@ TEST(SegmentObjects, FlushBoxesWithASticker_SplitAlongTheMainColours) {
 }
 
 namespace {
-/// Paints truth object `id`'s pixels with stripes of two colours, `period_m` wide, fixed on
-/// its surfaces (the stripes follow x + y + z of the points, as the generator's do).
-void paint_stripes(PlaneStage& in, int id, const std::uint8_t (&a)[3], const std::uint8_t (&b)[3], float period_m) {
+/// Paints truth object `id`'s pixels p where `where(p)` holds with stripes of the N colours
+/// in turn, `period_m` wide, fixed on its surfaces (the stripes follow x + y + z of the
+/// points, as the generator's do).
+template <std::size_t N, class Where>
+void paint_bands(PlaneStage& in, int id, const std::uint8_t (&colours)[N][3], float period_m, Where&& where) {
+    const auto n = static_cast<long>(N);
     for (std::size_t p = 0; p < in.truth.size(); ++p) {
-        if (in.truth[p] != id) continue;
-        const float t = (in.cloud.x[p] + in.cloud.y[p] + in.cloud.z[p]) / period_m;
-        const auto& c = static_cast<long>(std::floor(t)) % 2 == 0 ? a : b;
+        if (in.truth[p] != id || !where(p)) continue;
+        const long stripe = static_cast<long>(std::floor((in.cloud.x[p] + in.cloud.y[p] + in.cloud.z[p]) / period_m));
+        const auto& c = colours[(stripe % n + n) % n];
         in.cloud.r[p] = c[0], in.cloud.g[p] = c[1], in.cloud.b[p] = c[2];
     }
+}
+
+/// paint_bands with two colours over the whole object.
+void paint_stripes(PlaneStage& in, int id, const std::uint8_t (&a)[3], const std::uint8_t (&b)[3], float period_m) {
+    const std::uint8_t two[2][3] = {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}};
+    paint_bands(in, id, two, period_m, [](std::size_t) { return true; });
+}
+
+/// Three flush boxes in a row, 15 cm each, a metre away (the third's colour `third`).
+PlaneStage three_flush_boxes(const std::uint8_t (&third)[3] = {200, 30, 30}) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    s.boxes = {SceneBox{.x = -0.15f, .z = 1.0f}, SceneBox{.x = 0.0f, .z = 1.0f},
+               SceneBox{.x = 0.15f, .z = 1.0f, .r = third[0], .g = third[1], .b = third[2]}};
+    return up_to_the_plane(s);
+}
+
+/// Each two of three_flush_boxes' boxes in objects of their own (expect_separate, 0.9 of
+/// each); `why`: what failed for the first and second, the second and third, the first and
+/// third.
+void expect_three_apart(const LabelImage& out, const std::vector<int>& truth, const char* const (&why)[3]) {
+    expect_separate(out, truth, kTruthBox0, kTruthBox0 + 1, 0.9, why[0]);
+    expect_separate(out, truth, kTruthBox0 + 1, kTruthBox0 + 2, 0.9, why[1]);
+    expect_separate(out, truth, kTruthBox0, kTruthBox0 + 2, 0.9, why[2]);
 }
 
 /// Two flush boxes, the left plain red, the right striped (blue and yellow, 2 cm).
@@ -261,17 +288,13 @@ TEST(SegmentObjects, PlainBoxFlushBesideAStripedBox_SplitByMaterial) {
 // colours make three materials (the stripes' two interleave). The one that touches the
 // others least for its size is split off, then the rest in the second round: three objects.
 TEST(SegmentObjects, ThreeFlushBoxesOneStriped_EachItsOwnMaterial) {
-    Scene s = pitched_tabletop_scene();
-    s.noise_seed = 13;
-    s.boxes = {SceneBox{.x = -0.15f, .z = 1.0f}, SceneBox{.x = 0.0f, .z = 1.0f},
-               SceneBox{.x = 0.15f, .z = 1.0f, .r = 40, .g = 170, .b = 60}};
-    PlaneStage in = up_to_the_plane(s);
+    PlaneStage in = three_flush_boxes({40, 170, 60});
     paint_stripes(in, kTruthBox0 + 1, {40, 60, 210}, {220, 200, 40}, 0.02f);
     SegmentStats stats;
     const LabelImage out = segment(in, SegmentParams{}, &stats);
-    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 1, 0.9, "the red box stayed with the striped one");
-    expect_separate(out, in.truth, kTruthBox0 + 1, kTruthBox0 + 2, 0.9, "the green box stayed with the striped one");
-    expect_separate(out, in.truth, kTruthBox0, kTruthBox0 + 2, 0.9, "the red and green boxes stayed one");
+    expect_three_apart(out, in.truth,
+                       {"the red box stayed with the striped one", "the green box stayed with the striped one",
+                        "the red and green boxes stayed one"});
     EXPECT_GE(stats.colour.texture_splits, 1);
 }
 
@@ -283,6 +306,47 @@ TEST(SegmentObjects, StripedBox_StaysOneObject) {
     s.boxes = {SceneBox{.z = 1.0f, .w = 0.25f}};
     PlaneStage in = up_to_the_plane(s);
     paint_stripes(in, kTruthBox0, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0), 0.95);
+    EXPECT_EQ(stats.colour.splits, 0);
+    EXPECT_EQ(stats.segments, 1);
+}
+
+// Three flush boxes, each striped in its own two colours (2 cm): six colours, and the four
+// of the texture clustering each span two boxes, so every pair interleaves and the four make
+// one material. Eight colours tell the three textures apart: three materials, and each box
+// its own object after the second round.
+TEST(SegmentObjects, ThreeFlushStripedBoxes_PartedByEightColours) {
+    PlaneStage in = three_flush_boxes();
+    paint_stripes(in, kTruthBox0, {200, 30, 30}, {240, 240, 240}, 0.02f);
+    paint_stripes(in, kTruthBox0 + 1, {40, 60, 210}, {220, 200, 40}, 0.02f);
+    paint_stripes(in, kTruthBox0 + 2, {40, 170, 60}, {150, 40, 160}, 0.02f);
+    SegmentStats stats;
+    const LabelImage out = segment(in, SegmentParams{}, &stats);
+    expect_three_apart(out, in.truth,
+                       {"the first two striped boxes stayed one", "the last two striped boxes stayed one",
+                        "the outer striped boxes stayed one"});
+    EXPECT_GE(stats.colour.texture_splits, 2);
+}
+
+// One box printed in three colours on its top and three others on its sides (2 cm stripes):
+// the four colours make one material, eight make two, the top and the sides. Their boundary
+// runs along the box's edge, a convex fold, where two objects of a pile meet across a
+// concave one: the split between them is refused, and the box stays one.
+TEST(SegmentObjects, BoxPrintedOtherwiseOnTopAndSides_StaysOneAcrossItsEdge) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 13;
+    const SceneBox box{.z = 1.0f, .w = 0.25f};
+    s.boxes = {box};
+    PlaneStage in = up_to_the_plane(s);
+    const std::uint8_t top[3][3] = {{200, 30, 30}, {240, 240, 240}, {30, 30, 30}};
+    const std::uint8_t sides[3][3] = {{40, 60, 210}, {220, 200, 40}, {40, 170, 60}};
+    const auto on_top = [&](std::size_t p) {
+        return in.plane.support.height(in.cloud.x[p], in.cloud.y[p], in.cloud.z[p]) > box.h - 0.01f;
+    };
+    paint_bands(in, kTruthBox0, top, 0.02f, on_top);
+    paint_bands(in, kTruthBox0, sides, 0.02f, [&](std::size_t p) { return !on_top(p); });
     SegmentStats stats;
     const LabelImage out = segment(in, SegmentParams{}, &stats);
     EXPECT_GT(dominant_share(out.labels, in.truth, kTruthBox0), 0.95);
