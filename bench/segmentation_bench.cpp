@@ -15,12 +15,13 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     SegmentWorkspace ws;
     LabelImage out;
     const Plane* support = pf.result.plane.found ? &pf.result.plane.support : nullptr;
+    const Plane* low_support = support && pf.result.plane.low_found ? &pf.result.plane.low_support : nullptr;
     SegmentStats stats = segment_objects(params, pf.pipeline.cloud(), pf.pipeline.normals(),
-                                         classes, support, clusters, ws, out);
+                                         classes, support, low_support, clusters, ws, out);
     SegmentStats::Phases sum;
     for (auto _ : state) {
         stats = segment_objects(params, pf.pipeline.cloud(), pf.pipeline.normals(), classes,
-                                support, clusters, ws, out);
+                                support, low_support, clusters, ws, out);
         benchmark::DoNotOptimize(out.labels.data());
         sum.smoothing += stats.ms.smoothing;
         sum.cuts += stats.ms.cuts;

@@ -184,13 +184,15 @@ inline void chromaticity(const OrganizedCloud& c, std::size_t p, float (&out)[3]
 constexpr float kUprightDeg = 25.0f;
 
 /// What every phase reads: the parameters, the frame and the normals of the crease tests
-/// (smoothed when cuts.normal_smooth_px > 0), the plane's classes per pixel.
+/// (smoothed when cuts.normal_smooth_px > 0), the plane's classes per pixel, and the top of
+/// a board or tray lying on the support (nullptr: none).
 struct Ctx {
     const SegmentParams& prm;
     const OrganizedCloud& c;
     const NormalMap& n;
     const std::vector<std::uint8_t>& cls;
     int W, H;
+    const Plane* low_support = nullptr;
 
     /// sensor_depth_step with this frame's parameters.
     float depth_step(float z) const { return sensor_depth_step(prm.depth_jump_m, prm.depth_jump_rel, z); }

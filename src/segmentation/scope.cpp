@@ -120,6 +120,12 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
 
 using ScopeCounts = SegmentBuffers::ScopeCounts;
 
+/// A removed point no higher over a low support than this many depth steps at its depth
+/// (Ctx::depth_step) lies on it. The plane stage removes the low support's band, widened up
+/// to 1.5 times with the frame's noise, about one depth step; twice takes in its noise. The
+/// generated floor tune seeds score alike from 1 to 100 steps (docs/ABLATION.md, "Scope").
+constexpr float kLowSupportSteps = 2.0f;
+
 /// measure_scope's counts of the segments' pixels in rows [v0, v1) into cnt[0, n], the
 /// touching pairs into `edges` (not unique), and with `sums` (one strip: the whole frame)
 /// the sums of the points into sums[0][l], sums[1][l], sums[2][l]. Writes nothing else:
@@ -131,10 +137,15 @@ void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     auto height = [&](std::size_t p) { return pl.height(x.c.x[p], x.c.y[p], x.c.z[p]); };
     // A removed point clearly above the support (by more than the depth noise at its depth)
     // was removed for lying off the support's hull: the segment that runs on into it, with
-    // continuous depth, continues beyond the support's volume.
+    // continuous depth, continues beyond the support's volume. Unless it lies on a low
+    // support (kLowSupportSteps): a board's top, or the band of it that its removal took off
+    // an object standing on it, is inside the volume.
     auto beyond = [&](std::size_t q, std::size_t p) {
         if (!x.c.valid[q] || x.cls[q] != kPlaneRemoved || !x.connected(p, q)) return false;
         const float z = x.c.z[q];
+        if (x.low_support &&
+            x.low_support->height(x.c.x[q], x.c.y[q], z) <= kLowSupportSteps * x.depth_step(z))
+            return false;
         return height(q) > x.depth_step(z);
     };
     // Outline pairs: touching segment pairs, and the pairs that lead out of the volume.

@@ -41,7 +41,7 @@ SegmentWorkspace::Buffers& SegmentWorkspace::buffers() {
 /// a file in src/segmentation/ and a line here.
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
-                             const Plane* support, const LabelImage& clusters,
+                             const Plane* support, const Plane* low_support, const LabelImage& clusters,
                              SegmentWorkspace& workspace, LabelImage& out) {
     using namespace detail;
     SegmentBuffers& ws = workspace.buffers();
@@ -49,7 +49,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     SegmentStats stats;
     SegmentStats::Phases& ms = stats.ms;
     Lap lap;
-    const Ctx x{params, cloud, crease_normals(params, normals, classes, W, H, ws), classes, W, H};
+    const Ctx x{params, cloud, crease_normals(params, normals, classes, W, H, ws), classes, W, H, low_support};
     ms.smoothing = lap();
     find_seeds(x, normals.valid.data(), clusters, ws);
     ms.cuts = lap();

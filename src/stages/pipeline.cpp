@@ -337,7 +337,8 @@ void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
     SegmentParams segmentation = params.segmentation;
     segmentation.cuts.crease_step_px = crease_step_for(params.segmentation.cuts, r.normal_radius_px);
     r.segment_stats = segment_objects(segmentation, cloud_, normals_, r.plane_classes,
-                                      r.plane.found ? &r.plane.support : nullptr, r.labels,
+                                      r.plane.found ? &r.plane.support : nullptr,
+                                      r.plane.found && r.plane.low_found ? &r.plane.low_support : nullptr, r.labels,
                                       segment_ws_, r.segments);
     r.times.segmentation = ms_since(t);
 }

@@ -182,7 +182,7 @@ Segmented segment_at(const SegmentParams& params, const OrganizedCloud& cloud, c
                      const std::vector<std::uint8_t>& classes, const Plane* support, const LabelImage& clusters,
                      SegmentWorkspace& ws) {
     LabelImage out;
-    const SegmentStats s = segment_objects(params, cloud, normals, classes, support, clusters, ws, out);
+    const SegmentStats s = segment_objects(params, cloud, normals, classes, support, nullptr, clusters, ws, out);
     Segmented r;
     r.labels = out.labels;
     r.stats = {s.segments,    s.colour.splits, s.colour.texture_splits, s.stacks.splits, s.pieces.splits,

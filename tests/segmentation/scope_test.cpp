@@ -240,3 +240,32 @@ TEST(SegmentObjects, Scope_BoardHoldingObjectsIsASupportNotAnObject) {
         EXPECT_NE(id, 0) << "box " << i << " (3: the book) is no object";
     }
 }
+
+// The board of board_on_table_scene 4 cm thick, 1.1 m away, where the depth step that joins
+// one surface is 19 mm: the plane stage removes the board's top as a low support, and its
+// removed points lie more than a depth step over the table. The boxes standing on it run on
+// into those points along their feet; they lie on the low support, inside the support's
+// volume, and the boxes stay objects. Without the low support passed to the segmentation the
+// same points lead out of the volume, as a table's hull does, and the boxes go.
+TEST(SegmentObjects, Scope_BoxesOnAThickBoard_TheBoardIsInsideTheVolume) {
+    Scene s = board_on_table_scene(0.6f, 0.45f);
+    s.boxes[0].h = 0.04f;
+    s.boxes[1].lift = s.boxes[2].lift = s.boxes[0].h;
+    const PlaneStage st = up_to_the_plane(s);
+    ASSERT_TRUE(st.plane.low_found) << "the board should be a low support (test premise)";
+    auto boxes_kept = [&](const Plane* low_support) {
+        SegmentWorkspace ws;
+        LabelImage out;
+        segment_objects(SegmentParams{}, st.cloud, st.normals, st.classes, &st.plane.support, low_support,
+                        LabelImage{}, ws, out);
+        int kept = 0;
+        for (const int box : {kTruthBox0 + 1, kTruthBox0 + 2}) {
+            int id = 0;
+            const double share = dominant_share(out.labels, st.truth, box, &id);
+            kept += id != 0 && share > 0.9;
+        }
+        return kept;
+    };
+    ASSERT_EQ(boxes_kept(nullptr), 0) << "without the low support the boxes should leave the volume (test premise)";
+    EXPECT_EQ(boxes_kept(&st.plane.low_support), 2);
+}

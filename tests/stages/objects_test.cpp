@@ -130,6 +130,7 @@ ObjectRun run_moving_sequence(float psi, int frames) {
             remove_support_plane(PlaneParams{}, f.intrinsics, cloud, normals, active, pws, classes);
         const SegmentStats st = segment_objects(SegmentParams{}, cloud, normals, classes,
                                                 plane.found ? &plane.support : nullptr,
+                                                plane.found && plane.low_found ? &plane.low_support : nullptr,
                                                 LabelImage{}, sws, segments);
         tracker.step(cloud, segments, st.segments, LabelImage{}, objects, list);
         // Every listed object is in the label image with its pixel count.

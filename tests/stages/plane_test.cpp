@@ -616,7 +616,7 @@ TEST(RemoveSupportPlane, EnclosedPatchAboveThePlane_IsAContainersInside) {
             EXPECT_GT(static_cast<double>(inside) / static_cast<double>(patch_size), 0.9);
             SegmentWorkspace sws;
             LabelImage segments;
-            segment_objects(SegmentParams{}, f.cloud, f.normals, classes, nullptr, LabelImage{}, sws,
+            segment_objects(SegmentParams{}, f.cloud, f.normals, classes, nullptr, nullptr, LabelImage{}, sws,
                             segments);
             int box_label = 0;
             EXPECT_GT(dominant_share(segments.labels, truth, kTruthBox0, &box_label), 0.95);
