@@ -275,8 +275,10 @@ struct SegmentStats {
 /// `classes` and `support` come from remove_support_plane (PlaneClass: 0 removed, 1 object,
 /// 2 foot, 3 inside; `support` nullptr when no plane was found or removed: no container
 /// joins), and so does `low_support`, the top of a board or tray lying on the support whose
-/// points it removed (PlaneResult::low_support; nullptr when none). `clusters` are the ClusterState labels of the same frame (used by kmeans; may be
-/// empty for geometric and hybrid). `out` gets 0 = background, 1..n = segment.
+/// points it removed (PlaneResult::low_support; nullptr when none), which the scope counts
+/// inside the support's volume. `clusters` are the ClusterState labels of the same
+/// frame (used by kmeans; may be empty for geometric and hybrid). `out` gets 0 =
+/// background, 1..n = segment.
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
                              const Plane* support, const Plane* low_support, const LabelImage& clusters,

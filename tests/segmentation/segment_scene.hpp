@@ -54,7 +54,8 @@ inline LabelImage segment(const PlaneStage& in, const SegmentParams& params, Seg
     LabelImage out;
     const SegmentStats st = segment_objects(params, in.cloud, in.normals, in.classes,
                                             &in.plane.support,
-                                            in.plane.low_found ? &in.plane.low_support : nullptr, LabelImage{}, ws, out);
+                                            in.plane.low_found ? &in.plane.low_support : nullptr, LabelImage{}, ws,
+                                            out);
     if (stats) *stats = st;
     return out;
 }
