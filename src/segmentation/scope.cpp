@@ -121,10 +121,13 @@ float support_middle_depth(const Ctx& x, const Plane& pl) {
 using ScopeCounts = SegmentBuffers::ScopeCounts;
 
 /// A removed point no higher over a low support than this many depth steps at its depth
-/// (Ctx::depth_step) lies on it. The plane stage removes the low support's band, widened up
-/// to 1.5 times with the frame's noise, about one depth step; twice takes in its noise. The
-/// generated floor tune seeds score alike from 1 to 100 steps (docs/ABLATION.md, "Scope").
-constexpr float kLowSupportSteps = 2.0f;
+/// (Ctx::depth_step) lies on it. The plane stage removes the low support's band (about a
+/// depth step, widened up to 1.5 times with the frame's noise), and with it the strip of
+/// what stands on the board within that band, whose noisy points reach higher: a box's
+/// strip on a floor tune frame lay 30-33 mm over the board's top, two steps there. The
+/// floor tune seeds score alike from 3 to 100 steps, a little lower at 1 and 2
+/// (docs/ABLATION.md, "Scope").
+constexpr float kLowSupportSteps = 3.0f;
 
 /// measure_scope's counts of the segments' pixels in rows [v0, v1) into cnt[0, n], the
 /// touching pairs into `edges` (not unique), and with `sums` (one strip: the whole frame)
