@@ -534,7 +534,21 @@ void check_records(const std::string& path) {
         std::string compression;            // a chunk's
         std::vector<std::uint64_t> points_to;  // index_pos, chunk_pos
     };
-    std::vector<char> header;
+    std::vector<char> header, connection;
+    // The fields must tile a header exactly, each "name=value": cpp_common's
+    // ros::Header::parse reads past a header whose fields do not (fuzz_bag found it, in a
+    // record's header and in a connection's). visit(field) sees each.
+    const auto check_fields = [&](std::uint64_t pos, const std::vector<char>& h, auto&& visit) {
+        for (std::size_t f = 0; f < h.size();) {
+            const std::uint32_t n = h.size() - f >= 4 ? le32(h.data() + f) : 0;
+            if (h.size() - f < 4 || n > h.size() - f - 4)
+                throw damaged(pos, "has a header field running past its header");
+            const std::string field(h.data() + f + 4, n);
+            if (field.find('=') == std::string::npos) throw damaged(pos, "has a header field with no '='");
+            visit(field);
+            f += 4 + std::size_t(n);
+        }
+    };
     const auto read_record = [&](std::uint64_t pos, std::uint64_t end) {
         Record r;
         char len[4];
@@ -550,15 +564,7 @@ void check_records(const std::string& path) {
         r.data_len = le32(len);
         if (end - pos - 8 - r.header_len < r.data_len)
             throw damaged(pos, "declares " + std::to_string(r.data_len) + " bytes of data");
-        // The fields must tile the header exactly, each "name=value": cpp_common's
-        // ros::Header::parse reads past a header whose fields do not (fuzz_bag found it).
-        for (std::size_t f = 0; f < header.size();) {
-            const std::uint32_t n = header.size() - f >= 4 ? le32(header.data() + f) : 0;
-            if (header.size() - f < 4 || n > header.size() - f - 4)
-                throw damaged(pos, "has a header field running past its header");
-            const std::string field(header.data() + f + 4, n);
-            if (field.find('=') == std::string::npos)
-                throw damaged(pos, "has a header field with no '='");
+        check_fields(pos, header, [&](const std::string& field) {
             if (field.size() == 4 && field.compare(0, 3, "op=") == 0) r.op = field[3];
             if (field.size() == 9 && field.compare(0, 5, "size=") == 0) r.size = le32(field.data() + 5);
             if (field.compare(0, 12, "compression=") == 0) r.compression = field.substr(12);
@@ -567,7 +573,16 @@ void check_records(const std::string& path) {
                 const std::uint64_t to = le64(field.data() + 10);
                 if (to != 0) r.points_to.push_back(to);  // index_pos 0: an unindexed bag
             }
-            f += 4 + std::size_t(n);
+        });
+        // A connection's data is a header of its own (topic, type, md5sum, definition): its
+        // fields, the data length their header length, parsed by librosbag alike.
+        if (r.op == 0x07) {
+            if (r.data_len > kMaxRecordHeaderBytes)
+                throw damaged(pos, "is a connection of " + std::to_string(r.data_len) + " bytes");
+            connection.resize(r.data_len);
+            in.read(connection.data(), r.data_len);
+            if (!in) throw damaged(pos, "is cut short");
+            check_fields(pos, connection, [](const std::string&) {});
         }
         return r;
     };

@@ -306,7 +306,8 @@ TEST(BagCli, BadBags_OneLineAndExit2) {
 TEST(BagCli, FuzzFindings_OneLineAndExit2) {
     // fuzz_bag's findings (docs/FUZZING.md): librosbag allocated 2 GB, or read past a buffer.
     for (const char* name : {"bag-record-header-of-538-mb.bag", "bag-index-into-a-record.bag",
-                             "bag-message-past-its-chunk.bag", "bag-header-field-past-its-header.bag"}) {
+                             "bag-message-past-its-chunk.bag", "bag-header-field-past-its-header.bag",
+                             "bag-connection-field-past-its-header.bag"}) {
         expect_refused({(fs::path(WUL3D_TEST_DATA_DIR) / "fuzz" / name).string()},
                        "cannot read the bag");
     }
