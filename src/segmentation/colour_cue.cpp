@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 
@@ -30,8 +31,8 @@ void sort_pixels_by_segment(const Ctx& x, SegmentBuffers& ws, int n) {
     for (int band = 0; band < kSortBands; ++band) {
         int* const count = ws.remap.data() + static_cast<std::size_t>(band) * L;
         const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
-        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p)
-            ++count[static_cast<std::size_t>(ws.label[p])];
+        for_label_runs(ws.label.data(), static_cast<std::size_t>(H * band / kSortBands) * W, p1,
+                       [&](int l, std::size_t, std::size_t run) { count[l] += static_cast<int>(run); });
     }
     ws.offsets.assign(L + 1, 0);  // segment l's pixels: order[offsets[l], offsets[l + 1])
     int position = 0;
@@ -50,10 +51,13 @@ void sort_pixels_by_segment(const Ctx& x, SegmentBuffers& ws, int n) {
     for (int band = 0; band < kSortBands; ++band) {
         int* const next = ws.remap.data() + static_cast<std::size_t>(band) * L;
         const std::size_t p1 = static_cast<std::size_t>(H * (band + 1) / kSortBands) * W;
-        for (std::size_t p = static_cast<std::size_t>(H * band / kSortBands) * W; p < p1; ++p) {
-            const int l = ws.label[p];
-            if (l) ws.order[static_cast<std::size_t>(next[l]++)] = static_cast<int>(p);
-        }
+        for_label_runs(ws.label.data(), static_cast<std::size_t>(H * band / kSortBands) * W, p1,
+                       [&](int l, std::size_t p, std::size_t run) {
+                           if (l == 0) return;
+                           int* const out = ws.order.data() + next[l];
+                           for (std::size_t i = 0; i < run; ++i) out[i] = static_cast<int>(p + i);
+                           next[l] += static_cast<int>(run);
+                       });
     }
 }
 
@@ -158,12 +162,12 @@ double principal_axis(const double (&cov)[3][3], double (&e)[3]) {
 /// double, pixel order), which two_means needs too. Cost: three passes over the segment's
 /// planes.
 bool seed_centres(const float* const* f, int m, float min_spread, float (&cen)[2][6], double (&total)[6]) {
+    // The six sums side by side, each in pixel order: one sum alone waits for each addition.
+    double sum[6] = {};
+    for (int i = 0; i < m; ++i)
+        for (int q = 0; q < 6; ++q) sum[q] += f[q][i];
     double mean[6];
-    for (int q = 0; q < 6; ++q) {
-        total[q] = 0;
-        for (int i = 0; i < m; ++i) total[q] += f[q][i];
-        mean[q] = total[q] / m;
-    }
+    for (int q = 0; q < 6; ++q) total[q] = sum[q], mean[q] = total[q] / m;
     const float *const cr = f[3], *const cg = f[4], *const cb = f[5];
     // The parts' mean colours lie among the segment's colours, so they are at most the
     // segment's colour diameter apart, at most twice the farthest colour from the mean:
@@ -488,6 +492,11 @@ constexpr int kMoreTextureColours = 8;
 /// tune seeds at twice the cost, 512 cost `osd_mosd` 0.2 Overlap F.
 constexpr int kSamplesPerColour = 256;
 
+/// Vectors of eight lanes (GCC's and Clang's vector extension), each lane the scalar
+/// operation: one AVX2 operation, or two of SSE2.
+using Float8 = float __attribute__((vector_size(32)));
+using Int8 = std::int32_t __attribute__((vector_size(32)));
+
 /// Each pixel's nearest centre (eq. 4 squared) for pixels [0, n) of the planes `f`, into
 /// out[0, n): |f - c_k|^2 less |f|^2, i.e. |c_k|^2 - 2 f . c_k, from `w` = 2 c_k and `bias`
 /// = |c_k|^2; the first of equals. A block of pixels at a time, the centres in the outer loop
@@ -501,8 +510,7 @@ template <int K>
     const float *const f0 = f[0], *const f1 = f[1], *const f2 = f[2], *const f3 = f[3], *const f4 = f[4],
                       *const f5 = f[5];
     constexpr int kBlock = 128;
-    float dist[K][kBlock], best[kBlock];
-    int nearest[kBlock];
+    float dist[K][kBlock];
     for (int i0 = 0; i0 < n; i0 += kBlock) {
         const int b = std::min(kBlock, n - i0);
         for (int k = 0; k < K; ++k) {
@@ -521,17 +529,50 @@ template <int K>
                 dk[i] = d;
             }
         }
-        for (int i = 0; i < b; ++i) best[i] = dist[0][i], nearest[i] = 0;
-        for (int k = 1; k < K; ++k) {
-            const float* const dk = dist[k];
-            for (int i = 0; i < b; ++i) {
-                const bool nearer = dk[i] < best[i];
-                best[i] = nearer ? dk[i] : best[i];
-                nearest[i] = nearer ? k : nearest[i];
+        // Eight pixels at a time, the nearest so far in registers: kept in memory between
+        // the centres, it went through masked stores, which no load can take from.
+        int i = 0;
+        for (; i + 8 <= b; i += 8) {
+            Float8 best, d;
+            std::memcpy(&best, dist[0] + i, sizeof best);
+            Int8 nearest = {};
+            for (int k = 1; k < K; ++k) {
+                std::memcpy(&d, dist[k] + i, sizeof d);
+                const Int8 nearer = d < best;  // -1 or 0 per lane
+                best = nearer ? d : best;
+                nearest = nearer ? k : nearest;
             }
+            for (int l = 0; l < 8; ++l) out[i0 + i + l] = static_cast<std::uint8_t>(nearest[l]);
         }
-        for (int i = 0; i < b; ++i) out[i0 + i] = static_cast<std::uint8_t>(nearest[i]);
+        for (; i < b; ++i) {
+            float best = dist[0][i];
+            int nearest = 0;
+            for (int k = 1; k < K; ++k)
+                if (dist[k][i] < best) best = dist[k][i], nearest = k;
+            out[i0 + i] = static_cast<std::uint8_t>(nearest);
+        }
     }
+}
+
+/// The index of the first largest of v[0, n) (std::max_element's), for n >= 1 and no NaN:
+/// the largest by a loop that vectorizes (max is exact in any order), then its first index.
+/// Inlined into texture_colours. Cost: at most two passes over v.
+[[gnu::always_inline]] inline int first_largest(const float* v, int n) {
+    // One running largest per lane, in a vector: as a float reduction the loop would not
+    // vectorize.
+    Float8 lane = v[0] - Float8{};
+    int j = 0;
+    for (; j + 8 <= n; j += 8) {
+        Float8 x;
+        std::memcpy(&x, v + j, sizeof x);
+        lane = x > lane ? x : lane;
+    }
+    float largest = v[0];
+    for (int l = 0; l < 8; ++l) largest = lane[l] > largest ? lane[l] : largest;
+    for (; j < n; ++j) largest = v[j] > largest ? v[j] : largest;
+    j = 0;
+    while (v[j] != largest) ++j;
+    return j;
 }
 
 /// k-means (eq. 4 squared, on the 2-means features `f` of the m pixels) with K centres
@@ -562,7 +603,7 @@ template <int K>
     float nearest_d[kMaxSamples];  // each sample's colour distance to the nearest centre so far
     for (int j = 0; j < n; ++j) nearest_d[j] = std::min(colour_distance(j, cen[0]), colour_distance(j, cen[1]));
     for (int k = 2; k < K; ++k) {
-        const int farthest = static_cast<int>(std::max_element(nearest_d, nearest_d + n) - nearest_d);
+        const int farthest = first_largest(nearest_d, n);
         for (int q = 0; q < 6; ++q) cen[k][q] = s[q][farthest];
         for (int j = 0; j < n; ++j) nearest_d[j] = std::min(nearest_d[j], colour_distance(j, cen[k]));
     }
@@ -596,8 +637,14 @@ template <int K>
     }
     set_weights();
     nearest_colours(f, m, w, bias, cluster);
-    for (int k = 0; k < K; ++k) count[k] = 0;
-    for (int i = 0; i < m; ++i) ++count[cluster[i]];
+    // Four counts per colour, for pixels i mod 4: one count waited for the pixel before
+    // whenever both had the same colour.
+    int counts[4][K] = {};
+    int i = 0;
+    for (; i + 4 <= m; i += 4)
+        for (int l = 0; l < 4; ++l) ++counts[l][cluster[i + l]];
+    for (; i < m; ++i) ++counts[0][cluster[i]];
+    for (int k = 0; k < K; ++k) count[k] = counts[0][k] + counts[1][k] + counts[2][k] + counts[3][k];
 }
 
 /// texture_colours_of at kTextureColours and at kMoreTextureColours, each built for AVX2 and

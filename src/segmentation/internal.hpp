@@ -303,6 +303,21 @@ void relabel_to_roots(SegmentBuffers& ws);
 /// parallel region, or on one thread. What the passes compute does not depend on it.
 int row_strips(int rows);
 
+/// Calls visit(l, p, run) for each run of equal labels label[p, p + run) in [p0, p1), in
+/// order. A pass pixel by pixel that counted into memory made each pixel wait for the one
+/// before, which mostly has the same label. Cost: one pass.
+template <typename Visit>
+void for_label_runs(const int* label, std::size_t p0, std::size_t p1, Visit&& visit) {
+    std::size_t p = p0;
+    while (p < p1) {
+        const int l = label[p];
+        std::size_t q = p + 1;
+        while (q < p1 && label[q] == l) ++q;
+        visit(l, p, q - p);
+        p = q;
+    }
+}
+
 /// Counting sort of the segments' pixels by segment (background left out): segment l's
 /// pixels are ws.order[ws.offsets[l], ws.offsets[l + 1]), in raster order. Per fixed band of
 /// rows in parallel: counts per band, then each band writes from its own start (segment by
