@@ -1,8 +1,9 @@
 #pragma once
 // A circle through 2D points: the rims of containers and the walls of round objects, on the
-// support plane (segmentation/containers.cpp, segmentation/colour_cue.cpp). Header-only: the
-// points come from a visitor, so the callers map pixels to the plane without a copy, and the
-// tests feed plain points.
+// support plane (segmentation/containers.cpp, segmentation/colour_cue.cpp), and circles about
+// one centre, one per layer of a solid of revolution. Header-only: the points come from a
+// visitor, so the callers map pixels to the plane without a copy, and the tests feed plain
+// points.
 #include <Eigen/Dense>
 #include <cmath>
 #include <limits>
@@ -65,6 +66,76 @@ Circle fit_circle(ForPoints&& for_points) {
     }
     if (!(c.radius > 0)) c.radius = std::numeric_limits<double>::quiet_NaN();
     return c;
+}
+
+/// Circles about one centre, one per layer: the walls of a solid of revolution (a bottle's
+/// neck narrower than its body) seen on the plane its axis stands on. kLayers layers at most.
+template <int kLayers>
+struct CoaxialCircles {
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    double radius[kLayers] = {};  ///< per layer, its points' mean distance from the centre
+    int count[kLayers] = {};      ///< per layer, its points
+    bool fitted = false;          ///< false: the points fix no centre (all on one line, or none)
+};
+
+/// The circles about one centre that minimise sum (|p - c| - R_layer)^2. `for_points(visit)`
+/// calls visit(p, layer) with each point and its layer in [0, kLayers), best centred near the
+/// origin. The start is Kasa's with a constant per layer (the points and their squared
+/// lengths taken less their layer's means: two unknowns, one 2 x 2 solve), then
+/// Gauss-Newton steps on the centre, each layer's radius its points' mean distance (so the
+/// steps move the centre along the points' directions less their layer's mean direction).
+/// One layer is fit_circle's circle. Cost: 2 + 2 kCircleSteps passes over the points.
+template <int kLayers, class ForPoints>
+CoaxialCircles<kLayers> fit_coaxial(ForPoints&& for_points) {
+    CoaxialCircles<kLayers> fit;
+    double sum_x[kLayers] = {}, sum_y[kLayers] = {}, sum_sq[kLayers] = {};
+    for_points([&](const Eigen::Vector2d& p, int layer) {
+        ++fit.count[layer];
+        sum_x[layer] += p.x(), sum_y[layer] += p.y(), sum_sq[layer] += p.squaredNorm();
+    });
+    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
+    for_points([&](const Eigen::Vector2d& p, int layer) {
+        const double n = fit.count[layer];
+        const Eigen::Vector2d d(p.x() - sum_x[layer] / n, p.y() - sum_y[layer] / n);
+        A += d * d.transpose();
+        rhs -= d * (p.squaredNorm() - sum_sq[layer] / n);
+    });
+    fit.centre = A.ldlt().solve(rhs) / -2.0;
+    if (!fit.centre.allFinite()) return fit;
+    Eigen::Vector2d mean_dir[kLayers];
+    auto layer_means = [&] {  // each layer's radius and mean direction from the centre
+        for (int l = 0; l < kLayers; ++l) fit.radius[l] = 0, mean_dir[l].setZero();
+        for_points([&](const Eigen::Vector2d& p, int layer) {
+            const Eigen::Vector2d d = p - fit.centre;
+            const double len = d.norm();
+            fit.radius[layer] += len;
+            if (len > 0) mean_dir[layer] += d / len;
+        });
+        for (int l = 0; l < kLayers; ++l)
+            if (fit.count[l] > 0) fit.radius[l] /= fit.count[l], mean_dir[l] /= fit.count[l];
+    };
+    for (int step = 0; step < kCircleSteps; ++step) {
+        layer_means();
+        // Residual r = |p - c| - R_layer(c); its gradient in c is -(u - mean_layer(u)), u the
+        // unit vector from c to p.
+        Eigen::Matrix2d JtJ = Eigen::Matrix2d::Zero();
+        Eigen::Vector2d Jtr = Eigen::Vector2d::Zero();
+        for_points([&](const Eigen::Vector2d& p, int layer) {
+            const Eigen::Vector2d d = p - fit.centre;
+            const double len = d.norm();
+            if (!(len > 0)) return;
+            const Eigen::Vector2d J = mean_dir[layer] - d / len;
+            JtJ += J * J.transpose();
+            Jtr += J * (len - fit.radius[layer]);
+        });
+        const Eigen::Vector2d delta = JtJ.ldlt().solve(-Jtr);
+        if (!delta.allFinite()) break;
+        fit.centre += delta;
+    }
+    layer_means();
+    fit.fitted = true;
+    return fit;
 }
 
 }  // namespace wul3d::detail

@@ -31,9 +31,10 @@ float hit_box(float dx, float dy, float dz, float x0, float x1, float y0, float 
 }
 
 // Ray (dx, dy, dz) against an open cup on the table at height `table_y` (y down): the
-// nearest of its outer and inner walls, rim and floor, or +inf. Taking the nearest hit of
-// every surface is exact for a closed thick-walled shape: a ray that meets an inner wall
-// from outside has met the outer wall or passed over the rim first.
+// nearest of its outer and inner walls, rim and floor (a bottle: its outer wall, closed top
+// and neck), or +inf. Taking the nearest hit of every surface is exact for a closed
+// thick-walled shape: a ray that meets an inner wall from outside has met the outer wall or
+// passed over the rim first.
 float hit_cup(float dx, float dy, float dz, const SceneCup& c, float table_y) {
     const float top = table_y - c.h, floor_y = table_y - c.wall, inner = c.radius - c.wall;
     float best = std::numeric_limits<float>::infinity();
@@ -52,15 +53,36 @@ float hit_cup(float dx, float dy, float dz, const SceneCup& c, float table_y) {
         }
     };
     tube(c.radius, top, table_y);
-    tube(inner, top, floor_y);
+    const bool bottle = c.neck_radius > 0 && c.neck_h > 0;
+    // A bottle's shoulder: a cone at 45 degrees from the body's radius at its top to the
+    // neck's, r = k0 - k1 t along the ray (the height over the table grows as r shrinks).
+    const float shoulder = c.radius - c.neck_radius, neck_top = top - shoulder - c.neck_h;
+    if (bottle) {
+        const float k0 = c.radius - (top - 0.0f), k1 = dy;  // r(y) = radius - (top - y) = k0 + y
+        const float a = dx * dx + dz * dz - k1 * k1, b = -2 * (dx * c.x + dz * c.z) - 2 * k0 * k1,
+                    cc = c.x * c.x + c.z * c.z - k0 * k0;
+        const float disc = b * b - 4 * a * cc;
+        if (std::fabs(a) > 1e-12f && disc >= 0)
+            for (float sign : {-1.0f, 1.0f}) {
+                const float t = (-b + sign * std::sqrt(disc)) / (2 * a), y = t * dy;
+                keep(t, y >= top - shoulder && y <= top);
+            }
+        tube(c.neck_radius, neck_top, top - shoulder);
+    } else {
+        tube(inner, top, floor_y);
+    }
     // Horizontal rings: the rim (inner..radius at the top) and the floor (0..inner).
     auto ring = [&](float y, float r0, float r1) {
         if (std::fabs(dy) < 1e-12f) return;
         const float t = y / dy, ex = t * dx - c.x, ez = t * dz - c.z, d2 = ex * ex + ez * ez;
         keep(t, d2 >= r0 * r0 && d2 <= r1 * r1);
     };
-    ring(top, inner, c.radius);
-    ring(floor_y, 0, inner);
+    if (bottle) {
+        ring(neck_top, 0, c.neck_radius);
+    } else {
+        ring(top, inner, c.radius);
+        ring(floor_y, 0, inner);
+    }
     return best;
 }
 }  // namespace
@@ -140,7 +162,8 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
                     rgb[0] = c.r; rgb[1] = c.g; rgb[2] = c.b;
                     const float ex = t * dx - c.x, ez = t * dz - c.z, height = s.table_y - t * dy;
                     const float mid = c.radius - c.wall / 2;
-                    if (ex * ex + ez * ez >= mid * mid && height >= c.band_lo && height <= c.band_hi) {
+                    const bool outer = ex * ex + ez * ez >= mid * mid || height > c.h + 1e-4f;  // or the neck
+                    if (outer && height >= c.band_lo && height <= c.band_hi) {
                         rgb[0] = c.band_r; rgb[1] = c.band_g; rgb[2] = c.band_b;
                     }
                 }

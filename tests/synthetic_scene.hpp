@@ -17,16 +17,19 @@ struct SceneBox {
     std::uint8_t r = 200, g = 30, b = 30;
 };
 
-/// An open container standing on the table: a vertical tube (a cup, a pot) with a floor.
+/// An open container standing on the table: a vertical tube (a cup, a pot) with a floor; or,
+/// with a neck, a bottle.
 struct SceneCup {
     float x = 0, z = 1.0f;          ///< centre of the footprint on the table, metres
     float radius = 0.08f;           ///< outer radius, metres
     float h = 0.08f;                ///< height, metres
     float wall = 0.005f;            ///< wall and floor thickness, metres
     std::uint8_t r = 230, g = 200, b = 60;
-    float band_lo = 0, band_hi = 0;  ///< a printed band round the outer wall, heights over the
-                                     ///< table, metres (none when equal)
+    float band_lo = 0, band_hi = 0;  ///< a printed band round the outer wall (and the neck),
+                                     ///< heights over the table, metres (none when equal)
     std::uint8_t band_r = 40, band_g = 60, band_b = 200;
+    float neck_radius = 0, neck_h = 0;  ///< a bottle: a shoulder at 45 degrees on its wall up to
+                                        ///< a closed neck of this radius and height (none when 0)
 };
 
 struct Scene {

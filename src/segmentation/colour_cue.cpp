@@ -319,13 +319,21 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, cons
     return sb;
 }
 
+/// The layers of stands_round's walls: kRoundLayerM of height over the support each, so that a
+/// bottle's neck and its body, narrower and wider, are circles about one axis. 0.5, 1 and
+/// 2 cm scored alike on the generated tune seeds (docs/ABLATION.md, "Colour cue"). Walls
+/// higher than kRoundLayers layers share the top one.
+constexpr double kRoundLayerM = 0.01;
+constexpr int kRoundLayers = 48;
+
 /// Whether the pixels px[0, m) of one segment stand round on the support pl: a quarter of
 /// them or more are walls (normals within colour.round_deg of the plane), the walls lie on
-/// one upright circle (fit_circle on the plane, as the containers' rims: RMS within
-/// containers.max_residual_m at any depth, spanning containers.min_arc of the diameter,
-/// radius up to colour.round_max_radius_m) and three quarters of them face within
-/// colour.round_deg of its radii. A can, a bottle or a cup is one solid of revolution; two objects flush in view
-/// show flat faces. Cost: two passes and fit_circle's six over the m pixels.
+/// upright circles about one axis, one per layer of height (fit_coaxial on the plane: RMS
+/// within containers.max_residual_m at any depth, as the containers' rims, spanning
+/// containers.min_arc of the mean diameter, radii up to colour.round_max_radius_m) and three
+/// quarters of them face within colour.round_deg of their radii. A can, a bottle or a cup
+/// is one solid of revolution; two objects flush in view show flat faces. Cost: two passes
+/// and fit_coaxial's twelve over the m pixels.
 bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, const int* px, int m) {
     const SegmentParams& prm = x.prm;
     const float sin_wall = std::sin(prm.colour.round_deg * kDegToRad);
@@ -343,19 +351,30 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     });
     if (walls < 3 || 4 * walls < m) return false;
     mean /= walls;
-    const Circle fit = fit_circle(on_plane(x, plane_xy, mean, for_walls));
-    const Eigen::Vector2d centre = fit.centre;
-    const double R = fit.radius;
-    if (!std::isfinite(R) || R > prm.colour.round_max_radius_m) return false;
+    auto layer_of = [&](std::size_t p) {
+        const double h = pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
+        return std::clamp(static_cast<int>(std::floor(h / kRoundLayerM)), 0, kRoundLayers - 1);
+    };
+    const auto fit = fit_coaxial<kRoundLayers>([&](auto&& visit) {
+        for_walls([&](std::size_t p) { visit(Eigen::Vector2d(plane_xy(x.c, p) - mean), layer_of(p)); });
+    });
+    if (!fit.fitted) return false;
+    double R = 0, widest = 0;  // the walls' mean radius, and the widest layer's
+    for (int l = 0; l < kRoundLayers; ++l) {
+        R += fit.radius[l] * fit.count[l];
+        if (fit.count[l] > 0) widest = std::max(widest, fit.radius[l]);
+    }
+    R /= walls;
+    if (!(R > 0) || widest > prm.colour.round_max_radius_m) return false;
     const double cos_radial = std::cos(prm.colour.round_deg * kDegToRad);
     // Residual, the walls' extent (the diagonal of their box on the plane) and how many
     // face along a radius (either way: a cup's inside faces in).
     double res = 0, radial = 0;
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::max()), hi = -lo;
     for_walls([&](std::size_t p) {
-        const Eigen::Vector2d d = plane_xy(x.c, p) - mean - centre;
-        const double r = d.norm();
-        res += (r - R) * (r - R);
+        const Eigen::Vector2d d = plane_xy(x.c, p) - mean - fit.centre;
+        const double r = d.norm(), off = r - fit.radius[layer_of(p)];
+        res += off * off;
         const Eigen::Vector3d nrm(x.n.nx[p], x.n.ny[p], x.n.nz[p]);
         const Eigen::Vector2d n2(nrm.dot(plane_xy.e1), nrm.dot(plane_xy.e2));  // the normal on the plane
         radial += std::fabs(n2.dot(d)) >= cos_radial * n2.norm() * r;

@@ -157,6 +157,28 @@ TEST(SegmentObjects, CupWithAPrintedBand_StaysOneObject) {
     EXPECT_GE(dominant_share(one.labels, in.truth, kTruthCup0), 0.95) << "the printed cup was split";
 }
 
+// A bottle whose neck is another colour than its body (a cap, a label round the neck): the
+// neck is a compact piece the colour cue would cut off. Body and neck are circles of two
+// radii about one axis, layer by layer (fit_coaxial), so the bottle stays one object.
+TEST(SegmentObjects, BottleWithANeckOfAnotherColour_StaysOneObject) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 5;
+    s.cups = {SceneCup{.z = 0.8f, .radius = 0.05f, .h = 0.1f, .band_lo = 0.101f, .band_hi = 0.2f,
+                       .neck_radius = 0.025f, .neck_h = 0.09f}};
+    const PlaneStage in = up_to_the_plane(s);
+    SegmentParams without;
+    without.colour.round_deg = 0;
+    SegmentStats split_stats;
+    const LabelImage split = segment(in, without, &split_stats);
+    ASSERT_GE(split_stats.colour.splits, 1) << "without the round test the neck should be cut off (test premise)";
+    ASSERT_LT(dominant_share(split.labels, in.truth, kTruthCup0), 0.95) << "(test premise)";
+
+    SegmentStats stats;
+    const LabelImage one = segment(in, SegmentParams{}, &stats);
+    EXPECT_EQ(stats.colour.splits, 0);
+    EXPECT_GE(dominant_share(one.labels, in.truth, kTruthCup0), 0.95) << "the bottle's neck was split off";
+}
+
 // Three flush boxes of three colours in a row: one 2-means split cuts one box off, and the
 // second round splits the two that are left.
 TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {

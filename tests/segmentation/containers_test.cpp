@@ -2,8 +2,10 @@
 // rims' circle fit (circle_fit.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "circle_fit.hpp"  // src/: the rims' and the round test's circle fit, tested here
@@ -103,6 +105,55 @@ TEST(CircleFit, ShortNoisyArc_GeometricFitKeepsTheRadiusWhereKasaShrinks) {
     EXPECT_NEAR(geo_mean, R, 0.05 * R);
     EXPECT_LT(std::fabs(geo_mean - R), 0.5 * std::fabs(kasa_mean - R));
     EXPECT_LT(geo_centre_err / draws, 0.02);
+}
+
+// A bottle's walls, a body and a neck of two radii about one axis on a half circle each:
+// one circle fits them badly (the premise), circles about one centre, one per layer, fit them
+// exactly. Two flat faces at a corner, layer after layer, fit no small circle.
+TEST(CircleFit, CoaxialCircles_ABottlesBodyAndNeck) {
+    const Eigen::Vector2d centre(0.3, -0.2);
+    std::vector<std::pair<Eigen::Vector2d, int>> walls;
+    for (int layer = 0; layer < 16; ++layer) {
+        const double R = layer < 11 ? 0.04 : 0.015;  // the body up to 11 cm, then the neck
+        for (int i = 0; i <= 12; ++i) {
+            const double a = M_PI * i / 12;
+            walls.push_back({centre + R * Eigen::Vector2d(std::cos(a), std::sin(a)), layer});
+        }
+    }
+    const detail::Circle one = detail::fit_circle([&](auto&& visit) {
+        for (const auto& w : walls) visit(w.first);
+    });
+    double one_res = 0;
+    for (const auto& w : walls) one_res += std::pow((w.first - one.centre).norm() - one.radius, 2);
+    ASSERT_GT(std::sqrt(one_res / static_cast<double>(walls.size())), SegmentParams{}.containers.max_residual_m)
+        << "one circle should not fit a body and a neck (test premise)";
+
+    const auto fit = detail::fit_coaxial<16>([&](auto&& visit) {
+        for (const auto& w : walls) visit(w.first, w.second);
+    });
+    ASSERT_TRUE(fit.fitted);
+    EXPECT_NEAR(fit.centre.x(), centre.x(), 1e-9);
+    EXPECT_NEAR(fit.centre.y(), centre.y(), 1e-9);
+    EXPECT_NEAR(fit.radius[0], 0.04, 1e-9);
+    EXPECT_NEAR(fit.radius[15], 0.015, 1e-9);
+    EXPECT_EQ(fit.count[0], 13);
+
+    const auto corner = detail::fit_coaxial<4>([](auto&& visit) {
+        for (int layer = 0; layer < 4; ++layer)
+            for (int i = 0; i <= 10; ++i) {
+                visit(Eigen::Vector2d(0.01 * i, 0.0), layer);  // one face
+                visit(Eigen::Vector2d(0.0, 0.01 * i), layer);  // the other
+            }
+    });
+    double widest = 0;
+    for (int layer = 0; layer < 4; ++layer) widest = std::max(widest, corner.radius[layer]);
+    double res = 0;
+    for (int i = 0; i <= 10; ++i) {
+        res += std::pow(Eigen::Vector2d(0.01 * i - corner.centre.x(), -corner.centre.y()).norm() - corner.radius[0], 2);
+        res += std::pow(Eigen::Vector2d(-corner.centre.x(), 0.01 * i - corner.centre.y()).norm() - corner.radius[0], 2);
+    }
+    EXPECT_TRUE(!corner.fitted || std::sqrt(res / 22) > SegmentParams{}.containers.max_residual_m)
+        << "two flat faces fitted circles of radius " << widest;
 }
 
 // A circle's own points give it back exactly; points on a line fit no circle, or one so large
