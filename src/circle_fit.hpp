@@ -84,7 +84,7 @@ struct CoaxialCircles {
 /// lengths taken less their layer's means: two unknowns, one 2 x 2 solve), then
 /// Gauss-Newton steps on the centre, each layer's radius its points' mean distance (so the
 /// steps move the centre along the points' directions less their layer's mean direction).
-/// One layer is fit_circle's circle. Cost: 2 + 2 kCircleSteps passes over the points.
+/// One layer is fit_circle's circle. Cost: 3 + kCircleSteps passes over the points.
 template <int kLayers, class ForPoints>
 CoaxialCircles<kLayers> fit_coaxial(ForPoints&& for_points) {
     CoaxialCircles<kLayers> fit;
@@ -103,37 +103,43 @@ CoaxialCircles<kLayers> fit_coaxial(ForPoints&& for_points) {
     });
     fit.centre = A.ldlt().solve(rhs) / -2.0;
     if (!fit.centre.allFinite()) return fit;
-    Eigen::Vector2d mean_dir[kLayers];
-    auto layer_means = [&] {  // each layer's radius and mean direction from the centre
-        for (int l = 0; l < kLayers; ++l) fit.radius[l] = 0, mean_dir[l].setZero();
-        for_points([&](const Eigen::Vector2d& p, int layer) {
-            const Eigen::Vector2d d = p - fit.centre;
-            const double len = d.norm();
-            fit.radius[layer] += len;
-            if (len > 0) mean_dir[layer] += d / len;
-        });
+    // Per layer: points, sums of the unit vectors u from the centre, of the distances d, of
+    // u u^T and of u d. The Gauss-Newton step comes from these in one pass: with R_layer the
+    // mean d and r = d - R_layer, the gradient of r in the centre is mean(u) - u, so
+    // J^T J = sum (u u^T) - n mean(u) mean(u)^T and J^T r = R_layer sum(u) - sum(u d) per layer.
+    double su_x[kLayers], su_y[kLayers], sd[kLayers], suu_xx[kLayers], suu_xy[kLayers], suu_yy[kLayers],
+        sud_x[kLayers], sud_y[kLayers];
+    auto layer_sums = [&] {
         for (int l = 0; l < kLayers; ++l)
-            if (fit.count[l] > 0) fit.radius[l] /= fit.count[l], mean_dir[l] /= fit.count[l];
+            su_x[l] = su_y[l] = sd[l] = suu_xx[l] = suu_xy[l] = suu_yy[l] = sud_x[l] = sud_y[l] = 0;
+        for_points([&](const Eigen::Vector2d& p, int layer) {
+            const Eigen::Vector2d v = p - fit.centre;
+            const double len = v.norm();
+            sd[layer] += len;
+            if (!(len > 0)) return;
+            const double ux = v.x() / len, uy = v.y() / len;
+            su_x[layer] += ux, su_y[layer] += uy;
+            suu_xx[layer] += ux * ux, suu_xy[layer] += ux * uy, suu_yy[layer] += uy * uy;
+            sud_x[layer] += ux * len, sud_y[layer] += uy * len;
+        });
+        for (int l = 0; l < kLayers; ++l) fit.radius[l] = fit.count[l] > 0 ? sd[l] / fit.count[l] : 0.0;
     };
     for (int step = 0; step < kCircleSteps; ++step) {
-        layer_means();
-        // Residual r = |p - c| - R_layer(c); its gradient in c is -(u - mean_layer(u)), u the
-        // unit vector from c to p.
+        layer_sums();
         Eigen::Matrix2d JtJ = Eigen::Matrix2d::Zero();
         Eigen::Vector2d Jtr = Eigen::Vector2d::Zero();
-        for_points([&](const Eigen::Vector2d& p, int layer) {
-            const Eigen::Vector2d d = p - fit.centre;
-            const double len = d.norm();
-            if (!(len > 0)) return;
-            const Eigen::Vector2d J = mean_dir[layer] - d / len;
-            JtJ += J * J.transpose();
-            Jtr += J * (len - fit.radius[layer]);
-        });
+        for (int l = 0; l < kLayers; ++l) {
+            if (fit.count[l] == 0) continue;
+            const double n = fit.count[l];
+            const Eigen::Vector2d su(su_x[l], su_y[l]);
+            JtJ += Eigen::Matrix2d{{suu_xx[l], suu_xy[l]}, {suu_xy[l], suu_yy[l]}} - su * su.transpose() / n;
+            Jtr += fit.radius[l] * su - Eigen::Vector2d(sud_x[l], sud_y[l]);
+        }
         const Eigen::Vector2d delta = JtJ.ldlt().solve(-Jtr);
         if (!delta.allFinite()) break;
         fit.centre += delta;
     }
-    layer_means();
+    layer_sums();
     fit.fitted = true;
     return fit;
 }

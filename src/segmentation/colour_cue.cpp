@@ -333,7 +333,7 @@ constexpr int kRoundLayers = 48;
 /// containers.min_arc of the mean diameter, radii up to colour.round_max_radius_m) and three
 /// quarters of them face within colour.round_deg of their radii. A can, a bottle or a cup
 /// is one solid of revolution; two objects flush in view show flat faces. Cost: two passes
-/// and fit_coaxial's twelve over the m pixels.
+/// and fit_coaxial's eight over the m pixels.
 bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, const int* px, int m) {
     const SegmentParams& prm = x.prm;
     const float sin_wall = std::sin(prm.colour.round_deg * kDegToRad);
