@@ -55,10 +55,11 @@ float hit_cup(float dx, float dy, float dz, const SceneCup& c, float table_y) {
     tube(c.radius, top, table_y);
     const bool bottle = c.neck_radius > 0 && c.neck_h > 0;
     // A bottle's shoulder: a cone at 45 degrees from the body's radius at its top to the
-    // neck's, r = k0 - k1 t along the ray (the height over the table grows as r shrinks).
+    // neck's, its radius r = radius - (top - y) = k0 + k1 t at the ray's point (y = t dy,
+    // downwards: r shrinks as the point rises).
     const float shoulder = c.radius - c.neck_radius, neck_top = top - shoulder - c.neck_h;
     if (bottle) {
-        const float k0 = c.radius - (top - 0.0f), k1 = dy;  // r(y) = radius - (top - y) = k0 + y
+        const float k0 = c.radius - top, k1 = dy;
         const float a = dx * dx + dz * dz - k1 * k1, b = -2 * (dx * c.x + dz * c.z) - 2 * k0 * k1,
                     cc = c.x * c.x + c.z * c.z - k0 * k0;
         const float disc = b * b - 4 * a * cc;

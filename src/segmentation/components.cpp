@@ -344,11 +344,11 @@ int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out) {
     for (int band = 0; band < bands; ++band) {
         int* const count = ws.sizes.data() + static_cast<std::size_t>(band) * B;
         int* const first = ws.offsets.data() + static_cast<std::size_t>(band) * B;
-        for_label_runs(label, static_cast<std::size_t>(N * band / bands), static_cast<std::size_t>(N * (band + 1) / bands),
-                       [&](int l, std::size_t p, std::size_t run) {
-                           if (count[l] == 0) first[l] = static_cast<int>(p);
-                           count[l] += static_cast<int>(run);
-                       });
+        const auto p0 = static_cast<std::size_t>(N * band / bands), p1 = static_cast<std::size_t>(N * (band + 1) / bands);
+        for_label_runs(label, p0, p1, [&](int l, std::size_t p, std::size_t run) {
+            if (count[l] == 0) first[l] = static_cast<int>(p);
+            count[l] += static_cast<int>(run);
+        });
     }
     // Labels in order of their first pixel; the large enough ones numbered in that order.
     ws.order.clear();
