@@ -321,8 +321,9 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, cons
 
 /// The layers of stands_round's walls: kRoundLayerM of height over the support each, so that a
 /// bottle's neck and its body, narrower and wider, are circles about one axis. 0.5, 1 and
-/// 2 cm scored alike on the generated tune seeds (docs/ABLATION.md, "Colour cue"). Walls
-/// higher than kRoundLayers layers share the top one.
+/// 2 cm scored alike on the generated tune seeds (docs/ABLATION.md, "Colour cue"). The
+/// layers reach 48 cm, about the scope's height limit (scope.max_height_m); walls higher
+/// share the top one.
 constexpr double kRoundLayerM = 0.01;
 constexpr int kRoundLayers = 48;
 
@@ -578,7 +579,7 @@ template <int K>
 /// Inlined into texture_colours. Cost: at most two passes over v.
 [[gnu::always_inline]] inline int first_largest(const float* v, int n) {
     // One running largest per lane, in a vector: as a float reduction the loop would not
-    // vectorize.
+    // vectorize. It starts at v[0] in every lane (a scalar less a vector is taken lane by lane).
     Float8 lane = v[0] - Float8{};
     int j = 0;
     for (; j + 8 <= n; j += 8) {
