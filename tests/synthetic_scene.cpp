@@ -30,7 +30,7 @@ float hit_box(float dx, float dy, float dz, float x0, float x1, float y0, float 
     return t0 > 0 ? t0 : std::numeric_limits<float>::infinity();
 }
 
-// Ray (dx, dy, dz) against an open cup on the table at height `table_y` (y down): the
+// Ray (dx, dy, dz) against an open cup standing at height `table_y` (y down): the
 // nearest of its outer and inner walls, rim and floor (a bottle: its outer wall, closed top
 // and neck), or +inf. Taking the nearest hit of every surface is exact for a closed
 // thick-walled shape: a ray that meets an inner wall from outside has met the outer wall or
@@ -156,12 +156,13 @@ RgbdFrame render_scene(const Scene& s, std::vector<int>* truth) {
             }
             for (std::size_t i = 0; i < s.cups.size(); ++i) {
                 const SceneCup& c = s.cups[i];
-                const float t = hit_cup(dx, dy, dz, c, s.table_y);
+                const float base_y = s.table_y - c.lift;
+                const float t = hit_cup(dx, dy, dz, c, base_y);
                 if (t < best) {
                     best = t;
                     id = kTruthCup0 + static_cast<int>(i);
                     rgb[0] = c.r; rgb[1] = c.g; rgb[2] = c.b;
-                    const float ex = t * dx - c.x, ez = t * dz - c.z, height = s.table_y - t * dy;
+                    const float ex = t * dx - c.x, ez = t * dz - c.z, height = base_y - t * dy;
                     const float mid = c.radius - c.wall / 2;
                     const bool outer = ex * ex + ez * ez >= mid * mid || height > c.h + 1e-4f;  // or the neck
                     if (outer && height >= c.band_lo && height <= c.band_hi) {

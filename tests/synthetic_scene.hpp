@@ -30,6 +30,7 @@ struct SceneCup {
     std::uint8_t band_r = 40, band_g = 60, band_b = 200;
     float neck_radius = 0, neck_h = 0;  ///< a bottle: a shoulder at 45 degrees on its wall up to
                                         ///< a closed neck of this radius and height (none when 0)
+    float lift = 0;                     ///< its foot this high over the table (on a box), metres
 };
 
 struct Scene {

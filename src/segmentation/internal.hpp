@@ -129,6 +129,21 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::uint8_t> wall_cells;    ///< 1 = an upper object's wall stands in that cell
     std::vector<std::array<double, 4>> wall_colour;  ///< per segment and piece: chromaticity
                                                      ///< sums (3) and count
+    /// Per cut segment, the colour's verdict on its walls and, where colour cannot tell, its
+    /// upper object's footprint on the support plane and where its lower layer's top shows
+    /// round it (stacks.cpp, keep_walls).
+    struct Footprint {
+        bool up_by_colour = false;             ///< the walls under its walls go up by colour
+        bool wanted = false;                   ///< measured: colour cannot tell (one material)
+        double su = 0, sv = 0, n = 0;          ///< the upper object's points summed (u, v), counted
+        double c4 = 0, s4 = 0, walls = 0;      ///< its walls' normals' directions, four times the
+                                               ///< angle, summed; its walls counted
+        double axis[2][2] = {};                ///< its two axes (unit u, v)
+        double lo[2] = {0, 0}, hi[2] = {0, 0};  ///< its extent along them from its mean point
+        int side[4] = {0, 0, 0, 0};            ///< the lower top's upward pixels beyond each side
+    };
+    std::vector<Footprint> footprints;
+    std::vector<int> footprint_px;  ///< scratch: the pixels of the segments whose footprint is wanted
 };
 
 }  // namespace wul3d

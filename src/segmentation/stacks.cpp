@@ -4,7 +4,8 @@
 // to show a fold under the sensor's noise) and the colour cue cannot part them (one colour,
 // or a print that 2-means follows), the heights still tell them apart. Two boxes of two
 // heights standing side by side show the same two layers; there the taller one's walls run
-// on below the cut, and their colour sends them up with it (keep_walls_by_colour).
+// on below the cut, and their colour sends them up with it, or, in one colour, the lower
+// layer's top showing on one side of the upper object only (keep_walls).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -190,7 +191,7 @@ bool under_upper_walls(const SegmentBuffers& ws, int l, const Eigen::Vector2d& q
 /// Where a pixel of a cut segment goes: above the cut, to the upper object (its walls,
 /// kUpperWall, or the rest, kUpper); below it, to the lower object, but for the walls that
 /// stand under the upper object's walls (kUnderUpperWalls), which go up when their colour
-/// says so (keep_walls_by_colour). The first three index ws.wall_colour.
+/// or the lower layer's place says so (keep_walls). The first three index ws.wall_colour.
 enum Piece : int { kUpperWall = 0, kUnderUpperWalls = 1, kLower = 2, kUpper = 3 };
 
 /// The piece of pixel p (height h) of cut segment l. Cost: O(1).
@@ -211,16 +212,114 @@ double colour_distance(const std::array<double, 4>& a, const std::array<double, 
     return std::sqrt(d2);
 }
 
+/// The lower layer's top shows on one side of the upper object when this share of its
+/// upward pixels or more lies beyond one side of the upper object's footprint: a taller box
+/// beside a lower one shows the lower one's top beside one of its sides, in front, behind or
+/// to one side; a box resting on a larger one shows the larger one's top round two sides or
+/// more (on a corner, flush with two of its edges: beside one side and behind). Chosen on
+/// the generated tune seeds (docs/ABLATION.md, "Stacks").
+constexpr double kOneSideShare = 0.9;
+/// A footprint has sides when its walls face along two axes: the mean of the unit vectors
+/// at four times their angles on the support plane is this long or more (a box's walls,
+/// 90 degrees apart, add up; a can's face every way and cancel). Boxes measure 0.56-0.99
+/// (0.56 seen steeply from above, `ocid_sample`), cans 0.07-0.13 (the shipped RealSense
+/// frames' soup can on a tin, which without this test loses its front wall to the can); set
+/// between them by hand, not tuned.
+constexpr double kBoxAxes = 0.4;
+
+/// Per cut segment whose footprint is wanted (colour cannot tell: keep_walls), into
+/// ws.footprints: its upper object's (above the cut) mean point on the support plane, its
+/// axes (from its walls' normals on the plane: a box's sides face along two axes, four
+/// times their angle one direction), its extent along them, and its lower layer's upward
+/// pixels (the layer's three bins, kCutOverLowerM under the cut) counted beyond each of the
+/// footprint's four sides (the side the pixel lies beyond relative to the footprint's
+/// half-extent that way). Cost: one pass over the rows with objects to gather those
+/// segments' pixels, then three over them.
+void measure_footprints(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentBuffers& ws) {
+    using Footprint = SegmentBuffers::Footprint;
+    ws.footprint_px.clear();
+    for_segment_pixels(x, ws, [&](std::size_t p, int l) {
+        if (ws.footprints[static_cast<std::size_t>(l)].wanted) ws.footprint_px.push_back(static_cast<int>(p));
+    });
+    // Calls visit(p, footprint, h) for each gathered pixel, h its height over the support.
+    auto for_gathered = [&](auto&& visit) {
+        for (const int q : ws.footprint_px) {
+            const auto p = static_cast<std::size_t>(q);
+            const auto l = static_cast<std::size_t>(ws.label[p]);
+            visit(p, l, pl.height(x.c.x[p], x.c.y[p], x.c.z[p]));
+        }
+    };
+    for_gathered([&](std::size_t p, std::size_t l, float h) {
+        if (h <= ws.stack_cut[l]) return;
+        Footprint& f = ws.footprints[l];
+        const Eigen::Vector2d q = axes(x.c, p);
+        f.su += q.x(), f.sv += q.y(), f.n += 1;
+        if (!faces_sideways(x, pl, p, sin_wall)) return;
+        // The normal on the plane, (a, b) = r (cos t, sin t): cos 4t and sin 4t from
+        // (a + ib)^4 / r^4, without trigonometry.
+        const Eigen::Vector3d nrm(x.n.nx[p], x.n.ny[p], x.n.nz[p]);
+        const double a = nrm.dot(axes.e1), b = nrm.dot(axes.e2), r2 = a * a + b * b;
+        if (!(r2 > 0)) return;
+        const double c2 = (a * a - b * b) / r2, s2 = 2 * a * b / r2;
+        f.c4 += c2 * c2 - s2 * s2, f.s4 += 2 * c2 * s2, f.walls += 1;
+    });
+    for (Footprint& f : ws.footprints) {
+        if (f.n == 0) continue;
+        const double t = std::atan2(f.s4, f.c4) / 4;
+        f.axis[0][0] = std::cos(t), f.axis[0][1] = std::sin(t);
+        f.axis[1][0] = -std::sin(t), f.axis[1][1] = std::cos(t);
+    }
+    auto along = [&](const Footprint& f, std::size_t p, double (&s)[2]) {
+        const Eigen::Vector2d q = axes(x.c, p);
+        const double du = q.x() - f.su / f.n, dv = q.y() - f.sv / f.n;
+        for (int k = 0; k < 2; ++k) s[k] = du * f.axis[k][0] + dv * f.axis[k][1];
+    };
+    for_gathered([&](std::size_t p, std::size_t l, float h) {
+        Footprint& f = ws.footprints[l];
+        if (f.n == 0 || h <= ws.stack_cut[l]) return;
+        double s[2];
+        along(f, p, s);
+        for (int k = 0; k < 2; ++k) f.lo[k] = std::min(f.lo[k], s[k]), f.hi[k] = std::max(f.hi[k], s[k]);
+    });
+    const float cos_up = std::cos(kUprightDeg * kDegToRad);
+    constexpr float kHalfLayer = 1.5f * kLayerBinM;
+    for_gathered([&](std::size_t p, std::size_t l, float h) {
+        Footprint& f = ws.footprints[l];
+        const float layer = ws.stack_cut[l] - kCutOverLowerM;
+        if (f.n == 0 || std::fabs(h - layer) > kHalfLayer || !faces_up(x, pl, p, cos_up)) return;
+        double s[2], reach[2];
+        along(f, p, s);
+        for (int k = 0; k < 2; ++k) {
+            const double half = s[k] > 0 ? f.hi[k] : -f.lo[k];
+            reach[k] = half > 0 ? std::fabs(s[k]) / half : 0.0;
+        }
+        const int k = reach[0] >= reach[1] ? 0 : 1;
+        ++f.side[2 * k + (s[k] > 0 ? 0 : 1)];
+    });
+}
+
+/// Whether segment l's upper object is box-like, its walls facing along two axes
+/// (kBoxAxes), and its lower layer shows beyond one side of it only (kOneSideShare).
+bool lower_top_beside(const SegmentBuffers& ws, int l) {
+    const SegmentBuffers::Footprint& f = ws.footprints[static_cast<std::size_t>(l)];
+    const int total = f.side[0] + f.side[1] + f.side[2] + f.side[3];
+    const int most = std::max(std::max(f.side[0], f.side[1]), std::max(f.side[2], f.side[3]));
+    return f.walls > 0 && std::hypot(f.c4, f.s4) >= kBoxAxes * f.walls && total > 0 && most >= kOneSideShare * total;
+}
+
 /// Two boxes of two heights flush side by side are one segment with two layers too, and the
 /// cut halves the taller one: its walls run on below the cut, under its walls above it.
-/// Their colour decides, as geometry cannot tell them from a box resting flush on the edge
-/// of a larger one (whose walls below the cut are the lower box's): they go up only when
+/// Geometry alone cannot tell them from a box resting flush on the edge of a larger one
+/// (whose walls below the cut are the lower box's). Colour decides first: they go up when
 /// their mean chromaticity lies colour.min_distance or more from the rest of the lower piece
-/// (another material) and nearer the upper object's walls. Same-coloured pairs stay cut by
-/// height. Clears the map of every segment whose walls stay. Cost: one pass over the rows
-/// with objects.
-void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentBuffers& ws,
-                          int n) {
+/// (another material) and nearer the upper object's walls. Where all three are within
+/// colour.min_distance of each other (one material: colour cannot tell), they go up when the
+/// upper object is box-like and the lower layer's top shows beyond one side of it only
+/// (lower_top_beside): a box resting on a larger one shows the larger one's top beyond two
+/// sides or more. Otherwise the pair stays cut by height. Clears the map of every segment
+/// whose walls stay. Cost: one pass over the rows with objects, and measure_footprints' where
+/// a segment asks it (none on most frames).
+void keep_walls(const Ctx& x, const Plane& pl, const PlaneAxes& axes, float sin_wall, SegmentBuffers& ws, int n) {
     ws.wall_colour.assign(static_cast<std::size_t>(n + 1) * 3, {0.0, 0.0, 0.0, 0.0});
     for_cut_pixels(x, pl, ws, [&](std::size_t p, int l, float h) {
         const Piece k = piece_of(x, pl, axes, sin_wall, ws, p, l, h);
@@ -237,13 +336,25 @@ void keep_walls_by_colour(const Ctx& x, const Plane& pl, const PlaneAxes& axes, 
         sum[2] += b * scale;
         sum[3] += 1;
     });
+    // Colour first; the footprints only of the segments whose three pieces are one material.
+    ws.footprints.assign(static_cast<std::size_t>(n) + 1, SegmentBuffers::Footprint{});
+    bool ask = false;
     for (int l = 1; l <= n; ++l) {
         const std::array<double, 4>* sums = ws.wall_colour.data() + 3 * static_cast<std::size_t>(l);
-        bool up = sums[kUpperWall][3] > 0 && sums[kUnderUpperWalls][3] > 0 && sums[kLower][3] > 0;
-        if (up) {
-            const double to_lower = colour_distance(sums[kUnderUpperWalls], sums[kLower]);
-            up = to_lower >= x.prm.colour.min_distance && colour_distance(sums[kUnderUpperWalls], sums[kUpperWall]) < to_lower;
-        }
+        if (sums[kUpperWall][3] == 0 || sums[kUnderUpperWalls][3] == 0 || sums[kLower][3] == 0) continue;
+        const double min_distance = x.prm.colour.min_distance;
+        const double to_lower = colour_distance(sums[kUnderUpperWalls], sums[kLower]);
+        const double to_upper = colour_distance(sums[kUnderUpperWalls], sums[kUpperWall]);
+        SegmentBuffers::Footprint& f = ws.footprints[static_cast<std::size_t>(l)];
+        f.up_by_colour = to_lower >= min_distance && to_upper < to_lower;
+        f.wanted = to_lower < min_distance && to_upper < min_distance &&
+                   colour_distance(sums[kUpperWall], sums[kLower]) < min_distance;
+        ask = ask || f.wanted;
+    }
+    if (ask) measure_footprints(x, pl, axes, sin_wall, ws);
+    for (int l = 1; l <= n; ++l) {
+        const SegmentBuffers::Footprint& f = ws.footprints[static_cast<std::size_t>(l)];
+        const bool up = f.up_by_colour || (f.wanted && lower_top_beside(ws, l));
         if (!up) ws.wall_maps[static_cast<std::size_t>(l)].cols = 0;  // no map: the walls stay
     }
 }
@@ -277,7 +388,7 @@ int split_by_height(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     if (x.prm.segmenter == Segmenter::Hybrid && x.c.has_color) {
         collect_upper_walls(x, pl, axes, sin_wall, ws);
         draw_wall_maps(ws, n);
-        keep_walls_by_colour(x, pl, axes, sin_wall, ws, n);
+        keep_walls(x, pl, axes, sin_wall, ws, n);
     } else {
         ws.wall_maps.assign(static_cast<std::size_t>(n) + 1, {});  // no maps
     }
