@@ -241,7 +241,8 @@ void measure_footprints(const Ctx& x, const Plane& pl, const PlaneAxes& axes, fl
     for_segment_pixels(x, ws, [&](std::size_t p, int l) {
         if (ws.footprints[static_cast<std::size_t>(l)].wanted) ws.footprint_px.push_back(static_cast<int>(p));
     });
-    // Calls visit(p, footprint, h) for each gathered pixel, h its height over the support.
+    // Calls visit(p, l, h) for each gathered pixel p, l its segment, h its height over the
+    // support.
     auto for_gathered = [&](auto&& visit) {
         for (const int q : ws.footprint_px) {
             const auto p = static_cast<std::size_t>(q);
