@@ -175,10 +175,13 @@ constexpr SceneCup kBottle{.z = 0.8f, .radius = 0.05f, .h = 0.1f, .band_lo = 0.1
 
 // The scene's bottle as the renderer draws it (the test scenes' own geometry): each of its
 // pixels, taken back to the scene's axes, lies on the body's wall, the shoulder's cone, the
-// neck's wall or the neck's top, within 2 mm, and each part shows.
-TEST(SyntheticScene, Bottle_BodyShoulderAndNeckWhereTheyShouldBe) {
+// neck's wall or the neck's top, within 2 mm, and each part shows; its heights counted from
+// its foot, `lift` over the table.
+static void expect_bottle_where_it_should_be(float lift) {
+    SceneCup bottle = kBottle;
+    bottle.lift = lift;
     Scene s = pitched_tabletop_scene();
-    s.cups = {kBottle};
+    s.cups = {bottle};
     std::vector<int> truth;
     const RgbdFrame f = render_scene(s, &truth);
     const auto& K = f.intrinsics;
@@ -193,7 +196,7 @@ TEST(SyntheticScene, Bottle_BodyShoulderAndNeckWhereTheyShouldBe) {
             const float cp = std::cos(s.pitch_rad), sp = std::sin(s.pitch_rad);
             const float t = f.depth.data[p] * f.depth.scale_m_per_unit;
             const float x = t * dx, y = t * (dy_cam * cp + sp), z = t * (-dy_cam * sp + cp);
-            const float height = s.table_y - y, r = std::hypot(x - kBottle.x, z - kBottle.z);
+            const float height = s.table_y - lift - y, r = std::hypot(x - kBottle.x, z - kBottle.z);
             constexpr float kTol = 0.002f;
             if (height < kBottle.h - kTol && std::fabs(r - kBottle.radius) < kTol) ++body;
             else if (height > kBottle.h + kTol && height < kBottle.h + shoulder - kTol &&
@@ -209,6 +212,12 @@ TEST(SyntheticScene, Bottle_BodyShoulderAndNeckWhereTheyShouldBe) {
     EXPECT_GE(cap, 5);
     EXPECT_EQ(off, 0) << "bottle pixels on none of its surfaces";
 }
+
+TEST(SyntheticScene, Bottle_BodyShoulderAndNeckWhereTheyShouldBe) { expect_bottle_where_it_should_be(0.0f); }
+
+// The same bottle standing 6 cm over the table (SceneCup::lift: on a box) is drawn 6 cm higher:
+// measured from the table, every pixel would lie off its surfaces.
+TEST(SyntheticScene, LiftedBottle_DrawnThatMuchHigher) { expect_bottle_where_it_should_be(0.06f); }
 
 // A bottle whose neck is another colour than its body (a cap, a label round the neck): the
 // neck is a compact piece the colour cue would cut off. Body and neck are circles of two
