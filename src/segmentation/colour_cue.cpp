@@ -878,27 +878,39 @@ int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, i
     return number_splits(ws, n, by_material);
 }
 
+/// Rounds of the colour cue: each tries again the parts of the segments the round before
+/// split. Three flush boxes of three colours need two; a pile whose textured objects are one
+/// segment loses one material a round (split_by_materials), and the third round gains on
+/// the generated tune seeds (pile under active stereo most), a fourth splits nothing more
+/// (docs/ABLATION.md, "Colour cue").
+constexpr int kColourRounds = 3;
+
 /// The colour cue: tries to split each segment in two by 2-means under the paper's distance
 /// (eq. 4, 6) with a colour-heavy alpha; keeps a split only when the parts differ in colour,
 /// are large, and meet along one side of the smaller part or round a compact piece, across
 /// a smooth surface or with a turn of colour, and the segment does not stand round on the
 /// support (stands_round: a can's label is print). Where 2-means followed a texture, the
-/// same tests judge a split between the segment's materials (split_by_materials). A second
-/// round tries the two parts of each split segment again: three flush boxes of three colours
-/// need two cuts. In: ws.label (1..n with gaps). Out: ws.label with the new parts numbered
-/// n + 1, n + 2, ... (round 1's in segment order, then round 2's); `by_material` counts the splits between materials. Cost:
-/// split_round once, twice when it split anything.
+/// same tests judge a split between the segment's materials (split_by_materials). Each
+/// further round (kColourRounds) tries the two parts of each segment the round before split.
+/// In: ws.label (1..n with gaps). Out: ws.label with the new parts numbered n + 1, n + 2, ...
+/// (round by round, each in segment order); `by_material` counts the splits between
+/// materials. Cost: split_round once, and once more after each round that split anything.
 int color_splits(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, int& by_material) {
     by_material = 0;
     ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
-    const int first = split_round(x, support, ws, n, by_material);
-    if (first == 0) return 0;
-    // Round 2: the segments split in round 1 (part 0 kept their label) and their new parts.
-    // A third round split nothing more on the tune seeds (docs/ABLATION.md).
-    ws.to_try.assign(static_cast<std::size_t>(n + first) + 1, 0);
-    for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)] != kNotSplit;
-    for (int l = n + 1; l <= n + first; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
-    return first + split_round(x, support, ws, n + first, by_material);
+    int splits = 0;
+    for (int round = 0; round < kColourRounds; ++round) {
+        const int found = split_round(x, support, ws, n, by_material);
+        if (found == 0) break;
+        // The next round: the segments split in this one (part 0 kept their label) and their
+        // new parts.
+        ws.to_try.assign(static_cast<std::size_t>(n + found) + 1, 0);
+        for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)] != kNotSplit;
+        for (int l = n + 1; l <= n + found; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
+        n += found;
+        splits += found;
+    }
+    return splits;
 }
 
 }  // namespace

@@ -248,6 +248,28 @@ TEST(SegmentObjects, ThreeFlushBoxesOfThreeColours_SplitInTwoRounds) {
     EXPECT_EQ(stats.colour.splits, 2);
 }
 
+// Four flush boxes: a red one far in colour from three others, whose colours lie in a row
+// (green, teal, blue). Each round of 2-means peels the part farthest in colour: red, then
+// an end of the row, then the last pair, so the four need three rounds.
+TEST(SegmentObjects, FourFlushBoxesOfFourColours_SplitInThreeRounds) {
+    Scene s = pitched_tabletop_scene();
+    s.noise_seed = 9;
+    s.boxes = {SceneBox{.x = -0.15f, .z = 1.0f, .w = 0.1f, .r = 220, .g = 30, .b = 30},
+               SceneBox{.x = -0.05f, .z = 1.0f, .w = 0.1f, .r = 40, .g = 180, .b = 60},
+               SceneBox{.x = 0.05f, .z = 1.0f, .w = 0.1f, .r = 40, .g = 160, .b = 150},
+               SceneBox{.x = 0.15f, .z = 1.0f, .w = 0.1f, .r = 40, .g = 60, .b = 220}};
+    std::vector<int> truth;
+    SegmentStats stats;
+    const LabelImage out = segment(s, Segmenter::Hybrid, truth, &stats);
+    int id[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_GT(dominant_share(out.labels, truth, kTruthBox0 + i, &id[i]), 0.9) << "box " << i;
+        EXPECT_NE(id[i], 0) << "box " << i;
+        for (int j = 0; j < i; ++j) EXPECT_NE(id[i], id[j]) << "boxes " << j << " and " << i;
+    }
+    EXPECT_EQ(stats.colour.splits, 3);
+}
+
 // Two flush boxes of different colours, one with a small sticker of a third colour (under
 // 2 % of the pair) farther from each box's colour than they are from each other. 2-means
 // seeded at the farthest colours starts one part at the sticker and keeps it there (both
