@@ -154,8 +154,8 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
                          std::vector<DetectedObject>& out) {
     if (!s_) s_ = std::make_unique<Scratch>();  // a moved-from tracker, used again
     if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
-    // Pixels whose surface changed forget their weights (in weigh_pixels, after the votes);
-    // a scene cut forgets everything.
+    // Pixels whose surface changed neither vote for the matching nor keep their weights (in
+    // measure_segments and weigh_pixels); a scene cut forgets everything.
     if (mark_surface_changes(cloud)) start_afresh();
     ++tau_;
 
@@ -225,8 +225,8 @@ SurfaceCounts surface_changes(std::size_t p0, std::size_t p1, const std::uint8_t
         moved += seen & (dz > 0.05f);
         held += mine;
         held_moved += mine & depth_moved;
-        // Reset after the votes: the old weights still say which track was here, evidence
-        // of overlap for a moving object.
+        // A changed pixel's weights are another surface's history: it does not vote for the
+        // matching (measure_segments), and forgets them (weigh_pixels).
         changed[p] = mine & (depth_moved | (static_cast<float>(dr * dr + dg * dg + db * db) > rgb2));
         prev_z[p] = z;
         prev_r[p] = cr[p];
@@ -280,9 +280,10 @@ void ObjectTracker::start_afresh() {
     ++scene_cuts_;
 }
 
-// In: segments, the cloud, mu_. Out: s_->votes ((S+1) x K: each segment's sum of its pixels'
-// weights per slot, i.e. its overlap with the previous frames' objects as the paper's
-// weights remember them) and s_->seg_sums ((S+1) x kSegSums: pixel count and x, y, z sums).
+// In: segments, the cloud, mu_, s_->changed. Out: s_->votes ((S+1) x K: each segment's sum of
+// its pixels' weights per slot, i.e. its overlap with the previous frames' objects as the
+// paper's weights remember them, over the pixels whose surface did not change) and
+// s_->seg_sums ((S+1) x kSegSums: pixel count and x, y, z sums).
 // Votes are summed in integer units of the weights: exact in any order.
 // Cost: one pass over N pixels (6 weights each), then O(B x S x K); allocates only when S
 // grows.
@@ -307,7 +308,9 @@ void ObjectTracker::measure_segments(const OrganizedCloud& cloud, const LabelIma
             ss[1] += cloud.x[p];
             ss[2] += cloud.y[p];
             ss[3] += cloud.z[p];
-            if (!has_mu_[p]) continue;
+            // A pixel whose surface changed holds another surface's history: an object put
+            // down on another would take over that one's track by it.
+            if (!has_mu_[p] || s_->changed[p]) continue;
             std::uint64_t* vs = votes + static_cast<std::size_t>(s) * Kz;
             const PixelWeights& w = mu_[p];
             for (int q = 0; q < PixelWeights::kSlots; ++q) vs[w.cluster[q]] += w.mu[q];

@@ -279,3 +279,35 @@ TEST(ObjectTracker, PixelWhoseSurfaceChanged_TakesTheNewObjectAtOnce) {
     for (int u = 25; u < 30; ++u) EXPECT_EQ(objects.labels[static_cast<std::size_t>(u)], right) << u;
     EXPECT_EQ(tracker.scene_cuts(), 0);
 }
+
+// An object put down on another (a box on a board) covers most of it: its pixels held the
+// board's weights, but their surface changed, so they do not vote for the matching. The
+// board keeps its track, and its pixels, which still hold that track, are not taken into
+// the new object's. A third object stands by, unchanged: not a scene rearranged.
+TEST(ObjectTracker, ObjectPutDownOnAnother_BothKeepTheirOwnTracks) {
+    ObjectTracker tracker(ObjectParams{});
+    OrganizedCloud cloud;
+    cloud.resize(100, 20);
+    const std::size_t N = 100 * 20;
+    LabelImage segments{100, 20, std::vector<std::uint16_t>(N, 0)}, objects;
+    std::vector<DetectedObject> list;
+    // A board over columns 10-49 at 1 m, an object over 55-99; then a box on the board's
+    // columns 20-49, 10 cm nearer.
+    for (int frame = 0; frame < 6; ++frame) {
+        const bool box = frame == 5;
+        for (std::size_t p = 0; p < N; ++p) {
+            const int u = static_cast<int>(p % 100);
+            const bool on_box = box && u >= 20 && u < 50;
+            cloud.valid[p] = 1;
+            cloud.z[p] = on_box ? 0.9f : 1.0f;
+            segments.labels[p] = u < 10 || (u >= 50 && u < 55) ? 0 : (u >= 55 ? 1 : (on_box ? 3 : 2));
+        }
+        tracker.step(cloud, segments, box ? 3 : 2, LabelImage{}, objects, list);
+    }
+    ASSERT_EQ(list.size(), 3u);
+    EXPECT_EQ(tracker.scene_cuts(), 0);
+    const std::uint16_t board = objects.labels[15], on_top = objects.labels[35];
+    EXPECT_EQ(board, 2) << "the board keeps its track";
+    EXPECT_EQ(on_top, 3) << "the box starts a track of its own";
+    for (int u = 10; u < 20; ++u) EXPECT_EQ(objects.labels[static_cast<std::size_t>(u)], board) << u;
+}
