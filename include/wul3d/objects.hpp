@@ -24,7 +24,8 @@ struct ObjectParams {
     int max_tracks = 32;       ///< tracks held at once; [2, 255]. Each pixel keeps its 6 largest
                                ///< track weights (PixelWeights, 24 bytes), whatever this is
     float min_overlap = 0.2f;  ///< a segment continues a track when its weight mass on the track
-                               ///< is at least this share of the smaller of the two; (0, 1]
+                               ///< (over its pixels whose surface did not change) is at least
+                               ///< this share of the smaller of the two; (0, 1]
     float max_jump_m = 0.15f;  ///< else a lost track within this distance (centroids) is taken
                                ///< back; >= 0
     int max_lost_frames = 15;  ///< a track unseen this many frames is retired; >= 0
