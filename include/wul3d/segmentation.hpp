@@ -180,11 +180,10 @@ struct ScopeParams {
     float max_outside = 0.1f;    ///< largest share of a segment's outline that continues into
                                  ///< removed points above the support, or into the frame's
                                  ///< edge beyond the support's middle; [0, 1]
-    float upright_share = 0.7f;  ///< the frame's sides and bottom count for a segment only
-                                 ///< when this share of its pixels face sideways (within 25
-                                 ///< degrees of the support plane): a wall; an object on the
-                                 ///< table the frame cuts shows its top (its top edge counts
-                                 ///< for all); [0, 1]
+    float upright_share = 0.7f;  ///< the frame's edges count for a segment only when this
+                                 ///< share of its pixels face sideways (within 25 degrees of
+                                 ///< the support plane): a wall; an object on the table the
+                                 ///< frame cuts shows its top; [0, 1]
     /// Low supports: a kept segment no higher than scope.low_support_max_m over the support that
     /// covers scope.low_support_min_area_m2 of it and holds two kept segments or more (they touch
     /// it and rise contact_m above it) is a board or a tray lying on the floor, a second

@@ -93,8 +93,8 @@ struct SegmentWorkspace::Buffers {
     std::vector<int> scope_any_px;                     ///< one pixel of each segment
     std::vector<double> scope_sx, scope_sy, scope_sz;  ///< sums of each segment's points
     std::vector<int> scope_high, scope_outline, scope_outside;
-    std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's sides or
-                                                  ///< bottom; pixels facing sideways
+    std::vector<int> scope_frame, scope_upright;  ///< outline pairs into the frame's edges;
+                                                  ///< pixels facing sideways
     std::vector<std::uint8_t> scope_keep;
     std::vector<int> scope_held;  ///< per segment, the kept segments it holds (low supports)
     std::vector<std::uint8_t> scope_wide;  ///< per segment, 1 = spans past the height limit

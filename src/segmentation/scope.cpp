@@ -191,10 +191,8 @@ void measure_strip(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                 const int on_edge = x.c.z[p] > far_z ? (v == fe.edge_top) + (u == fe.edge_left) +
                                                            (u == fe.edge_right) + (v == fe.edge_bottom)
                                                      : 0;
-                const int on_top = x.c.z[p] > far_z && v == fe.edge_top;
                 c.outline += on_edge;
-                c.outside += on_top;
-                c.frame += on_edge - on_top;
+                c.frame += on_edge;
             }
             // Most pairs join equal labels and add nothing: that test stays here, in line
             // (GCC does not inline `pair`, called twice).
@@ -259,8 +257,7 @@ void sum_points(const Ctx& x, const FrameEdge& fe, SegmentBuffers& ws) {
 /// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
 /// (ws.sizes), the sums of its points (scope_sx, sy, sz), outline pairs (scope_outline) and
 /// those that lead out of the volume (scope_outside: into removed points above the support,
-/// or into the frame's top edge, beyond the support's middle `far_z`) or into its other
-/// edges there (scope_frame); the touching segment pairs, once each, into ws.edges. In:
+/// beyond the support's middle `far_z`) or into the frame's edges there (scope_frame); the touching segment pairs, once each, into ws.edges. In:
 /// ws.label (1..n with gaps). Cost: one pass over the pixels in strips of rows, a strip per
 /// thread, the counts gathered (O(strips n)), a sort of the pairs, and with more than one
 /// strip a pass over the labelled rows for the sums.
@@ -288,7 +285,7 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     if (strips > 1) sum_points(x, fe, ws);
 }
 
-/// ws.scope_upright: per segment that runs into the frame's sides or bottom (scope_frame),
+/// ws.scope_upright: per segment that runs into the frame's edges (scope_frame),
 /// its pixels facing sideways (normals within kUprightDeg of the support plane); 0 for the
 /// others. Cost: none when no segment does (most tabletop frames), else one pass over the
 /// pixels.
@@ -457,8 +454,9 @@ void decide_scope(const Ctx& x, const Plane& pl, SegmentBuffers& ws, int n) {
     keep.assign(L, 0);
     for (std::size_t l = 1; l < L; ++l) {
         if (ws.sizes[l] == 0) continue;
-        // The frame's sides and bottom cut walls and the sides of furniture, and objects on
-        // the table too; only an upright segment (a wall) leaves the volume there.
+        // The frame's edges cut walls and the sides of furniture, and objects on the table
+        // too (at the top, on its far half); only an upright segment (a wall) leaves the
+        // volume there.
         const bool upright =
             static_cast<float>(ws.scope_upright[l]) >= prm.scope.upright_share * static_cast<float>(ws.sizes[l]);
         const int outside = ws.scope_outside[l] + (upright ? ws.scope_frame[l] : 0);

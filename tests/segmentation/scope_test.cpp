@@ -269,3 +269,38 @@ TEST(SegmentObjects, Scope_BoxesOnAThickBoard_TheBoardIsInsideTheVolume) {
     ASSERT_EQ(boxes_kept(nullptr), 0) << "without the low support the boxes should leave the volume (test premise)";
     EXPECT_EQ(boxes_kept(&st.plane.low_support), 2);
 }
+
+// The frame's top edge, on the far half of the table, cuts a flat box and an upright board
+// (a wall's stand-in), as the sides cut them above. The box shows its top: an object the
+// frame cuts, which stays. The board faces sideways and leaves. The top edge counts as the
+// sides and the bottom do, for an upright segment only.
+TEST(SegmentObjects, Scope_FrameTopCutsABoxThatStaysAndABoardThatLeaves) {
+    Scene s = pitched_tabletop_scene();
+    s.pitch_rad = 0.9f;  // looking down steeply: the frame's top cuts the table
+    s.table_half_width = 0.8f;
+    s.boxes = {SceneBox{.x = 0.2f, .z = 0.95f, .w = 0.3f, .h = 0.06f, .d = 0.3f},
+               SceneBox{.x = -0.3f, .z = 0.9f, .w = 0.3f, .h = 0.35f, .d = 0.02f, .r = 40, .g = 60, .b = 200}};
+    const PlaneStage st = up_to_the_plane(s);
+    const int W = 320;
+    int box_top = 0, board_top = 0;
+    for (std::size_t p = 0; p < static_cast<std::size_t>(W); ++p) {
+        box_top += st.truth[p] == kTruthBox0;
+        board_top += st.truth[p] == kTruthBox0 + 1;
+    }
+    ASSERT_GT(box_top, 10) << "the frame's top should cut the box (test premise)";
+    ASSERT_GT(board_top, 10) << "the frame's top should cut the board (test premise)";
+    SegmentParams no_edges;  // nothing leaves through its outline: the board is held
+    no_edges.scope.max_outside = 1;
+    int box = 0, board = 0;
+    const LabelImage held = segment(st, no_edges);
+    dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
+    ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &box), 0.9);
+    EXPECT_NE(box, 0) << "the box the frame's top cuts was left out";
+    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
+    EXPECT_EQ(board, 0) << "the upright board the frame's top cuts is an object";
+    EXPECT_EQ(stats.scope.out_of_scope, 1);
+}
