@@ -257,10 +257,11 @@ void sum_points(const Ctx& x, const FrameEdge& fe, SegmentBuffers& ws) {
 /// support (ws.scope_lo, scope_hi), points over the height limit (scope_high), pixels
 /// (ws.sizes), the sums of its points (scope_sx, sy, sz), outline pairs (scope_outline) and
 /// those that lead out of the volume (scope_outside: into removed points above the support,
-/// beyond the support's middle `far_z`) or into the frame's edges there (scope_frame); the touching segment pairs, once each, into ws.edges. In:
-/// ws.label (1..n with gaps). Cost: one pass over the pixels in strips of rows, a strip per
-/// thread, the counts gathered (O(strips n)), a sort of the pairs, and with more than one
-/// strip a pass over the labelled rows for the sums.
+/// beyond the support's middle `far_z`) or into the frame's edges there (scope_frame); the
+/// touching segment pairs, once each, into ws.edges. In: ws.label (1..n with gaps). Cost: one
+/// pass over the pixels in strips of rows, a strip per thread, the counts gathered (O(strips
+/// n)), a sort of the pairs, and with more than one strip a pass over the labelled rows for
+/// the sums.
 void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far_z, SegmentBuffers& ws,
                    int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
