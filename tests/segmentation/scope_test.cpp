@@ -1,6 +1,8 @@
 // The scope (src/segmentation/scope.cpp): what the support holds stays, what it does not leaves.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "segment_scene.hpp"
 
 using namespace wul3d;
@@ -100,6 +102,30 @@ TEST(SegmentObjects, Scope_BoxWhoseSidesAreUnseenStays) {
     EXPECT_EQ(stats.segments, 2);
 }
 
+namespace {
+
+// The frame-cut scenes below: the box (kTruthBox0) and an upright board (kTruthBox0 + 1)
+// that `edge` cuts. The board would be held but for the frame (the premise); by default the
+// box stays and the board leaves, the one segment left out.
+void expect_box_stays_and_board_leaves(const PlaneStage& st, const std::string& edge) {
+    SegmentParams no_edges;  // nothing leaves through its outline: the board is held
+    no_edges.scope.max_outside = 1;
+    int box = 0, board = 0;
+    const LabelImage held = segment(st, no_edges);
+    dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
+    ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
+
+    SegmentStats stats;
+    const LabelImage out = segment(st, SegmentParams{}, &stats);
+    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &box), 0.9);
+    EXPECT_NE(box, 0) << "the box " << edge << " cuts was left out";
+    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
+    EXPECT_EQ(board, 0) << "the upright board " << edge << " cuts is an object";
+    EXPECT_EQ(stats.scope.out_of_scope, 1);
+}
+
+}  // namespace
+
 // On the far half of the table, the frame's right edge cuts a box and its left edge a board
 // standing upright (a wall's stand-in). The box shows its top: an object the frame cuts,
 // which stays. The board faces sideways: like a wall, it leaves the support's volume through
@@ -120,23 +146,11 @@ TEST(SegmentObjects, Scope_FrameCutsABoxThatStaysAndABoardThatLeaves) {
     ASSERT_TRUE(box_at_edge && board_at_edge) << "the frame should cut both (test premise)";
     SegmentParams every;
     every.scope.upright_share = 0;
-    int box = 0, board = 0;
+    int box = 0;
     const LabelImage before = segment(st, every);
     dominant_share(before.labels, st.truth, kTruthBox0, &box);
     ASSERT_EQ(box, 0) << "counting the frame's sides for every segment should leave the box out (test premise)";
-    SegmentParams no_edges;  // nothing leaves through its outline: the board is held
-    no_edges.scope.max_outside = 1;
-    const LabelImage held = segment(st, no_edges);
-    dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
-    ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
-
-    SegmentStats stats;
-    const LabelImage out = segment(st, SegmentParams{}, &stats);
-    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &box), 0.9);
-    EXPECT_NE(box, 0) << "the box the frame cuts was left out";
-    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
-    EXPECT_EQ(board, 0) << "the upright board the frame cuts is an object";
-    EXPECT_EQ(stats.scope.out_of_scope, 1);
+    expect_box_stays_and_board_leaves(st, "the frame");
 }
 
 // The same lift on a box that touches another in the image (a small box in front of a tall
@@ -289,18 +303,5 @@ TEST(SegmentObjects, Scope_FrameTopCutsABoxThatStaysAndABoardThatLeaves) {
     }
     ASSERT_GT(box_top, 10) << "the frame's top should cut the box (test premise)";
     ASSERT_GT(board_top, 10) << "the frame's top should cut the board (test premise)";
-    SegmentParams no_edges;  // nothing leaves through its outline: the board is held
-    no_edges.scope.max_outside = 1;
-    int box = 0, board = 0;
-    const LabelImage held = segment(st, no_edges);
-    dominant_share(held.labels, st.truth, kTruthBox0 + 1, &board);
-    ASSERT_NE(board, 0) << "the board should be held but for the frame (test premise)";
-
-    SegmentStats stats;
-    const LabelImage out = segment(st, SegmentParams{}, &stats);
-    EXPECT_GT(dominant_share(out.labels, st.truth, kTruthBox0, &box), 0.9);
-    EXPECT_NE(box, 0) << "the box the frame's top cuts was left out";
-    dominant_share(out.labels, st.truth, kTruthBox0 + 1, &board);
-    EXPECT_EQ(board, 0) << "the upright board the frame's top cuts is an object";
-    EXPECT_EQ(stats.scope.out_of_scope, 1);
+    expect_box_stays_and_board_leaves(st, "the frame's top");
 }

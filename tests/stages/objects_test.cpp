@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <utility>
+
 #include "synthetic_scene.hpp"
 #include "wul3d/background.hpp"
 #include "wul3d/clustering.hpp"
@@ -251,28 +255,48 @@ TEST(ObjectTracker, ObjectsRearranged_StartNewTracks_ASlidingObjectDoesNot) {
     EXPECT_EQ(slid.second, 1);
 }
 
+namespace {
+
+// `frames` frames of a W x 20 scene whose depth and segment label depend on the column only
+// (column(frame, u) -> {z, label}; every pixel has depth; the segments are counted as the
+// largest label), through `tracker`. Returns the last frame's object labels, its objects in
+// `list`.
+template <class Column>
+LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column column,
+                               std::vector<DetectedObject>& list) {
+    OrganizedCloud cloud;
+    cloud.resize(W, 20);
+    const std::size_t N = static_cast<std::size_t>(W) * 20;
+    LabelImage segments{W, 20, std::vector<std::uint16_t>(N, 0)}, objects;
+    for (int frame = 0; frame < frames; ++frame) {
+        int n = 0;
+        for (std::size_t p = 0; p < N; ++p) {
+            const auto [z, label] = column(frame, static_cast<int>(p % static_cast<std::size_t>(W)));
+            cloud.valid[p] = 1;
+            cloud.z[p] = z;
+            segments.labels[p] = label;
+            n = std::max<int>(n, label);
+        }
+        tracker.step(cloud, segments, n, LabelImage{}, objects, list);
+    }
+    return objects;
+}
+
+}  // namespace
+
 // A pixel whose surface changed forgets its weights: with psi = 0.5 a pixel that held the
 // left object for many frames would need two frames of evidence to change object, but when
 // the other object arrives over it (depth moved) it changes at once.
 TEST(ObjectTracker, PixelWhoseSurfaceChanged_TakesTheNewObjectAtOnce) {
     ObjectTracker tracker(ObjectParams{});
-    OrganizedCloud cloud;
-    cloud.resize(60, 20);
-    const std::size_t N = 60 * 20;
-    LabelImage segments{60, 20, std::vector<std::uint16_t>(N, 0)}, objects;
     std::vector<DetectedObject> list;
     // Two blocks side by side at 1 m; then the right one grows over columns 25-29, which
     // come 10 cm nearer (a new surface), while the left one keeps columns 10-24.
-    for (int frame = 0; frame < 6; ++frame) {
+    const LabelImage objects = track_column_frames(tracker, 60, 6, [](int frame, int u) {
         const int boundary = frame < 5 ? 30 : 25;
-        for (std::size_t p = 0; p < N; ++p) {
-            const int u = static_cast<int>(p % 60);
-            cloud.valid[p] = 1;
-            cloud.z[p] = (frame == 5 && u >= 25 && u < 30) ? 0.9f : 1.0f;
-            segments.labels[p] = u < 10 ? 0 : (u < boundary ? 1 : 2);
-        }
-        tracker.step(cloud, segments, 2, LabelImage{}, objects, list);
-    }
+        const float z = (frame == 5 && u >= 25 && u < 30) ? 0.9f : 1.0f;
+        return std::pair<float, std::uint16_t>(z, u < 10 ? 0 : (u < boundary ? 1 : 2));
+    }, list);
     ASSERT_EQ(list.size(), 2u);
     const std::uint16_t right = objects.labels[45], left = objects.labels[15];
     EXPECT_NE(right, left);
@@ -286,24 +310,14 @@ TEST(ObjectTracker, PixelWhoseSurfaceChanged_TakesTheNewObjectAtOnce) {
 // the new object's. A third object stands by, unchanged: not a scene rearranged.
 TEST(ObjectTracker, ObjectPutDownOnAnother_BothKeepTheirOwnTracks) {
     ObjectTracker tracker(ObjectParams{});
-    OrganizedCloud cloud;
-    cloud.resize(100, 20);
-    const std::size_t N = 100 * 20;
-    LabelImage segments{100, 20, std::vector<std::uint16_t>(N, 0)}, objects;
     std::vector<DetectedObject> list;
     // A board over columns 10-49 at 1 m, an object over 55-99; then a box on the board's
     // columns 20-49, 10 cm nearer.
-    for (int frame = 0; frame < 6; ++frame) {
-        const bool box = frame == 5;
-        for (std::size_t p = 0; p < N; ++p) {
-            const int u = static_cast<int>(p % 100);
-            const bool on_box = box && u >= 20 && u < 50;
-            cloud.valid[p] = 1;
-            cloud.z[p] = on_box ? 0.9f : 1.0f;
-            segments.labels[p] = u < 10 || (u >= 50 && u < 55) ? 0 : (u >= 55 ? 1 : (on_box ? 3 : 2));
-        }
-        tracker.step(cloud, segments, box ? 3 : 2, LabelImage{}, objects, list);
-    }
+    const LabelImage objects = track_column_frames(tracker, 100, 6, [](int frame, int u) {
+        const bool on_box = frame == 5 && u >= 20 && u < 50;
+        const std::uint16_t label = u < 10 || (u >= 50 && u < 55) ? 0 : (u >= 55 ? 1 : (on_box ? 3 : 2));
+        return std::pair<float, std::uint16_t>(on_box ? 0.9f : 1.0f, label);
+    }, list);
     ASSERT_EQ(list.size(), 3u);
     EXPECT_EQ(tracker.scene_cuts(), 0);
     const std::uint16_t board = objects.labels[15], on_top = objects.labels[35];
