@@ -13,6 +13,8 @@
 #include <limits>
 #include <optional>
 
+#include <omp.h>
+
 #include "../branch_free.hpp"
 #include "../circle_fit.hpp"
 #include "internal.hpp"
@@ -869,11 +871,20 @@ int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, i
     // so that the labels do not depend on the threads.
     order_by_size(prm, ws, n);
     const auto n_tried = static_cast<std::ptrdiff_t>(ws.by_size.size());
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::ptrdiff_t t = 0; t < n_tried; ++t) {
+    auto try_segment = [&](std::ptrdiff_t t) {
         const int l = ws.by_size[static_cast<std::size_t>(t)];
         const PlaneAxes* axes = plane_xy ? &*plane_xy : nullptr;
         ws.split[static_cast<std::size_t>(l)] = try_colour_split(x, support, axes, features, cp, cos_crease, ws, l);
+    };
+    // Inside a team (the pipeline's two halves side by side, Pipeline::Impl::run_on) the
+    // segments go out as tasks, which the other half's thread takes once its own work is done;
+    // elsewhere the threads share them in a loop.
+    if (omp_in_parallel()) {
+#pragma omp taskloop grainsize(1)
+        for (std::ptrdiff_t t = 0; t < n_tried; ++t) try_segment(t);
+    } else {
+#pragma omp parallel for schedule(dynamic, 1)
+        for (std::ptrdiff_t t = 0; t < n_tried; ++t) try_segment(t);
     }
     return number_splits(ws, n, by_material);
 }

@@ -218,28 +218,34 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     }
     // On two threads the plane and segmentation stages leave one idle for half their time
     // (their flood fills are serial), so they may run beside the clustering, each on one
-    // thread (nested loops run on the thread that meets them). Whether that pays depends on
-    // the frame (SideBySideChoice). With more threads every stage's loops use them all: the
-    // stages run one after the other.
+    // thread (nested loops run on the thread that meets them). The clustering's half is the
+    // shorter: its thread then waits at the region's end, where it takes the colour cue's
+    // segments, which that stage hands out as tasks inside a team. Whether that pays depends
+    // on the frame (SideBySideChoice). With more threads every stage's loops use them all:
+    // the stages run one after the other.
     const bool may_overlap = params.segmentation.segmenter != Segmenter::Kmeans &&
                              omp_get_max_threads() == 2 && !omp_in_parallel();
     const bool side_by_side = may_overlap && side_by_side_.next();
     t = Clock::now();
     if (side_by_side) {
-        std::exception_ptr failed[2];  // an exception may not leave an OpenMP section
-#pragma omp parallel sections num_threads(2)
+        std::exception_ptr failed[2];  // an exception may not leave an OpenMP region
+#pragma omp parallel num_threads(2)
         {
-#pragma omp section
-            try {
-                cluster_and_colour(frame, r);
-            } catch (...) {
-                failed[0] = std::current_exception();
+            // Thread 1 clusters, thread 0 does the rest (both, in a team of one).
+            const int me = omp_get_thread_num();
+            if (me == 1 || omp_get_num_threads() == 1) {
+                try {
+                    cluster_and_colour(frame, r);
+                } catch (...) {
+                    failed[0] = std::current_exception();
+                }
             }
-#pragma omp section
-            try {
-                plane_and_segments(frame, r);
-            } catch (...) {
-                failed[1] = std::current_exception();
+            if (me == 0) {
+                try {
+                    plane_and_segments(frame, r);
+                } catch (...) {
+                    failed[1] = std::current_exception();
+                }
             }
         }
         for (const auto& e : failed)

@@ -193,7 +193,8 @@ Segmented segment_at(const SegmentParams& params, const OrganizedCloud& cloud, c
 }
 
 /// segment_objects at 1, 2, 3, 5 and 8 threads, each segmenter, a workspace per thread count
-/// reused over two calls: the same labels and statistics as one thread.
+/// reused over two calls, and called inside a team of 2 and of 3: the same labels and
+/// statistics as one thread.
 void expect_same_at_any_thread_count(const OrganizedCloud& cloud, const NormalMap& normals,
                                      const std::vector<std::uint8_t>& classes, const Plane* support,
                                      const LabelImage& clusters, const std::string& what) {
@@ -212,6 +213,16 @@ void expect_same_at_any_thread_count(const OrganizedCloud& cloud, const NormalMa
             for (int call = 0; call < 2; ++call)
                 EXPECT_TRUE(segment_at(params, cloud, normals, classes, support, clusters, ws) == one)
                     << what << ", " << segmenter_name(segmenter) << ", " << threads << " threads, call " << call;
+        }
+        // Called by one thread of a team, as beside the pipeline's clustering: the colour cue
+        // hands its segments out as tasks, which the team's other threads take.
+        for (const int team : {2, 3}) {
+            SegmentWorkspace ws;
+            Segmented inside;
+#pragma omp parallel num_threads(team)
+#pragma omp single
+            inside = segment_at(params, cloud, normals, classes, support, clusters, ws);
+            EXPECT_TRUE(inside == one) << what << ", " << segmenter_name(segmenter) << ", a team of " << team;
         }
     }
 }

@@ -267,7 +267,7 @@ TEST(Pipeline, SwapImages_TheNextFrameWritesEveryPixelOfWhatItGets) {
 }
 
 // An error inside the stages that run side by side reaches the caller as itself (an exception
-// may not leave an OpenMP section): a first frame with fewer points in range than k.
+// may not leave an OpenMP region): a first frame with fewer points in range than k.
 TEST(Pipeline, ErrorBesideTheObjectStagesReachesTheCaller) {
     RgbdFrame f;
     f.name = "far";
