@@ -229,24 +229,19 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     t = Clock::now();
     if (side_by_side) {
         std::exception_ptr failed[2];  // an exception may not leave an OpenMP region
+        auto run_half = [&](int half, auto&& part) {
+            try {
+                part();
+            } catch (...) {
+                failed[half] = std::current_exception();
+            }
+        };
 #pragma omp parallel num_threads(2)
         {
             // Thread 1 clusters, thread 0 does the rest (both, in a team of one).
             const int me = omp_get_thread_num();
-            if (me == 1 || omp_get_num_threads() == 1) {
-                try {
-                    cluster_and_colour(frame, r);
-                } catch (...) {
-                    failed[0] = std::current_exception();
-                }
-            }
-            if (me == 0) {
-                try {
-                    plane_and_segments(frame, r);
-                } catch (...) {
-                    failed[1] = std::current_exception();
-                }
-            }
+            if (me == 1 || omp_get_num_threads() == 1) run_half(0, [&] { cluster_and_colour(frame, r); });
+            if (me == 0) run_half(1, [&] { plane_and_segments(frame, r); });
         }
         for (const auto& e : failed)
             if (e) std::rethrow_exception(e);
