@@ -17,6 +17,7 @@
 
 #include "../branch_free.hpp"
 #include "../circle_fit.hpp"
+#include "../team_tasks.hpp"
 #include "internal.hpp"
 #include "wul3d/clustering.hpp"  // ClusterParams: the colour cue's alpha and delta
 
@@ -848,14 +849,47 @@ int number_splits(SegmentBuffers& ws, int n, int& by_material) {
     return splits;
 }
 
-/// One round of the colour cue over the segments marked in ws.to_try (1..n): tries to split
-/// each in two, then numbers part 1 of each split segment n + 1, n + 2, ... in segment order.
-/// Returns the splits, and adds those by material to `by_material`. Cost: a counting sort
-/// and a gather of the object pixels (parallel passes), then O(segment pixels) per 2-means
-/// iteration per segment tried, segments in parallel.
+/// The next round's pixels by segment, from this round's: ws.order and ws.offsets over
+/// labels 1..n + found hold only the parts of the segments this round split (part 0 keeps
+/// label l, part 1 is the label number_splits gave it), each in raster order as
+/// sort_pixels_by_segment would put them; every other segment is empty. In: ws.split,
+/// ws.part_in_order. Cost: one pass over the split segments' pixels, O(n) more.
+void sort_split_parts(SegmentBuffers& ws, int n, int found) {
+    const std::size_t L = static_cast<std::size_t>(n + found) + 1;
+    std::vector<int>& size = ws.remap;
+    size.assign(L, 0);
+    for (int l = 1, id = n; l <= n; ++l) {
+        if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
+        const int o = ws.offsets[static_cast<std::size_t>(l)], m = segment_size(ws, l);
+        const std::uint8_t* const part = ws.part_in_order.data() + o;
+        const int in_part1 = static_cast<int>(std::count(part, part + m, std::uint8_t{1}));
+        size[static_cast<std::size_t>(l)] = m - in_part1;
+        size[static_cast<std::size_t>(++id)] = in_part1;
+    }
+    std::vector<int>& next = ws.next_offsets;
+    next.assign(L + 1, 0);
+    for (std::size_t l = 1; l < L; ++l) next[l + 1] = next[l] + size[l];
+    std::vector<int>& order = ws.next_order;
+    order.resize(static_cast<std::size_t>(next[L]));
+    for (int l = 1, id = n; l <= n; ++l) {
+        if (ws.split[static_cast<std::size_t>(l)] == kNotSplit) continue;
+        const int o = ws.offsets[static_cast<std::size_t>(l)], m = segment_size(ws, l);
+        int at[2] = {next[static_cast<std::size_t>(l)], next[static_cast<std::size_t>(++id)]};
+        for (int i = 0; i < m; ++i)
+            order[static_cast<std::size_t>(at[ws.part_in_order[static_cast<std::size_t>(o + i)]]++)] =
+                ws.order[static_cast<std::size_t>(o + i)];
+    }
+    ws.offsets.swap(next);
+    ws.order.swap(order);
+}
+
+/// One round of the colour cue over the segments marked in ws.to_try (1..n), whose pixels
+/// ws.order and ws.offsets hold by segment: tries to split each in two, then numbers part 1
+/// of each split segment n + 1, n + 2, ... in segment order. Returns the splits, and adds
+/// those by material to `by_material`. Cost: a gather of the sorted pixels (a parallel pass),
+/// then O(segment pixels) per 2-means iteration per segment tried, segments in parallel.
 int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, int& by_material) {
     const SegmentParams& prm = x.prm;
-    sort_pixels_by_segment(x, ws, n);
     // part is written for a segment's pixels before anything reads them: no clearing.
     ws.part.resize(static_cast<std::size_t>(x.W) * x.H);
     ws.part_in_order.resize(static_cast<std::size_t>(ws.offsets[static_cast<std::size_t>(n) + 1]));
@@ -876,16 +910,8 @@ int split_round(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, i
         const PlaneAxes* axes = plane_xy ? &*plane_xy : nullptr;
         ws.split[static_cast<std::size_t>(l)] = try_colour_split(x, support, axes, features, cp, cos_crease, ws, l);
     };
-    // Inside a team (the pipeline's two halves side by side, Pipeline::Impl::run_on) the
-    // segments go out as tasks, which the other half's thread takes once its own work is done;
-    // elsewhere the threads share them in a loop.
-    if (omp_in_parallel()) {
-#pragma omp taskloop grainsize(1)
-        for (std::ptrdiff_t t = 0; t < n_tried; ++t) try_segment(t);
-    } else {
-#pragma omp parallel for schedule(dynamic, 1)
-        for (std::ptrdiff_t t = 0; t < n_tried; ++t) try_segment(t);
-    }
+    // Inside a team the other half's thread takes a share once its own work is done.
+    for_each_part(n_tried, Spread::kDynamic, try_segment);
     return number_splits(ws, n, by_material);
 }
 
@@ -909,15 +935,17 @@ constexpr int kColourRounds = 3;
 int color_splits(const Ctx& x, const Plane* support, SegmentBuffers& ws, int n, int& by_material) {
     by_material = 0;
     ws.to_try.assign(static_cast<std::size_t>(n) + 1, 1);
+    sort_pixels_by_segment(x, ws, n);
     int splits = 0;
     for (int round = 0; round < kColourRounds; ++round) {
         const int found = split_round(x, support, ws, n, by_material);
         if (found == 0) break;
         // The next round: the segments split in this one (part 0 kept their label) and their
-        // new parts.
+        // new parts, the only pixels it sorts.
         ws.to_try.assign(static_cast<std::size_t>(n + found) + 1, 0);
         for (int l = 1; l <= n; ++l) ws.to_try[static_cast<std::size_t>(l)] = ws.split[static_cast<std::size_t>(l)] != kNotSplit;
         for (int l = n + 1; l <= n + found; ++l) ws.to_try[static_cast<std::size_t>(l)] = 1;
+        if (round + 1 < kColourRounds) sort_split_parts(ws, n, found);
         n += found;
         splits += found;
     }

@@ -65,6 +65,7 @@ struct SegmentWorkspace::Buffers {
     std::vector<int> strip_rows;
     std::vector<std::uint8_t> part;    ///< colour cue: 2-means part per pixel
     std::vector<std::uint8_t> part_in_order;  ///< ... and per position in `order`
+    std::vector<int> next_order, next_offsets;  ///< colour cue: the next round's sort
     std::vector<float> feature;        ///< colour cue: 6 planes, segment pixels in `order`
     std::vector<std::uint8_t> split;   ///< colour cue: 1 = split segment l
     std::vector<std::uint8_t> to_try;  ///< colour cue: 1 = try segment l this round
