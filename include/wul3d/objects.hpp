@@ -81,6 +81,11 @@ public:
     /// them, as in ClusterState.
     void step(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments,
               const LabelImage& clusters, LabelImage& objects, std::vector<DetectedObject>& out);
+    /// step()'s first phase, the one that needs only the frame's cloud: where the surfaces
+    /// changed since the last frame, and whether the scene cut. A caller with a thread free
+    /// before the segments are ready may call it then, with the cloud it passes to step()
+    /// next; else step() calls it. The same results either way.
+    void observe(const OrganizedCloud& cloud);
     void reset();
 
     const ObjectParams& params() const { return params_; }
@@ -118,6 +123,7 @@ private:
     // State across frames.
     int width_ = 0, height_ = 0;
     std::int64_t tau_ = 0;
+    const OrganizedCloud* observed_ = nullptr;  ///< the cloud observe() saw, until step()
     int next_id_ = 1;
     int scene_cuts_ = 0;
     std::vector<Track> tracks_;           ///< max_tracks slots

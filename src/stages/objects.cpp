@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "branch_free.hpp"
 #include "param_check.hpp"
 #include "point_moments.hpp"
+#include "team_tasks.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -130,6 +132,7 @@ ObjectTracker::ObjectTracker(const ObjectParams& params)
 }
 
 void ObjectTracker::reset() {
+    observed_ = nullptr;
     std::fill(mu_.begin(), mu_.end(), PixelWeights{});
     std::fill(has_mu_.begin(), has_mu_.end(), 0);
     tracks_.assign(static_cast<std::size_t>(params_.max_tracks), Track{});
@@ -152,11 +155,12 @@ void ObjectTracker::free_slot(int slot) {
 void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments,
                          const LabelImage& clusters, LabelImage& objects,
                          std::vector<DetectedObject>& out) {
-    if (!s_) s_ = std::make_unique<Scratch>();  // a moved-from tracker, used again
-    if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
-    // Pixels whose surface changed neither vote for the matching nor keep their weights (in
-    // measure_segments and weigh_pixels); a scene cut forgets everything.
-    if (mark_surface_changes(cloud)) start_afresh();
+    if (observed_ == nullptr) observe(cloud);
+    if (observed_ != &cloud) {
+        observed_ = nullptr;
+        throw std::invalid_argument("ObjectTracker::step: not the cloud that observe() was given");
+    }
+    observed_ = nullptr;
     ++tau_;
 
     // Segments to track slots: by the weight mass they overlap, else by distance, else new.
@@ -177,6 +181,15 @@ void ObjectTracker::step(const OrganizedCloud& cloud, const LabelImage& segments
 
     // What the next frame matches against.
     follow_tracks();
+}
+
+void ObjectTracker::observe(const OrganizedCloud& cloud) {
+    if (!s_) s_ = std::make_unique<Scratch>();  // a moved-from tracker, used again
+    if (cloud.width != width_ || cloud.height != height_) allocate(cloud.width, cloud.height);
+    // Pixels whose surface changed neither vote for the matching nor keep their weights (in
+    // measure_segments and weigh_pixels); a scene cut forgets everything.
+    if (mark_surface_changes(cloud)) start_afresh();
+    observed_ = &cloud;
 }
 
 // New resolution: per-pixel state sized to N and everything forgotten, as reset().
@@ -246,17 +259,18 @@ bool ObjectTracker::mark_surface_changes(const OrganizedCloud& cloud) {
     const std::size_t N = cloud.size();
     std::size_t both = 0, moved = 0, held = 0, held_moved = 0;
     const float rgb2 = params_.surface_change_rgb * params_.surface_change_rgb;
-    // Ranges of pixels spread over the threads; each call counts in unsigned, the sums
-    // are size_t.
-    constexpr std::size_t kRange = 4096;
-    const auto ranges = static_cast<std::ptrdiff_t>((N + kRange - 1) / kRange);
-#pragma omp parallel for schedule(static) reduction(+ : both, moved, held, held_moved)
-    for (std::ptrdiff_t i = 0; i < ranges; ++i) {
-        const std::size_t p0 = static_cast<std::size_t>(i) * kRange, p1 = std::min(N, p0 + kRange);
-        const SurfaceCounts c = surface_changes(
+    // Bands of pixels spread over the threads (as tasks inside a team: observe() may run
+    // beside the segmentation); each call counts in unsigned, the sums are size_t.
+    SurfaceCounts band_counts[kBands];
+    detail::for_each_part(kBands, detail::Spread::kStatic, [&](std::ptrdiff_t band) {
+        const std::size_t p0 = N * static_cast<std::size_t>(band) / kBands,
+                          p1 = N * static_cast<std::size_t>(band + 1) / kBands;
+        band_counts[band] = surface_changes(
             p0, p1, cloud.valid.data(), cloud.z.data(), cloud.r.data(), cloud.g.data(), cloud.b.data(),
             has_mu_.data(), rgb2, params_.surface_change_m, params_.surface_change_rel, prev_z_.data(),
             prev_r_.data(), prev_g_.data(), prev_b_.data(), s_->changed.data());
+    });
+    for (const SurfaceCounts& c : band_counts) {
         both += c.both;
         moved += c.moved;
         held += c.held;
@@ -271,11 +285,17 @@ bool ObjectTracker::mark_surface_changes(const OrganizedCloud& cloud) {
 }
 
 // A scene cut: weights, changes and tracks forgotten; track ids go on counting.
-// Cost: O(N), no allocation.
+// Cost: O(N), in ranges of pixels that fall to the threads as weigh_pixels' do (where the
+// weights are read next), no allocation.
 void ObjectTracker::start_afresh() {
-    std::fill(mu_.begin(), mu_.end(), PixelWeights{});
-    std::fill(has_mu_.begin(), has_mu_.end(), 0);
-    std::fill(s_->changed.begin(), s_->changed.end(), 0);
+    const std::size_t N = mu_.size();
+    detail::for_each_part(kBands, detail::Spread::kStatic, [&](std::ptrdiff_t band) {
+        const std::size_t p0 = N * static_cast<std::size_t>(band) / kBands,
+                          p1 = N * static_cast<std::size_t>(band + 1) / kBands;
+        std::fill(mu_.data() + p0, mu_.data() + p1, PixelWeights{});
+        std::fill(has_mu_.data() + p0, has_mu_.data() + p1, std::uint8_t{0});
+        std::fill(s_->changed.data() + p0, s_->changed.data() + p1, std::uint8_t{0});
+    });
     tracks_.assign(static_cast<std::size_t>(params_.max_tracks), Track{});
     ++scene_cuts_;
 }

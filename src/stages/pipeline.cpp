@@ -96,6 +96,10 @@ struct Pipeline::Impl {
     /// and the segments (which read no cluster label but with the kmeans segmenter).
     void cluster_and_colour(const RgbdView& frame, FrameResult& r);
     void plane_and_segments(const RgbdView& frame, FrameResult& r);
+    /// The objects stage's first phase (ObjectTracker::observe), which needs only the cloud:
+    /// beside the segmentation when the halves run side by side. Times it into
+    /// r.times.objects.
+    void observe_surfaces(FrameResult& r);
 
     detail::SideBySideChoice side_by_side_;  ///< whether run_on's two parts run side by side
     PipelineParams params_;
@@ -219,10 +223,10 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     // On two threads the plane and segmentation stages leave one idle for half their time
     // (their flood fills are serial), so they may run beside the clustering, each on one
     // thread (nested loops run on the thread that meets them). The clustering's half is the
-    // shorter: its thread then waits at the region's end, where it takes the colour cue's
-    // segments, which that stage hands out as tasks inside a team. Whether that pays depends
-    // on the frame (SideBySideChoice). With more threads every stage's loops use them all:
-    // the stages run one after the other.
+    // shorter: its thread then observes the surfaces for the objects stage, and waits at the
+    // region's end, where it takes the colour cue's segments, which that stage hands out as
+    // tasks inside a team. Whether that pays depends on the frame (SideBySideChoice). With
+    // more threads every stage's loops use them all: the stages run one after the other.
     const bool may_overlap = params.segmentation.segmenter != Segmenter::Kmeans &&
                              omp_get_max_threads() == 2 && !omp_in_parallel();
     const bool side_by_side = may_overlap && side_by_side_.next();
@@ -240,7 +244,10 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
         {
             // Thread 1 clusters, thread 0 does the rest (both, in a team of one).
             const int me = omp_get_thread_num();
-            if (me == 1 || omp_get_num_threads() == 1) run_half(0, [&] { cluster_and_colour(frame, r); });
+            if (me == 1 || omp_get_num_threads() == 1) run_half(0, [&] {
+                cluster_and_colour(frame, r);
+                observe_surfaces(r);
+            });
             if (me == 0) run_half(1, [&] { plane_and_segments(frame, r); });
         }
         for (const auto& e : failed)
@@ -248,18 +255,19 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     } else {
         cluster_and_colour(frame, r);
         plane_and_segments(frame, r);
+        observe_surfaces(r);  // timed with the halves either way, for SideBySideChoice
     }
     const double both_ms = ms_since(t);
     throw_if_stop_requested("the segmentation");
     if (may_overlap) side_by_side_.record(side_by_side, both_ms);
     if (side_by_side)
         r.times.overlap = std::max(0.0, r.times.clustering + r.times.colors + r.times.plane +
-                                            r.times.segmentation - both_ms);
+                                            r.times.segmentation + r.times.objects - both_ms);
 
     t = Clock::now();
     tracker_.step(cloud_, r.segments, r.segment_stats.segments, r.labels, r.objects,
                   r.object_list);
-    r.times.objects = ms_since(t);
+    r.times.objects += ms_since(t);
 }
 
 bool detail::SideBySideChoice::next() const {
@@ -275,6 +283,12 @@ void detail::SideBySideChoice::record(bool side_by_side, double ms) {
     double& best = best_ms_[side_by_side ? 1 : 0];
     best = i < 2 ? ms : std::min(best, ms);
     if (i == 2 * kTrials - 1) side_by_side_ = best_ms_[1] < best_ms_[0];
+}
+
+void Pipeline::Impl::observe_surfaces(FrameResult& r) {
+    const auto t = Clock::now();
+    tracker_.observe(cloud_);
+    r.times.objects = ms_since(t);
 }
 
 void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {

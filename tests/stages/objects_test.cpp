@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <stdexcept>
 #include <utility>
 
 #include "synthetic_scene.hpp"
@@ -202,6 +203,20 @@ TEST(ObjectTracker, MovingBox_KeepsItsTrackIdAndLabelsDoNotFlicker) {
     EXPECT_LT(flicker(run), 0.002);
 }
 
+// step() on another cloud than the one observe() saw would mix two frames: an error, and
+// the tracker goes on (the next step observes its own cloud).
+TEST(ObjectTracker, StepOnAnotherCloudThanObserved_Throws) {
+    ObjectTracker tracker(ObjectParams{});
+    OrganizedCloud a, b;
+    a.resize(40, 30);
+    b.resize(40, 30);
+    LabelImage segments{40, 30, std::vector<std::uint16_t>(1200, 0)}, objects;
+    std::vector<DetectedObject> list;
+    tracker.observe(a);
+    EXPECT_THROW(tracker.step(b, segments, 0, LabelImage{}, objects, list), std::invalid_argument);
+    EXPECT_NO_THROW(tracker.step(b, segments, 0, LabelImage{}, objects, list));
+}
+
 // A folder of unrelated frames is a sequence of scene cuts: each frame starts new tracks.
 TEST(ObjectTracker, SceneCut_StartsNewTracks) {
     ObjectTracker tracker(ObjectParams{});
@@ -260,10 +275,11 @@ namespace {
 // `frames` frames of a W x 20 scene whose depth and segment label depend on the column only
 // (column(frame, u) -> {z, label}; every pixel has depth; the segments are counted as the
 // largest label), through `tracker`. Returns the last frame's object labels, its objects in
-// `list`.
+// `list`. `observe_ahead`: each frame's surfaces observed (ObjectTracker::observe) before
+// step(), as the pipeline does beside the segmentation.
 template <class Column>
 LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column column,
-                               std::vector<DetectedObject>& list) {
+                               std::vector<DetectedObject>& list, bool observe_ahead = false) {
     OrganizedCloud cloud;
     cloud.resize(W, 20);
     const std::size_t N = static_cast<std::size_t>(W) * 20;
@@ -277,6 +293,7 @@ LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column
             segments.labels[p] = label;
             n = std::max<int>(n, label);
         }
+        if (observe_ahead) tracker.observe(cloud);
         tracker.step(cloud, segments, n, LabelImage{}, objects, list);
     }
     return objects;
@@ -286,22 +303,26 @@ LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column
 
 // A pixel whose surface changed forgets its weights: with psi = 0.5 a pixel that held the
 // left object for many frames would need two frames of evidence to change object, but when
-// the other object arrives over it (depth moved) it changes at once.
+// the other object arrives over it (depth moved) it changes at once. The same with the
+// surfaces observed ahead of step(), as the pipeline does.
 TEST(ObjectTracker, PixelWhoseSurfaceChanged_TakesTheNewObjectAtOnce) {
-    ObjectTracker tracker(ObjectParams{});
-    std::vector<DetectedObject> list;
-    // Two blocks side by side at 1 m; then the right one grows over columns 25-29, which
-    // come 10 cm nearer (a new surface), while the left one keeps columns 10-24.
-    const LabelImage objects = track_column_frames(tracker, 60, 6, [](int frame, int u) {
-        const int boundary = frame < 5 ? 30 : 25;
-        const float z = (frame == 5 && u >= 25 && u < 30) ? 0.9f : 1.0f;
-        return std::pair<float, std::uint16_t>(z, u < 10 ? 0 : (u < boundary ? 1 : 2));
-    }, list);
-    ASSERT_EQ(list.size(), 2u);
-    const std::uint16_t right = objects.labels[45], left = objects.labels[15];
-    EXPECT_NE(right, left);
-    for (int u = 25; u < 30; ++u) EXPECT_EQ(objects.labels[static_cast<std::size_t>(u)], right) << u;
-    EXPECT_EQ(tracker.scene_cuts(), 0);
+    for (const bool observe_ahead : {false, true}) {
+        SCOPED_TRACE(observe_ahead);
+        ObjectTracker tracker(ObjectParams{});
+        std::vector<DetectedObject> list;
+        // Two blocks side by side at 1 m; then the right one grows over columns 25-29, which
+        // come 10 cm nearer (a new surface), while the left one keeps columns 10-24.
+        const LabelImage objects = track_column_frames(tracker, 60, 6, [](int frame, int u) {
+            const int boundary = frame < 5 ? 30 : 25;
+            const float z = (frame == 5 && u >= 25 && u < 30) ? 0.9f : 1.0f;
+            return std::pair<float, std::uint16_t>(z, u < 10 ? 0 : (u < boundary ? 1 : 2));
+        }, list, observe_ahead);
+        ASSERT_EQ(list.size(), 2u);
+        const std::uint16_t right = objects.labels[45], left = objects.labels[15];
+        EXPECT_NE(right, left);
+        for (int u = 25; u < 30; ++u) EXPECT_EQ(objects.labels[static_cast<std::size_t>(u)], right) << u;
+        EXPECT_EQ(tracker.scene_cuts(), 0);
+    }
 }
 
 // An object put down on another (a box on a board) covers most of it: its pixels held the
