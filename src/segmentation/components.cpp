@@ -9,6 +9,7 @@
 
 #include <omp.h>
 
+#include "../team_tasks.hpp"
 #include "internal.hpp"
 #include "wul3d/plane.hpp"
 
@@ -297,6 +298,10 @@ int row_strips(int rows) {
     return omp_in_parallel() ? 1 : std::max(1, std::min(omp_get_max_threads(), rows / 8));
 }
 
+int team_strips(int rows) {
+    return omp_in_parallel() ? std::max(1, std::min(omp_get_num_threads(), rows / 8)) : row_strips(rows);
+}
+
 void relabel_to_roots(SegmentBuffers& ws) {
     int* const parent = ws.parent.data();
     const auto n = static_cast<int>(ws.parent.size());
@@ -333,15 +338,14 @@ std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
 /// parallel passes over the pixels, O(bands n + n log n) between them.
 int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out) {
     // Bands of 512 pixels at least (row_strips' 8 rows of 64).
-    const int bands = row_strips(static_cast<int>(std::min<std::size_t>(ws.label.size(), 1u << 30) / 64));
+    const int bands = team_strips(static_cast<int>(std::min<std::size_t>(ws.label.size(), 1u << 30) / 64));
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const std::size_t B = (L + 15) / 16 * 16;  // a band's row, whole cache lines (no false sharing)
     const auto N = static_cast<std::ptrdiff_t>(ws.label.size());
     ws.sizes.assign(static_cast<std::size_t>(bands) * B, 0);  // per band: pixels
     ws.offsets.resize(static_cast<std::size_t>(bands) * B);   // per band: first pixel, valid where it has pixels
     int* const label = ws.label.data();
-#pragma omp parallel for schedule(static)
-    for (int band = 0; band < bands; ++band) {
+    for_each_part(bands, Spread::kStatic, [&](std::ptrdiff_t band) {
         int* const count = ws.sizes.data() + static_cast<std::size_t>(band) * B;
         int* const first = ws.offsets.data() + static_cast<std::size_t>(band) * B;
         const auto p0 = static_cast<std::size_t>(N * band / bands), p1 = static_cast<std::size_t>(N * (band + 1) / bands);
@@ -349,7 +353,7 @@ int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out) {
             if (count[l] == 0) first[l] = static_cast<int>(p);
             count[l] += static_cast<int>(run);
         });
-    }
+    });
     // Labels in order of their first pixel; the large enough ones numbered in that order.
     ws.order.clear();
     for (std::size_t l = 1; l < L; ++l) {
@@ -371,8 +375,10 @@ int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out) {
     int next = 0;
     for (const int l : ws.order) ws.remap[static_cast<std::size_t>(l)] = ++next;
     const int* const remap = ws.remap.data();
-#pragma omp parallel for schedule(static)
-    for (std::ptrdiff_t p = 0; p < N; ++p) out[p] = static_cast<std::uint16_t>(std::min(remap[label[p]], 65535));
+    for_each_part(bands, Spread::kStatic, [&](std::ptrdiff_t band) {
+        for (std::ptrdiff_t p = N * band / bands; p < N * (band + 1) / bands; ++p)
+            out[p] = static_cast<std::uint16_t>(std::min(remap[label[p]], 65535));
+    });
     return next;
 }
 

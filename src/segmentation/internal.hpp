@@ -318,6 +318,10 @@ void relabel_to_roots(SegmentBuffers& ws);
 /// thread, of 8 rows at least (fewer cost more in joining than they save); 1 inside another
 /// parallel region, or on one thread. What the passes compute does not depend on it.
 int row_strips(int rows);
+/// row_strips, but inside a team one strip per team thread (for_each_part hands them out as
+/// tasks there): for the passes after the colour cue, when the clustering's thread beside
+/// them is done with its own half and can take a share.
+int team_strips(int rows);
 
 /// Calls visit(l, p, run) for each run of equal labels label[p, p + run) in [p0, p1), in
 /// order. A pass pixel by pixel that counted into memory made each pixel wait for the one

@@ -12,6 +12,7 @@
 
 #include <omp.h>
 
+#include "../team_tasks.hpp"
 #include "internal.hpp"
 #include "wul3d/plane.hpp"
 
@@ -99,13 +100,15 @@ DepthSum sum_support_depths(const Ctx& x, const Plane& plane, std::size_t p0, st
 float support_middle_depth(const Ctx& x, const Plane& pl) {
     constexpr int kParts = 16;
     const std::size_t N = x.c.size();
-    if (omp_in_parallel() || omp_get_max_threads() == 1) {  // one thread: in pixel order
+    if (team_strips(x.H) == 1) {  // one thread: in pixel order
         const DepthSum d = sum_support_depths(x, pl, 0, N);
         return d.count > 0 ? static_cast<float>(d.sum / d.count) : 0.0f;
     }
     DepthSum part[kParts];
-#pragma omp parallel for schedule(static)
-    for (int k = 0; k < kParts; ++k) part[k] = sum_support_depths(x, pl, N * k / kParts, N * (k + 1) / kParts);
+    for_each_part(kParts, Spread::kStatic, [&](std::ptrdiff_t k) {
+        part[k] = sum_support_depths(x, pl, N * static_cast<std::size_t>(k) / kParts,
+                                     N * static_cast<std::size_t>(k + 1) / kParts);
+    });
     DepthSum all;
     for (const DepthSum& d : part) {
         all.sum += d.sum, all.count += d.count;
@@ -266,7 +269,7 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
                    int n) {
     const std::size_t L = static_cast<std::size_t>(n) + 1;
     const int rows = std::max(fe.bottom - fe.top, 0);
-    const int strips = row_strips(rows);
+    const int strips = team_strips(rows);
     constexpr float kMax = std::numeric_limits<float>::max();
     ws.scope_strips.assign(static_cast<std::size_t>(strips) * L, ScopeCounts{kMax, -kMax, -1, 0, 0, 0, 0, 0});
     ws.strip_pairs.resize(static_cast<std::size_t>(strips));
@@ -275,13 +278,17 @@ void measure_scope(const Ctx& x, const Plane& pl, const FrameEdge& fe, float far
     ws.scope_sz.assign(L, 0.0);
     double* const sums[3] = {ws.scope_sx.data(), ws.scope_sy.data(), ws.scope_sz.data()};
     const int* const label = ws.label.data();
-#pragma omp parallel for schedule(static) if (strips > 1)
-    for (int s = 0; s < strips; ++s) {
+    auto strip = [&](std::ptrdiff_t s) {
         auto& edges = ws.strip_pairs[static_cast<std::size_t>(s)];
         edges.clear();
-        measure_strip(x, pl, fe, far_z, label, fe.top + rows * s / strips, fe.top + rows * (s + 1) / strips,
-                      ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges, strips == 1 ? sums : nullptr);
-    }
+        const int v0 = fe.top + rows * static_cast<int>(s) / strips, v1 = fe.top + rows * static_cast<int>(s + 1) / strips;
+        measure_strip(x, pl, fe, far_z, label, v0, v1, ws.scope_strips.data() + static_cast<std::size_t>(s) * L, edges,
+                      strips == 1 ? sums : nullptr);
+    };
+    if (strips == 1)
+        strip(0);
+    else
+        for_each_part(strips, Spread::kStatic, strip);
     gather_strips(ws, strips, L);
     if (strips > 1) sum_points(x, fe, ws);
 }
