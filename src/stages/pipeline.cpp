@@ -11,6 +11,7 @@
 
 #include "param_check.hpp"
 #include "side_by_side.hpp"
+#include "weight_colours.hpp"
 #include "wul3d/error.hpp"
 #include "wul3d/stop.hpp"
 
@@ -96,6 +97,12 @@ struct Pipeline::Impl {
     /// and the segments (which read no cluster label but with the kmeans segmenter).
     void cluster_and_colour(const RgbdView& frame, FrameResult& r);
     void plane_and_segments(const RgbdView& frame, FrameResult& r);
+    /// cluster_and_colour's first step (eq. 4-8: r.labels), timed.
+    void cluster(FrameResult& r);
+    /// Its second (eq. 9: r.colors) as OpenMP tasks, for a thread of a team: they run after
+    /// the tasks queued before them (the colour cue's, when the segmentation beside is that
+    /// far), at the latest at the region's end. Their times add up in colour_task_ms_.
+    void colour_as_tasks(const RgbdView& frame, FrameResult& r);
     /// The objects stage's first phase (ObjectTracker::observe), which needs only the cloud:
     /// beside the segmentation when the halves run side by side. Times it into
     /// r.times.objects.
@@ -108,6 +115,9 @@ struct Pipeline::Impl {
     NormalMap normals_;
     std::vector<float> noise_scratch_;  ///< measure_depth_noise's samples
     ClusterState state_;
+    detail::WeightColours colours_;  ///< eq. 9's colours, a band of rows at a time
+    static constexpr int kColourTasks = 8;
+    double colour_task_ms_[kColourTasks] = {};
     ObjectTracker tracker_;
     PlaneWorkspace plane_ws_;
     SegmentWorkspace segment_ws_;
@@ -245,13 +255,15 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
             // Thread 1 clusters, thread 0 does the rest (both, in a team of one).
             const int me = omp_get_thread_num();
             if (me == 1 || omp_get_num_threads() == 1) run_half(0, [&] {
-                cluster_and_colour(frame, r);
+                cluster(r);
                 observe_surfaces(r);
+                colour_as_tasks(frame, r);
             });
             if (me == 0) run_half(1, [&] { plane_and_segments(frame, r); });
         }
         for (const auto& e : failed)
             if (e) std::rethrow_exception(e);
+        for (const double ms : colour_task_ms_) r.times.colors += ms;
     } else {
         cluster_and_colour(frame, r);
         plane_and_segments(frame, r);
@@ -291,13 +303,35 @@ void Pipeline::Impl::observe_surfaces(FrameResult& r) {
     r.times.objects = ms_since(t);
 }
 
-void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {
-    auto t = Clock::now();
+void Pipeline::Impl::cluster(FrameResult& r) {
+    const auto t = Clock::now();
     r.stats = state_.step(cloud_, normals_, r.active, r.labels);
     r.times.clustering = ms_since(t);
-    t = Clock::now();
-    render_weight_colors(state_, r.labels, frame, r.colors);
+}
+
+void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {
+    cluster(r);
+    const auto t = Clock::now();
+    colours_.prepare(state_, r.labels, frame, r.colors);
+    const int H = colours_.height();
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) colours_.rows(v, v + 1);
     r.times.colors = ms_since(t);
+}
+
+void Pipeline::Impl::colour_as_tasks(const RgbdView& frame, FrameResult& r) {
+    const auto t = Clock::now();
+    colours_.prepare(state_, r.labels, frame, r.colors);
+    r.times.colors = ms_since(t);
+    const int H = colours_.height();
+    for (int task = 0; task < kColourTasks; ++task) {
+#pragma omp task firstprivate(task)
+        {
+            const auto t0 = Clock::now();
+            colours_.rows(H * task / kColourTasks, H * (task + 1) / kColourTasks);
+            colour_task_ms_[task] = ms_since(t0);
+        }
+    }
 }
 
 namespace {

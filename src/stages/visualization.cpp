@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "weight_colours.hpp"
 #include "wul3d/error.hpp"
 
 namespace wul3d {
@@ -54,33 +55,40 @@ std::array<std::uint8_t, 3> object_color(int track_id) {
     return hsv_bytes(h, track_id % 2 ? 0.85 : 0.65, 0.95);
 }
 
-void render_weight_colors(const ClusterState& state, const LabelImage& labels,
-                          const RgbdView& frame, ColorImage& out) {
+void detail::WeightColours::prepare(const ClusterState& state, const LabelImage& labels, const RgbdView& frame,
+                                    ColorImage& out) {
     const int W = labels.width, H = labels.height, k = state.params().k;
     out.width = W;
     out.height = H;
     out.rgb.resize(static_cast<std::size_t>(W) * H * 3);
+    colour_.assign(static_cast<std::size_t>(k) * 4, 0.0f);
+    for (int j = 0; j < k; ++j) {
+        const auto c = cluster_color(j);
+        for (int q = 0; q < 3; ++q) colour_[4 * static_cast<std::size_t>(j) + q] = c[q] / PixelWeights::kOne;
+    }
+    const bool grey_ok = frame.has_color() && frame.color_width == W && frame.color_height == H;
+    rgb_ = grey_ok ? frame.rgb : nullptr;
+    state_ = &state;
+    labels_ = &labels;
+    out_ = &out;
+}
+
+void detail::WeightColours::rows(int v0, int v1) const {
+    const int W = labels_->width;
     // Four floats a colour (the fourth 0): a slot's three products and sums are one 4-wide
     // operation each (GCC's and Clang's vector extension), each lane the scalar one.
     using Float4 = float __attribute__((vector_size(16)));
-    std::vector<float> C(static_cast<std::size_t>(k) * 4, 0.0f);
-    for (int j = 0; j < k; ++j) {
-        const auto c = cluster_color(j);
-        for (int q = 0; q < 3; ++q) C[4 * j + q] = c[q] / PixelWeights::kOne;
-    }
-    const bool grey_ok = frame.has_color() && frame.color_width == W && frame.color_height == H;
-    const std::uint8_t* rgb = grey_ok ? frame.rgb : nullptr;
-
     // Raw pointers, read once: through the vectors and the state, each byte stored would
     // make the compiler load them again.
-    const std::uint16_t* const label = labels.labels.data();
-    std::uint8_t* const out_rgb = out.rgb.data();
-    const float* const colour = C.data();
+    const std::uint16_t* const label = labels_->labels.data();
+    std::uint8_t* const out_rgb = out_->rgb.data();
+    const std::uint8_t* const rgb = rgb_;
+    const float* const colour = colour_.data();
+    const ClusterState& state = *state_;
     const PixelWeights* const weights =
         state.grid_width() > 0 && state.grid_height() > 0 ? &state.weights(0) : nullptr;
     const int stride = state.params().stride;
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) {
+    for (int v = v0; v < v1; ++v) {
         // Pixel u's grid point, stepped: a division per pixel cost more than the sum.
         int cell = state.grid_index(0, v), in_cell = 0;
         for (int u = 0; u < W; ++u, in_cell = in_cell + 1 == stride ? 0 : in_cell + 1, cell += in_cell == 0) {
@@ -108,6 +116,15 @@ void render_weight_colors(const ClusterState& state, const LabelImage& labels,
             }
         }
     }
+}
+
+void render_weight_colors(const ClusterState& state, const LabelImage& labels,
+                          const RgbdView& frame, ColorImage& out) {
+    detail::WeightColours colours;
+    colours.prepare(state, labels, frame, out);
+    const int H = labels.height;
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) colours.rows(v, v + 1);
 }
 
 namespace {
