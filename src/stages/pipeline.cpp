@@ -313,9 +313,7 @@ void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {
     cluster(r);
     const auto t = Clock::now();
     colours_.prepare(state_, r.labels, frame, r.colors);
-    const int H = colours_.height();
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) colours_.rows(v, v + 1);
+    colours_.all_rows();
     r.times.colors = ms_since(t);
 }
 

@@ -118,13 +118,17 @@ void detail::WeightColours::rows(int v0, int v1) const {
     }
 }
 
+void detail::WeightColours::all_rows() const {
+    const int H = height();
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) rows(v, v + 1);
+}
+
 void render_weight_colors(const ClusterState& state, const LabelImage& labels,
                           const RgbdView& frame, ColorImage& out) {
     detail::WeightColours colours;
     colours.prepare(state, labels, frame, out);
-    const int H = labels.height;
-#pragma omp parallel for schedule(static)
-    for (int v = 0; v < H; ++v) colours.rows(v, v + 1);
+    colours.all_rows();
 }
 
 namespace {

@@ -19,6 +19,8 @@ public:
     /// Rows [v0, v1) of `out` (render_weight_colors' pixels). After prepare; bands may run in
     /// any order, on any threads. O(W (v1 - v0)).
     void rows(int v0, int v1) const;
+    /// Every row, spread over the threads.
+    void all_rows() const;
     int height() const { return labels_ ? labels_->height : 0; }
 
 private:
