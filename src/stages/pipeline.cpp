@@ -99,9 +99,10 @@ struct Pipeline::Impl {
     void plane_and_segments(const RgbdView& frame, FrameResult& r);
     /// cluster_and_colour's first step (eq. 4-8: r.labels), timed.
     void cluster(FrameResult& r);
-    /// Its second (eq. 9: r.colors) as OpenMP tasks, for a thread of a team: they run after
-    /// the tasks queued before them (the colour cue's, when the segmentation beside is that
-    /// far), at the latest at the region's end. Their times add up in colour_task_ms_.
+    /// Its second (eq. 9: r.colors) as OpenMP tasks of a band of rows each, for a thread of
+    /// a team: either thread may take them, at the latest at the region's end (libgomp runs
+    /// them on the creating thread first; their order is not ours to set). Their times add
+    /// up in colour_task_ms_.
     void colour_as_tasks(const RgbdView& frame, FrameResult& r);
     /// The objects stage's first phase (ObjectTracker::observe), which needs only the cloud:
     /// beside the segmentation when the halves run side by side. Times it into
@@ -233,10 +234,11 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     // On two threads the plane and segmentation stages leave one idle for half their time
     // (their flood fills are serial), so they may run beside the clustering, each on one
     // thread (nested loops run on the thread that meets them). The clustering's half is the
-    // shorter: its thread then observes the surfaces for the objects stage, and waits at the
-    // region's end, where it takes the colour cue's segments, which that stage hands out as
-    // tasks inside a team. Whether that pays depends on the frame (SideBySideChoice). With
-    // more threads every stage's loops use them all: the stages run one after the other.
+    // shorter: its thread then observes the surfaces for the objects stage, hands eq. 9's
+    // colours out as tasks, and waits at the region's end, where it takes those and the
+    // segmentation's tasks (the colour cue's segments, the passes after it). Whether that
+    // pays depends on the frame (SideBySideChoice). With more threads every stage's loops
+    // use them all: the stages run one after the other.
     const bool may_overlap = params.segmentation.segmenter != Segmenter::Kmeans &&
                              omp_get_max_threads() == 2 && !omp_in_parallel();
     const bool side_by_side = may_overlap && side_by_side_.next();
