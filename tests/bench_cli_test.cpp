@@ -97,6 +97,28 @@ TEST(CliBench, OneRowPerThreadCountWithEachStagesTime) {
     for (std::size_t s : {7u, 8u, 9u}) EXPECT_EQ(std::stod(cols[kFirstStage + s]), 0.0) << kStages[s];
 }
 
+// --no-colors reaches the measuring process: the colours' stage does not run, the others do.
+TEST(CliBench, NoColours_TheColoursStageIsZero) {
+    for (const bool without : {false, true}) {
+        std::vector<std::string> args = {"bench", (sample_dir() / "uois_tabletop").string(), "--k", "4",
+                                         "--threads", "1", "--frames", "1", "--passes", "2"};
+        if (without) args.emplace_back("--no-colors");
+        const auto r = run_cli(args);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto lines = split(r.out, '\n');
+        ASSERT_EQ(lines.size(), 2u) << r.out;
+        const auto cols = split(lines[1], ',');
+        ASSERT_EQ(cols.size(), kColumns) << lines[1];
+        const double colours = std::stod(cols[kFirstStage + 6]), clustering = std::stod(cols[kFirstStage + 5]);
+        EXPECT_EQ(kStages[6], std::string("colors"));
+        EXPECT_GT(clustering, 0.0);
+        if (without)
+            EXPECT_EQ(colours, 0.0);
+        else
+            EXPECT_GT(colours, 0.0);
+    }
+}
+
 TEST(CliBench, PaperPipelineStopsAfterTheColoursAndHoldsLessMemory) {
     // The paper's steps alone keep no plane, segment or track buffers: at 640x480 that is
     // tens of MB (the tracker's weights alone are 24 bytes a pixel), far above noise.

@@ -43,6 +43,7 @@ struct BenchOptions {
     std::string segmenter;             // empty: the default
     std::string threads = "0";         // comma-separated; 0: all cores
     int decimate = 0;                  // PipelineParams::decimation; 0: decimation_of()
+    bool no_colors = false;            // PipelineParams::render_colors off
     int single_k = 0;        // internal: measure this k in this process and print one row
 };
 
@@ -169,6 +170,7 @@ void measure_one(const BenchOptions& o) {
     params.detect_objects = o.pipeline == "objects";
     if (!o.segmenter.empty()) params.segmentation.segmenter = parse_segmenter(o.segmenter);
     params.decimation = decimation_of(o);
+    params.render_colors = !o.no_colors;
     const int threads = parse_int_list(o.threads, "--threads", 0, kMaxThreads).front();
     if (threads > 0) wul3d::set_num_threads(threads);
     Pipeline pipeline(params);
@@ -240,6 +242,7 @@ std::string run_child(const BenchOptions& o, int threads, int k) {
                                          "--decimate", std::to_string(decimation_of(o)),
                                          "--max-pixels", std::to_string(max_image_pixels())};
         if (!o.segmenter.empty()) args.insert(args.end(), {"--segmenter", o.segmenter});
+        if (o.no_colors) args.emplace_back("--no-colors");
         std::vector<char*> argv;
         for (auto& a : args) argv.push_back(a.data());
         argv.push_back(nullptr);
@@ -339,6 +342,9 @@ void add_bench_command(CLI::App& app) {
                     "Run the stages on every N-th pixel in u and v, results at the input's size "
                     "(default: 2 with --pipeline objects, 1 with paper)")
         ->check(NumberIn(1, 8));
+    cmd->add_flag("--no-colors", opts->no_colors,
+                  "Without eq. 9's colours, as `wul3d run --outputs` without colors, ply or "
+                  "--video runs");
     add_max_pixels_option(cmd);
     cmd->add_option("--single-k", opts->single_k, "Internal: measure one k in this process")
         ->group("");

@@ -144,6 +144,7 @@ void run(const RunCommandOptions& o) {
     }
     r.files.ply = r.files.ply || o.ply;
     r.files.overlay = r.files.overlay || o.overlay;
+    r.params.render_colors = r.files.reads_colors() || !o.video.empty();  // the video's clusters panel
     r.overwrite = o.overwrite;
     r.stop = stop_requested;
     apply_threads(o.pipeline);

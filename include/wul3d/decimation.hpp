@@ -42,6 +42,8 @@ struct ExpandParams {
     /// false: the result of the paper's steps only (labels, colours, active points); the
     /// outlines placed by colour are the clusters' then, not the objects'.
     bool objects = true;
+    /// false: r.colors is left empty (PipelineParams::render_colors; `small` has none).
+    bool colors = true;
     std::size_t min_object_pixels = 0;  ///< objects under it (input pixels) are dropped
 };
 
@@ -62,12 +64,12 @@ private:
 
 /// The last stage with decimation: `small`, the results of the stages on `decimated` (`frame`
 /// decimated by params.factor with decimate_frame and params.range), carried back to
-/// `frame`'s pixels into `out`. Each per-pixel result (labels, colours, active points, plane
-/// classes, segments, objects) comes from the pixel's source block: its own when its depth
-/// is on the block's surface, else the nearest in depth of the 3 x 3 blocks around; at the
-/// objects' outlines (the clusters' without params.objects) the input's colour places the
-/// outline (src/stages/decimated_source.hpp gives the rules). A pixel out of the depth range, or
-/// without a source, is no point. Each object's pixels and 2D box are counted again at the
+/// `frame`'s pixels into `out`. Each per-pixel result (labels, colours where params.colors,
+/// active points, plane classes, segments, objects) comes from the pixel's source block: its
+/// own when its depth is on the block's surface, else the nearest in depth of the 3 x 3
+/// blocks around; at the objects' outlines (the clusters' without params.objects) the
+/// input's colour places the outline (src/stages/decimated_source.hpp gives the rules). A
+/// pixel out of the depth range, or without a source, is no point. Each object's pixels and 2D box are counted again at the
 /// input's size, and objects left under params.min_object_pixels are dropped. Everything
 /// else of `small` (stats, plane, object_list) is copied; `out.times` is not set. The same
 /// bytes on any number of threads; no allocation from the second frame of a size on.

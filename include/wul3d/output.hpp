@@ -73,6 +73,9 @@ struct OutputFiles {
     bool overlay = false;
 
     bool any() const { return labels || colors || objects || json || ply || overlay; }
+    /// Whether a file asked for shows eq. 9's colours: colors.png, or cloud.ply (its
+    /// points' colours). Without, a run need not make them (PipelineParams::render_colors).
+    bool reads_colors() const { return colors || ply; }
 };
 
 /// "labels,colors,objects,json,ply,overlay": a comma-separated subset, in any order, at

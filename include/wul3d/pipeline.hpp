@@ -32,6 +32,12 @@ struct PipelineParams {
     /// tracks, and none of their buffers (`wul3d bench --pipeline paper`).
     bool detect_objects = true;
     bool remove_plane = true;  ///< false: --no-plane, the paper's background (depth range only)
+    /// false: eq. 9's display colours are not made. FrameResult::colors stays empty (0 x 0)
+    /// and times.colors 0; nothing else reads them. For a caller that neither shows nor
+    /// writes them: `wul3d run` without colors.png, cloud.ply or --video, the Python module's
+    /// process(outputs=...) without 'colors'. It saves their pass over the clusters' weights
+    /// and, with decimation, their share of the way back.
+    bool render_colors = true;
     PlaneParams plane;
     SegmentParams segmentation;
     ObjectParams objects;
@@ -82,6 +88,9 @@ public:
     /// them, nothing is swapped and this returns false. The result keeps its sizes.
     bool swap_images(std::vector<std::uint16_t>& labels, std::vector<std::uint8_t>& rgb,
                      std::vector<std::uint16_t>& objects);
+
+    /// params().render_colors, from the next frame on (nothing else changes).
+    void set_render_colors(bool on);
 
     const PipelineParams& params() const;
     /// The cloud, normals and clusters the stages ran on: the decimated frame's with

@@ -265,6 +265,7 @@ public:
             py::gil_scoped_release release;
             lock.lock();
             const RunningScope running;
+            pipeline_.set_render_colors(selection.colors);  // eq. 9's colours only when returned
             auto t0 = std::chrono::steady_clock::now();
 #if WUL3D_PYTHON_HAS_VIEW
             if (!arrays.depth_is_float) {  // the caller's memory as it is: no copy
@@ -621,7 +622,8 @@ Args:
     depth_scale (float): metres per unit of a uint16 depth (default 0.001, millimetres).
     outputs (keyword only): the images given in the Result, a tuple of names from
         'labels', 'objects', 'colors'; None (default) gives all three. The others are None
-        in the Result; the stages, instances, plane, times and stats are the same. With
+        in the Result; the stages, instances, plane and stats are the same. Without
+        'colors', eq. 9's colours are not made at all (times['colors'] is 0). With
         decimation (the default) the images are handed over without a copy; with
         decimate=1 each image left out saves its copy (a 640x480 frame's three are 2.1 MB).
 

@@ -82,6 +82,7 @@ RunOptions run_options(const std::string& input, const std::string& out, py::dic
     }
     if (take<bool>(o, "ply").value_or(false)) r.files.ply = true;
     if (take<bool>(o, "overlay").value_or(false)) r.files.overlay = true;
+    r.params.render_colors = r.files.reads_colors();
     r.overwrite = take<bool>(o, "overwrite").value_or(false);
     r.out_dir = out;
     if (!o.empty()) {

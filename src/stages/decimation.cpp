@@ -520,10 +520,10 @@ void mark_edge_blocks(const LabelImage& outline, ExpandBuffers& buf) {
 }
 
 /// 2. The result at the input's size W x H: `small`'s stats, plane and object list copied,
-/// its images sized (without the object stages theirs stay empty, as run_on leaves them).
-/// The pixels are written by expand_bands. O(objects) plus the resizes (none from the
-/// second frame of a size).
-void shape_result(const FrameResult& small, int W, int H, bool objects, FrameResult& r) {
+/// its images sized (without the object stages theirs stay empty, as run_on leaves them;
+/// without `colors`, r.colors). The pixels are written by expand_bands. O(objects) plus the
+/// resizes (none from the second frame of a size).
+void shape_result(const FrameResult& small, int W, int H, bool objects, bool colors, FrameResult& r) {
     r.stats = small.stats;
     r.depth_noise_px = small.depth_noise_px;
     r.normal_radius_px = small.normal_radius_px;
@@ -539,9 +539,9 @@ void shape_result(const FrameResult& small, int W, int H, bool objects, FrameRes
     shape(r.labels, W, H);
     shape(r.segments, objects ? W : 0, objects ? H : 0);
     shape(r.objects, objects ? W : 0, objects ? H : 0);
-    r.colors.width = W;
-    r.colors.height = H;
-    r.colors.rgb.resize(3 * N);
+    r.colors.width = colors ? W : 0;
+    r.colors.height = colors ? H : 0;
+    r.colors.rgb.resize(colors ? 3 * N : 0);
     r.active.resize(N);
     r.plane_classes.resize(objects ? N : 0);
 }
@@ -707,7 +707,8 @@ void colour_row(const std::uint8_t* code, const std::uint8_t* own, const std::ui
 
 /// The per-pixel results, in (`small`'s, per block) and out (`r`'s, per input pixel), as
 /// raw pointers: through the vectors, every byte store would make the compiler reload every
-/// data pointer. Copied by value into each band's closures for the same reason.
+/// data pointer. Copied by value into each band's closures for the same reason. `colors`
+/// (and `in_rgb`) nullptr: no colours to make (ExpandParams::colors).
 struct PixelArrays {
     const std::uint8_t* frame_rgb;  ///< the input's colour, or nullptr
     const std::uint16_t* in_depth;  ///< the decimated depth
@@ -720,14 +721,14 @@ struct PixelArrays {
 };
 
 PixelArrays pixel_arrays(const RgbdView& frame, const RgbdFrame& decimated, const FrameResult& s,
-                         const ExpandBuffers& buf, bool with_objects, FrameResult& r) {
+                         const ExpandBuffers& buf, bool with_objects, bool with_colors, FrameResult& r) {
     return {frame.has_color() && frame.color_matches() ? frame.rgb : nullptr,
             decimated.depth.data.data(),
             s.labels.labels.data(), s.segments.labels.data(), s.objects.labels.data(),
-            s.colors.rgb.data(), s.active.data(), s.plane_classes.data(),
+            with_colors ? s.colors.rgb.data() : nullptr, s.active.data(), s.plane_classes.data(),
             buf.edge_blocks.data(),
             r.labels.labels.data(), r.segments.labels.data(), r.objects.labels.data(),
-            r.colors.rgb.data(), r.active.data(), r.plane_classes.data(), with_objects};
+            with_colors ? r.colors.rgb.data() : nullptr, r.active.data(), r.plane_classes.data(), with_objects};
 }
 
 /// Block row bv into `row`: its results over the input's W columns, and its depth (float,
@@ -743,7 +744,7 @@ void widen_block_row(const PixelArrays& a, int bv, int w, int factor, int W, Exp
     }
     widen_row<1>(block_depth, factor, W, row.depth.data());
     widen_row<1>(a.in_labels + first, factor, W, row.labels.data());
-    widen_row<3>(a.in_rgb + 3 * first, factor, W, row.rgb.data());
+    if (a.colors) widen_row<3>(a.in_rgb + 3 * first, factor, W, row.rgb.data());
     if (a.with_objects) {
         widen_row<1>(a.in_classes + first, factor, W, row.classes.data());
         widen_row<1>(a.in_segments + first, factor, W, row.segments.data());
@@ -757,8 +758,9 @@ void widen_block_row(const PixelArrays& a, int bv, int w, int factor, int W, Exp
 /// it made active.
 unsigned write_row(const PixelArrays& a, ExpandBuffers::BlockRow& b, std::size_t row, int W) {
     const std::uint8_t* const code = b.code.data();
-    colour_row(code, b.rgb.data(), a.frame_rgb ? a.frame_rgb + 3 * row : nullptr, W, b.grey.data(), b.mask3.data(),
-               b.grey3.data(), a.colors + 3 * row);
+    if (a.colors)
+        colour_row(code, b.rgb.data(), a.frame_rgb ? a.frame_rgb + 3 * row : nullptr, W, b.grey.data(),
+                   b.mask3.data(), b.grey3.data(), a.colors + 3 * row);
     if (a.with_objects)
         return object_row(code, b.labels.data(), b.segments.data(), b.objects.data(), b.classes.data(), W,
                           a.labels + row, a.segments + row, a.objects + row, a.classes + row, a.active + row);
@@ -782,7 +784,7 @@ unsigned write_searched(const PixelArrays& a, const DecimatedSource& source, con
     std::uint16_t* const labels = a.labels + row;
     std::uint16_t* const segments = with_objects ? a.segments + row : nullptr;
     std::uint16_t* const objects = with_objects ? a.objects + row : nullptr;
-    std::uint8_t *const colors = a.colors + 3 * row, *const active = a.active + row;
+    std::uint8_t *const colors = a.colors ? a.colors + 3 * row : nullptr, *const active = a.active + row;
     std::uint8_t* const classes = with_objects ? a.classes + row : nullptr;
     const int factor = source.factor(), bv = v / factor;
     unsigned made = 0;
@@ -798,7 +800,8 @@ unsigned write_searched(const PixelArrays& a, const DecimatedSource& source, con
             if (q < 0) continue;  // no point: written so by write_row
             const auto sq = static_cast<std::size_t>(q);
             labels[u] = in_labels[sq];
-            for (int c = 0; c < 3; ++c) colors[3 * u + c] = in_rgb[3 * sq + c];
+            if (colors)
+                for (int c = 0; c < 3; ++c) colors[3 * u + c] = in_rgb[3 * sq + c];
             active[u] = 1;  // q is active: the search takes no other
             ++made;
             if (!with_objects) continue;
@@ -930,16 +933,18 @@ void expand_result(const ExpandParams& params, const RgbdView& frame, const Rgbd
     const bool objects = params.objects;
     const LabelImage& outline = objects ? s.objects : s.labels;
     if (outline.width != decimated.width() || outline.height != decimated.height() ||
-        s.active.size() != outline.labels.size())
+        s.active.size() != outline.labels.size() ||
+        (params.colors && s.colors.rgb.size() != 3 * outline.labels.size()))
         throw InputError(std::string(frame.name) + ": the decimated results do not match the decimated frame");
     mark_edge_blocks(outline, buf);
     if (frame.has_color() && !frame.color_matches())
         throw InputError(std::string(frame.name) + ": colour and depth sizes differ");
     source.use_colour_at_edges(frame.rgb, decimated.color, buf.edge_blocks.data(), outline.labels.data(),
                                buf.vote);
-    shape_result(s, W, H, objects, r);
+    shape_result(s, W, H, objects, params.colors, r);
     prepare_bands(r.object_list, W, H, outline.width, objects, buf);
-    expand_bands(params.range, frame, source, outline.width, pixel_arrays(frame, decimated, s, buf, objects, r), buf);
+    expand_bands(params.range, frame, source, outline.width,
+                 pixel_arrays(frame, decimated, s, buf, objects, params.colors, r), buf);
     count_objects(W, H, buf, r);
     drop_small_objects(params.min_object_pixels, r);
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 #include <exception>
+#include <iterator>
 #include <utility>
 
 #include "param_check.hpp"
@@ -77,6 +78,7 @@ ExpandParams expand_params(const PipelineParams& p) {
     e.same_rel = n * p.segmentation.depth_jump_rel;
     e.range = p.range;
     e.objects = p.detect_objects;
+    e.colors = p.render_colors;
     e.min_object_pixels = static_cast<std::size_t>(p.objects.min_points);
     return e;
 }
@@ -104,6 +106,9 @@ struct Pipeline::Impl {
     /// them on the creating thread first; their order is not ours to set). Their times add
     /// up in colour_task_ms_.
     void colour_as_tasks(const RgbdView& frame, FrameResult& r);
+    /// Eq. 9's palette and r.colors sized (timed into r.times.colors); or, without
+    /// render_colors, r.colors emptied and false returned: no colours this frame.
+    bool prepare_colours(const RgbdView& frame, FrameResult& r);
     /// The objects stage's first phase (ObjectTracker::observe), which needs only the cloud:
     /// beside the segmentation when the halves run side by side. Times it into
     /// r.times.objects.
@@ -144,6 +149,11 @@ bool Pipeline::swap_images(std::vector<std::uint16_t>& labels, std::vector<std::
     r.colors.rgb.swap(rgb);
     r.objects.labels.swap(objects);
     return true;
+}
+
+void Pipeline::set_render_colors(bool on) {
+    impl_->params_.render_colors = on;
+    impl_->stage_params_.render_colors = on;
 }
 
 const PipelineParams& Pipeline::params() const { return impl_->params_; }
@@ -313,16 +323,27 @@ void Pipeline::Impl::cluster(FrameResult& r) {
 
 void Pipeline::Impl::cluster_and_colour(const RgbdView& frame, FrameResult& r) {
     cluster(r);
+    if (!prepare_colours(frame, r)) return;
+    const auto t = Clock::now();
+    colours_.all_rows();
+    r.times.colors += ms_since(t);
+}
+
+bool Pipeline::Impl::prepare_colours(const RgbdView& frame, FrameResult& r) {
+    if (!stage_params_.render_colors) {
+        r.colors.width = r.colors.height = 0;
+        r.colors.rgb.clear();  // keeps its memory for a frame that wants them again
+        return false;
+    }
     const auto t = Clock::now();
     colours_.prepare(state_, r.labels, frame, r.colors);
-    colours_.all_rows();
     r.times.colors = ms_since(t);
+    return true;
 }
 
 void Pipeline::Impl::colour_as_tasks(const RgbdView& frame, FrameResult& r) {
-    const auto t = Clock::now();
-    colours_.prepare(state_, r.labels, frame, r.colors);
-    r.times.colors = ms_since(t);
+    std::fill(std::begin(colour_task_ms_), std::end(colour_task_ms_), 0.0);
+    if (!prepare_colours(frame, r)) return;
     const int H = colours_.height();
     for (int task = 0; task < kColourTasks; ++task) {
 #pragma omp task firstprivate(task)

@@ -115,12 +115,28 @@ def test_outputs_selects_the_images_and_nothing_else(frames, reference, outputs)
         assert r.stats == r_full.stats
         assert (r.width, r.height) == f.depth.shape[::-1]
         assert repr(r) == repr(r_full)
+        # Colours not asked for are not made at all.
+        assert (r.times["colors"] > 0) == ("colors" in chosen)
         for inst in r.instances:
             if "objects" in chosen:
                 assert int(inst.mask().sum()) == inst.pixels
             else:
                 with pytest.raises(ValueError, match=r"mask\(\): the result has no objects image"):
                     inst.mask()
+
+
+def test_colors_left_out_then_asked_for_again_are_the_full_pipelines(frames, reference):
+    # They are made from the clusters' weights, which go on either way.
+    p = wul3d.Pipeline()
+    for k, f in enumerate(frames + frames):
+        with_colors = k % 2 == 1
+        r = process(p, f, outputs=("objects", "colors") if with_colors else ("objects",))
+        expected = reference[k][0]
+        np.testing.assert_array_equal(r.objects, expected["objects"])
+        if with_colors:
+            np.testing.assert_array_equal(r.colors, expected["colors"])
+        else:
+            assert r.colors is None and r.times["colors"] == 0
 
 
 def test_bad_outputs_raise_before_the_frame_is_processed(frames, reference):

@@ -58,7 +58,9 @@ def test_outputs_writes_only_the_files_named(cli, tmp_path, outputs):
         _, mismatch, errors = filecmp.cmpfiles(ref / name, out / name,
                                                ["objects.json", "objects.png"], shallow=False)
         assert not mismatch and not errors
-    assert json.loads((out / "summary.json").read_text())["outputs"] == "objects,json"
+    summary_json = json.loads((out / "summary.json").read_text())
+    assert summary_json["outputs"] == "objects,json"
+    assert summary_json["stage_ms_median"]["colors"] == 0  # no colours made for no file
     with pytest.raises(ValueError, match="'masks' is not one of"):
         wul3d.run(SAMPLES / "uois_tabletop", tmp_path / "bad", outputs="objects,masks")
     with pytest.raises(TypeError, match="outputs"):

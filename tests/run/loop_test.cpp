@@ -186,6 +186,30 @@ TEST(RunSequence, OutputsWritesOnlyTheFilesAskedForWithTheSameBytes) {
               std::string::npos);
 }
 
+// The command makes eq. 9's colours only for a file or video that shows them: with
+// --outputs objects,json their stage is 0 in summary.json, and the objects are the bytes of
+// the default run; with colors.png or cloud.ply it runs.
+TEST(RunSequence, CommandWithoutColourFiles_MakesNoColours_TheSameObjects) {
+    TempDir dir;
+    const std::string input = (test::sample_dir() / "uois_tabletop").string();
+    auto colours_ms = [&](const std::string& out) {
+        const auto summary = nlohmann::json::parse(slurp(dir / out / "summary.json"));
+        return summary.at("stage_ms_median").at("colors").get<double>();
+    };
+    for (const auto& [out, outputs] : std::vector<std::pair<std::string, std::string>>{
+             {"all", "labels,colors,objects,json"}, {"objects", "objects,json"}, {"ply", "objects,ply"}}) {
+        const auto r = test::run_cli({"run", input, "-o", (dir / out).string(), "-q", "--frames", "2",
+                                      "--outputs", outputs});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    EXPECT_GT(colours_ms("all"), 0.0);
+    EXPECT_EQ(colours_ms("objects"), 0.0);
+    EXPECT_GT(colours_ms("ply"), 0.0);  // cloud.ply's points take their colours
+    for (const char* frame : {"image_0000", "image_0002"})
+        for (const char* f : {"objects.png", "objects.json"})
+            EXPECT_EQ(slurp(dir / "objects" / frame / f), slurp(dir / "all" / frame / f)) << frame << "/" << f;
+}
+
 TEST(RunSequence, OutputNamesAreParsedStrictly) {
     const OutputFiles f = parse_output_files("overlay,labels,ply");
     EXPECT_TRUE(f.labels && f.ply && f.overlay);

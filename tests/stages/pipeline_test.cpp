@@ -230,6 +230,54 @@ TEST(Pipeline, ClusteringBesideTheObjectStages_SameResultsAsOneAfterTheOther) {
     EXPECT_GT(overlap, 0.0) << "the stages did not run side by side (test premise)";
 }
 
+// Without render_colors the colours are left empty and everything else is the same, at every
+// pixel and with decimation, one after the other and side by side (two threads). Switched
+// back on mid-sequence (set_render_colors, as the Python module does per call), they are
+// again those of a pipeline that always made them: they are made from the weights, which
+// run on either way.
+TEST(Pipeline, WithoutColours_TheSameLabelsAndObjects_ColoursEmpty) {
+    auto source = open_source((sample_dir() / "uois_tabletop").string(), SourceOptions{});
+    const int threads = omp_get_max_threads();
+    for (const int decimation : {1, 2})
+        for (const int team : {1, 2}) {
+            SCOPED_TRACE("decimation " + std::to_string(decimation) + ", threads " + std::to_string(team));
+            omp_set_num_threads(team);
+            PipelineParams params;
+            params.decimation = decimation;
+            Pipeline with(params);
+            params.render_colors = false;
+            Pipeline without(params);
+            SourceItem item;
+            for (std::size_t pass = 0; pass < 2; ++pass)
+                for (std::size_t i = 0; i < source->size(); ++i) {
+                    source->read(i, item);
+                    SCOPED_TRACE(item.frame.name);
+                    const bool colours_back = pass == 1 && i % 2 == 1;  // on, off, on, ... in pass 2
+                    without.set_render_colors(colours_back);
+                    const FrameResult a = with.process(item.frame);
+                    const FrameResult& b = without.process(item.frame);
+                    EXPECT_EQ(a.labels.labels, b.labels.labels);
+                    EXPECT_EQ(a.active, b.active);
+                    EXPECT_EQ(a.objects.labels, b.objects.labels);
+                    EXPECT_EQ(a.segments.labels, b.segments.labels);
+                    ASSERT_EQ(a.object_list.size(), b.object_list.size());
+                    for (std::size_t o = 0; o < a.object_list.size(); ++o)
+                        EXPECT_EQ(a.object_list[o].pixels, b.object_list[o].pixels);
+                    ASSERT_FALSE(a.colors.rgb.empty());
+                    if (colours_back) {
+                        EXPECT_EQ(a.colors.rgb, b.colors.rgb);
+                        EXPECT_EQ(a.colors.width, b.colors.width);
+                    } else {
+                        EXPECT_TRUE(b.colors.rgb.empty());
+                        EXPECT_EQ(b.colors.width, 0);
+                        EXPECT_EQ(b.colors.height, 0);
+                        EXPECT_EQ(b.times.colors, 0.0);
+                    }
+                }
+        }
+    omp_set_num_threads(threads);
+}
+
 // swap_images hands the images over and takes any vectors in their place (scribbled over, of
 // other sizes): the next frames' images are those of a pipeline that never swapped, every
 // pixel written again. At decimation 1 nothing is swapped.
