@@ -82,7 +82,9 @@ wul3d::PipelineParams pipeline_params(const ros::NodeHandle& pnh) {
                     break;
             }
         }
-        return wul3d::make_params(preset, given);
+        wul3d::PipelineParams params = wul3d::make_params(preset, given);
+        params.render_colors = false;  // the node publishes no eq. 9 colours
+        return params;
     } catch (const wul3d::ParamError& e) {
         if (e.parameter().empty()) throw;
         const wul3d::ParamSpec* spec = wul3d::find_parameter(e.parameter());
