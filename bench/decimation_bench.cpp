@@ -77,15 +77,18 @@ const ExpandInputs& expand_inputs() {
 
 // The way back (expand_result) against the back-projection of the same input frame at its
 // full size, in the same loop: ours_ms is the way back, theirs_ms the back-projection, ratio
-// their per-iteration quotient (the way back should cost no more: ratio <= 1).
+// their per-iteration quotient (the way back should cost no more: ratio <= 1). colors:1 is
+// the default; colors:0 the way back without eq. 9's colours (PipelineParams::render_colors).
 static void BM_ExpandVsBackProject(benchmark::State& state) {
     const ExpandInputs& in = expand_inputs();
+    ExpandParams expand = in.expand;
+    expand.colors = state.range(0) != 0;
     const std::vector<RgbdFrame>& frames = in.frames;
     ExpandWorkspace ws;
     FrameResult out;
     OrganizedCloud cloud;
     for (std::size_t i = 0; i < frames.size(); ++i) {  // sizes every buffer once
-        expand_result(in.expand, frames[i].view(), in.decimated[i], in.small[i], ws, out);
+        expand_result(expand, frames[i].view(), in.decimated[i], in.small[i], ws, out);
         back_project(frames[i], cloud);
     }
     bench::PeerTimes times;
@@ -94,7 +97,7 @@ static void BM_ExpandVsBackProject(benchmark::State& state) {
     for (auto _ : state) {
         const RgbdFrame& f = frames[i];
         auto t0 = Clock::now();
-        expand_result(in.expand, f.view(), in.decimated[i], in.small[i], ws, out);
+        expand_result(expand, f.view(), in.decimated[i], in.small[i], ws, out);
         benchmark::DoNotOptimize(out.labels.labels.data());
         auto t1 = Clock::now();
         benchmark::DoNotOptimize(back_project(f, cloud));
@@ -105,4 +108,4 @@ static void BM_ExpandVsBackProject(benchmark::State& state) {
     }
     times.report(state);
 }
-BENCHMARK(BM_ExpandVsBackProject)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ExpandVsBackProject)->ArgName("colors")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
