@@ -844,4 +844,37 @@ TEST(ExpandResult, RejectsResultsThatDoNotMatchTheDecimatedFrame) {
     ExpandWorkspace ws;
     FrameResult out;
     EXPECT_THROW(expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, out), InputError);
+    // Colours asked for of a result that has none (a pipeline that made none): refused, not
+    // read; without them asked for, the same result is carried back, its colours left empty.
+    RandomExpand no_colours = random_expand(7, 40, 30, 2, true, true);
+    no_colours.small.colors = ColorImage{};
+    EXPECT_THROW(expand_result(no_colours.params, no_colours.frame.view(), no_colours.decimated, no_colours.small,
+                               ws, out),
+                 InputError);
+    no_colours.params.colors = false;
+    expand_result(no_colours.params, no_colours.frame.view(), no_colours.decimated, no_colours.small, ws, out);
+    EXPECT_TRUE(out.colors.rgb.empty());
+    EXPECT_EQ(out.colors.width, 0);
+    EXPECT_EQ(out.objects.labels.size(), static_cast<std::size_t>(out.objects.width) * out.objects.height);
+}
+
+// Without colours (ExpandParams::colors false) every other result is the same bytes.
+TEST(ExpandResult, WithoutColours_EveryOtherResultTheSame) {
+    for (const bool objects : {true, false}) {
+        SCOPED_TRACE(objects);
+        RandomExpand e = random_expand(11, 331, 243, 2, objects, true);
+        ExpandWorkspace ws;
+        FrameResult with, without;
+        expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, with);
+        e.params.colors = false;
+        expand_result(e.params, e.frame.view(), e.decimated, e.small, ws, without);
+        EXPECT_EQ(without.labels.labels, with.labels.labels);
+        EXPECT_EQ(without.active, with.active);
+        EXPECT_EQ(without.objects.labels, with.objects.labels);
+        EXPECT_EQ(without.segments.labels, with.segments.labels);
+        EXPECT_EQ(without.plane_classes, with.plane_classes);
+        EXPECT_EQ(without.active_points, with.active_points);
+        EXPECT_FALSE(with.colors.rgb.empty());
+        EXPECT_TRUE(without.colors.rgb.empty());
+    }
 }
