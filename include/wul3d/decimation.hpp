@@ -69,10 +69,11 @@ private:
 /// own when its depth is on the block's surface, else the nearest in depth of the 3 x 3
 /// blocks around; at the objects' outlines (the clusters' without params.objects) the
 /// input's colour places the outline (src/stages/decimated_source.hpp gives the rules). A
-/// pixel out of the depth range, or without a source, is no point. Each object's pixels and 2D box are counted again at the
-/// input's size, and objects left under params.min_object_pixels are dropped. Everything
-/// else of `small` (stats, plane, object_list) is copied; `out.times` is not set. The same
-/// bytes on any number of threads; no allocation from the second frame of a size on.
+/// pixel out of the depth range, or without a source, is no point. Each object's pixels and
+/// 2D box are counted again at the input's size, and objects left under
+/// params.min_object_pixels are dropped. Everything else of `small` (stats, plane,
+/// object_list) is copied; `out.times` is not set. The same bytes on any number of threads;
+/// no allocation from the second frame of a size on.
 /// Throws InputError for a `decimated` frame or colour that does not match `frame`.
 void expand_result(const ExpandParams& params, const RgbdView& frame, const RgbdFrame& decimated,
                    const FrameResult& small, ExpandWorkspace& ws, FrameResult& out);
