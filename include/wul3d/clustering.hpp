@@ -121,9 +121,10 @@ private:
     void update_weights_and_labels();
     // helpers of seeding and re-seeding
     void set_centre(int j, const Grid& grid, std::size_t g);
-    /// f of every active point to grid point c: Set stores it in f_, Lower keeps the
-    /// smaller of it and f_, Potential returns the sum of min(f_, f)^2 and stores nothing.
-    double f_to_point(const Grid& grid, std::size_t c, FToPoint use);
+    /// f of every active point to each of the n grid points c[0..n): Set (n = 1) stores it
+    /// in f_, Lower (n = 1) keeps the smaller of it and f_, Potential puts the sum of
+    /// min(f_, f)^2 for c[t] into potential[t] and stores nothing. One pass over the points.
+    void f_to_points(const Grid& grid, const std::size_t* c, int n, FToPoint use, double* potential);
     std::size_t sample_by_f_squared(const Grid& grid);
     void add_centre(int j, const Grid& grid);  ///< centre j by the greedy D^2 rule; lowers f_
     bool centre_has_normal(int j) const {

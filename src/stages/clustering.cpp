@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
+#include <tuple>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -225,6 +227,8 @@ namespace {
 // results do not depend on the number of threads.
 constexpr std::size_t kAssignBlock = 256;
 constexpr int kChunks = 64;
+/// The greedy k-means++ draws' candidates per centre: 2 + ln k, k <= 65535.
+constexpr int kMaxTrials = 13;
 constexpr int kSums = 11;  // x y z r g b nx ny nz, count, f
 constexpr std::uint16_t kNoWinner = 0xffff;  // k <= 65535, so 0-based winners stay below it
 
@@ -450,23 +454,39 @@ void ClusterState::set_centre(int j, const Grid& grid, std::size_t g) {
     centres_.count[j] = 0;
 }
 
-double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
-    // Point c as the one centre of the assignment kernel.
-    const std::size_t pc = grid.pixel(c);
-    const float x = grid.cloud.x[pc], y = grid.cloud.y[pc], z = grid.cloud.z[pc];
-    const float r = grid.cloud.r[pc], g = grid.cloud.g[pc], b = grid.cloud.b[pc];  // 0-255
-    const float nx = grid.normals.nx[pc], ny = grid.normals.ny[pc], nz = grid.normals.nz[pc];
-    const float has_normal = grid.normals.valid[pc] ? 1.0f : 0.0f;
-    const CentreView view{&x, &y, &z, &r, &g, &b, &nx, &ny, &nz, &has_normal, 1,
-                          params_.delta * params_.delta,
-                          use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
-    double chunk_potential[kChunks] = {};
+namespace {
+/// The candidates' features, one CentreView of one centre each: what assign_block compares
+/// the points with.
+struct Candidates {
+    float x[kMaxTrials], y[kMaxTrials], z[kMaxTrials], r[kMaxTrials], g[kMaxTrials], b[kMaxTrials];
+    float nx[kMaxTrials], ny[kMaxTrials], nz[kMaxTrials], has_normal[kMaxTrials];
+    CentreView view[kMaxTrials];
+};
+}  // namespace
+
+void ClusterState::f_to_points(const Grid& grid, const std::size_t* c, int n, FToPoint use, double* potential) {
+    // Points c[t] as the one centre of the assignment kernel each, all in one pass, so that
+    // the potentials' sums run side by side (below).
+    Candidates cand;
+    for (int t = 0; t < n; ++t) {
+        const std::size_t pc = grid.pixel(c[t]);
+        cand.x[t] = grid.cloud.x[pc], cand.y[t] = grid.cloud.y[pc], cand.z[t] = grid.cloud.z[pc];
+        cand.r[t] = grid.cloud.r[pc], cand.g[t] = grid.cloud.g[pc], cand.b[t] = grid.cloud.b[pc];  // 0-255
+        cand.nx[t] = grid.normals.nx[pc], cand.ny[t] = grid.normals.ny[pc], cand.nz[t] = grid.normals.nz[pc];
+        cand.has_normal[t] = grid.normals.valid[pc] ? 1.0f : 0.0f;
+        cand.view[t] = CentreView{&cand.x[t],  &cand.y[t],  &cand.z[t],  &cand.r[t],
+                                  &cand.g[t],  &cand.b[t],  &cand.nx[t], &cand.ny[t],
+                                  &cand.nz[t], &cand.has_normal[t], 1,
+                                  params_.delta * params_.delta,
+                                  use_color_ ? params_.alpha * params_.alpha : 0.0f, params_.gamma};
+    }
+    double chunk_potential[kChunks][kMaxTrials] = {};
 #pragma omp parallel for schedule(static)
     for (int ch = 0; ch < kChunks; ++ch) {
         PointBlock pb;
         int winner[kAssignBlock];
-        float f[kAssignBlock];
-        double potential = 0;
+        float f[kMaxTrials][kAssignBlock];
+        double sums[kMaxTrials] = {};
         const auto [first, last] = grid.chunk(ch);
         for (std::size_t g0 = first; g0 < last; g0 += kAssignBlock) {
             if (stop_requested()) break;  // thrown below, outside the parallel region
@@ -474,28 +494,37 @@ double ClusterState::f_to_point(const Grid& grid, std::size_t c, FToPoint use) {
             // Inactive points may come along: f_ is 0 there, which Lower and Potential
             // keep (f >= 0) and Set writes.
             const PointView pts = grid.points(g0, g1, pb, /*or_all=*/true);
-            assign_block(view, pts, winner, f);
+            for (int t = 0; t < n; ++t) assign_block(cand.view[t], pts, winner, f[t]);
             if (use == FToPoint::Set) {
                 std::fill(f_.begin() + static_cast<std::ptrdiff_t>(g0),
                           f_.begin() + static_cast<std::ptrdiff_t>(g1), 0.0f);
                 for (std::size_t q = 0; q < pts.m; ++q)
-                    if (grid.active[grid.pixel(pts.index(q))]) f_[pts.index(q)] = f[q];
+                    if (grid.active[grid.pixel(pts.index(q))]) f_[pts.index(q)] = f[0][q];
             } else if (use == FToPoint::Lower) {
                 for (std::size_t q = 0; q < pts.m; ++q)
-                    f_[pts.index(q)] = std::min(f_[pts.index(q)], f[q]);
+                    f_[pts.index(q)] = std::min(f_[pts.index(q)], f[0][q]);
             } else {
+                // Each sum in point order (a double sum in another order would round
+                // otherwise), the candidates' sums side by side: their chains of additions
+                // overlap, where one after the other each waits on its last addition.
                 for (std::size_t q = 0; q < pts.m; ++q) {
-                    const double d = std::min(f_[pts.index(q)], f[q]);
-                    potential += d * d;
+                    const float fq = f_[pts.index(q)];
+                    for (int t = 0; t < n; ++t) {
+                        const double d = std::min(fq, f[t][q]);
+                        sums[t] += d * d;
+                    }
                 }
             }
         }
-        chunk_potential[ch] = potential;
+        for (int t = 0; t < n; ++t) chunk_potential[ch][t] = sums[t];
     }
     throw_if_stop_requested("the clustering's seeding");
-    double total = 0;
-    for (double p : chunk_potential) total += p;
-    return total;
+    if (use != FToPoint::Potential) return;
+    for (int t = 0; t < n; ++t) {
+        double total = 0;
+        for (int ch = 0; ch < kChunks; ++ch) total += chunk_potential[ch][t];
+        potential[t] = total;
+    }
 }
 
 std::size_t ClusterState::sample_by_f_squared(const Grid& grid) {
@@ -504,18 +533,36 @@ std::size_t ClusterState::sample_by_f_squared(const Grid& grid) {
     // far, and keep the one that lowers the total f^2 most. Sums run in fixed chunks, in
     // order, so the choice does not depend on the thread count.
     double chunk_total[kChunks];
+    // Each chunk's sum in its points' order, kSideBySide chunks' side by side: their chains
+    // of additions overlap, where one after the other each waits on its last addition.
+    constexpr int kSideBySide = 4;
+    static_assert(kChunks % kSideBySide == 0);
+    const float* const f = f_.data();
 #pragma omp parallel for schedule(static)
-    for (int ch = 0; ch < kChunks; ++ch) {
-        const auto [first, last] = grid.chunk(ch);
-        double sum = 0;
-        for (std::size_t g = first; g < last; ++g) sum += static_cast<double>(f_[g]) * f_[g];
-        chunk_total[ch] = sum;
+    for (int group = 0; group < kChunks / kSideBySide; ++group) {
+        std::size_t first[kSideBySide], last[kSideBySide], common = SIZE_MAX;
+        double sum[kSideBySide] = {};
+        for (int i = 0; i < kSideBySide; ++i) {
+            std::tie(first[i], last[i]) = grid.chunk(group * kSideBySide + i);
+            common = std::min(common, last[i] - first[i]);
+        }
+        for (std::size_t j = 0; j < common; ++j)
+            for (int i = 0; i < kSideBySide; ++i) {
+                const double v = f[first[i] + j];
+                sum[i] += v * v;
+            }
+        for (int i = 0; i < kSideBySide; ++i) {
+            for (std::size_t g = first[i] + common; g < last[i]; ++g) sum[i] += static_cast<double>(f[g]) * f[g];
+            chunk_total[group * kSideBySide + i] = sum[i];
+        }
     }
     double total = 0;
     for (double t : chunk_total) total += t;
-    const int trials = 2 + static_cast<int>(std::log(static_cast<double>(params_.k)));
-    std::size_t best = 0;
-    double best_potential = INFINITY;
+    // At most kMaxTrials: k <= 65535 (ClusterParams).
+    const int trials = std::min(kMaxTrials, 2 + static_cast<int>(std::log(static_cast<double>(params_.k))));
+    // The draws do not depend on the potentials: all are drawn first (the generator's
+    // numbers in the same order), then measured in one pass.
+    std::size_t candidate[kMaxTrials];
     for (int t = 0; t < trials; ++t) {
         std::size_t c = 0;
         if (total > 0) {
@@ -541,26 +588,31 @@ std::size_t ClusterState::sample_by_f_squared(const Grid& grid) {
         } else {  // every point sits on a centre: any point will do
             c = nth_active(grid, std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_));
         }
-        const double potential = f_to_point(grid, c, FToPoint::Potential);
-        if (potential < best_potential) {
-            best_potential = potential;
-            best = c;
-        }
+        candidate[t] = c;
     }
+    double potential[kMaxTrials];
+    f_to_points(grid, candidate, trials, FToPoint::Potential, potential);
+    std::size_t best = 0;
+    double best_potential = INFINITY;
+    for (int t = 0; t < trials; ++t)
+        if (potential[t] < best_potential) {
+            best_potential = potential[t];
+            best = candidate[t];
+        }
     return best;
 }
 
 void ClusterState::add_centre(int j, const Grid& grid) {
     const std::size_t c = sample_by_f_squared(grid);
     set_centre(j, grid, c);
-    f_to_point(grid, c, FToPoint::Lower);
+    f_to_points(grid, &c, 1, FToPoint::Lower, nullptr);
 }
 
 void ClusterState::seed_kmeanspp(const Grid& grid) {
     const std::size_t first =
         nth_active(grid, std::uniform_int_distribution<std::size_t>(0, n_ - 1)(rng_));
     set_centre(0, grid, first);
-    f_to_point(grid, first, FToPoint::Set);
+    f_to_points(grid, &first, 1, FToPoint::Set, nullptr);
     for (int j = 1; j < params_.k; ++j) {
         throw_if_stop_requested("the clustering's seeding");
         add_centre(j, grid);
