@@ -52,28 +52,34 @@ def run(wul3d, data, out, flags):
         sys.exit(f"benchmark.py: {' '.join(cmd)} failed: {res.stderr.strip()}")
 
 
-def generate(work, seeds, family="tabletop", sensor="structured_light"):
-    """WORK/gen_<A-B> (or gen_<family>_<sensor>_<A-B> for another family or sensor): the
-    seeds' scenes, written by eval/scenegen.py unless its scenegen.json already names this
-    generator version, family, sensor and seeds."""
+def generate(work, seeds, family="tabletop", sensor="structured_light", incremental=False):
+    """WORK/gen_<A-B> (or gen_<family>_<sensor>_<A-B> for another family or sensor, and
+    gen_incremental_<family>_<sensor>_<A-B> for the seeds' sequences, scenegen.py
+    --incremental): the seeds' scenes, written by eval/scenegen.py unless its scenegen.json
+    already names this generator version, family, sensor, seeds and kind."""
     default = (family, sensor) == ("tabletop", "structured_light")
-    folder = work / (f"gen_{seeds}" if default else f"gen_{family}_{sensor}_{seeds}")
+    if incremental:
+        folder = work / f"gen_incremental_{family}_{sensor}_{seeds}"
+    else:
+        folder = work / (f"gen_{seeds}" if default else f"gen_{family}_{sensor}_{seeds}")
     a, _, b = seeds.partition("-")
     n = int(b or a) - int(a) + 1
     stamp = folder / "scenegen.json"
     version = re.search(r"^VERSION = (\d+)", (HERE / "scenegen.py").read_text(), re.M).group(1)
     if stamp.is_file():
         got = json.loads(stamp.read_text())
-        if (str(got.get("version")), got.get("family", "tabletop"),
-                got.get("sensor", "structured_light"), got.get("seeds", seeds)) == \
-                (version, family, sensor, seeds):
+        if (str(got.get("version")), got.get("family", "tabletop"), got.get("sensor", "structured_light"),
+                got.get("seeds", seeds), got.get("incremental", False)) == \
+                (version, family, sensor, seeds, incremental):
             return folder
     t = time.time()
     res = subprocess.run([sys.executable, str(HERE / "scenegen.py"), "--out", str(folder), "--seeds", seeds,
-                          "--family", family, "--sensor", sensor], capture_output=True, text=True)
+                          "--family", family, "--sensor", sensor] + (["--incremental"] if incremental else []),
+                         capture_output=True, text=True)
     if res.returncode != 0:
         sys.exit(f"scenegen.py failed: {res.stderr.strip()}")
-    print(f"generated {n} {family} scenes under {sensor} (seeds {seeds}) in {time.time() - t:.0f} s "
+    kind = "sequences" if incremental else "scenes"
+    print(f"generated {n} {family} {kind} under {sensor} (seeds {seeds}) in {time.time() - t:.0f} s "
           f"-> {folder}", file=sys.stderr)
     return folder
 

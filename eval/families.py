@@ -2,8 +2,8 @@
 """Every generated family under every sensor model: one table.
 
 Usage: eval/families.py [--set report|tune] [--seeds N] [--families a,b] [--sensors a,b]
-                        [--where-depth] [--wul3d build/wul3d] [--work out/families]
-                        [-- RUN_FLAGS...]
+                        [--where-depth] [--incremental] [--wul3d build/wul3d]
+                        [--work out/families] [-- RUN_FLAGS...]
 
 For every family x sensor (eval/scenegen.py --family, --sensor) it writes the set's seeds
 (docs/EVAL.md, "Generated scenes": tabletop tune 0-99 / report 1000-1099, pile 10000-10099 /
@@ -16,9 +16,15 @@ once to WORK/gen_<family>_<sensor>_<A-B> (WORK/gen_<A-B> for tabletop under stru
 light, as eval/benchmark.py names them) and reused while their scenegen.json names the
 generator's version, family, sensor and seeds. One process at a time: rendering is about 1-1.5 s
 a 640x480 frame.
+
+With --incremental every seed is a sequence whose objects are put down one at a time
+(scenegen.py --incremental, WORK/gen_incremental_<family>_<sensor>_<A-B>, 5-20 frames a seed):
+each sequence runs as one `wul3d run` (the objects' tracks carry from frame to frame, as in
+OCID's sequences), and every frame of every sequence is scored.
 """
 import argparse
 import pathlib
+import shutil
 import sys
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -30,6 +36,21 @@ SENSORS = ["structured_light", "active_stereo", "tof"]
 SEEDS = {"tabletop": {"tune": 0, "report": 1000},
          "pile": {"tune": 10000, "report": 11000},
          "floor": {"tune": 20000, "report": 21000}}  # each range 100 seeds from here
+
+
+def run_sequences(wul3d, gen, out, flags):
+    """Each GEN/seq_* run as one sequence into OUT/seq_*; returns the two folders `wul3d eval`
+    scores, OUT/truth and OUT/frames, each frame of each sequence linked as seq_*_step_*."""
+    truth, frames = out / "truth", out / "frames"
+    for folder in (truth, frames):
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+    for seq in sorted(gen.glob("seq_*")):
+        run(wul3d, seq, out / seq.name, flags)
+        for step in sorted(seq.glob("step_*")):
+            (truth / f"{seq.name}_{step.name}").symlink_to(step.resolve())
+            (frames / f"{seq.name}_{step.name}").symlink_to((out / seq.name / step.name).resolve())
+    return truth, frames
 
 
 def main():
@@ -45,6 +66,8 @@ def main():
     ap.add_argument("--sensors", default=",".join(SENSORS))
     ap.add_argument("--where-depth", action="store_true",
                     help="score only pixels with depth, as OSD's and OCID's labels are drawn")
+    ap.add_argument("--incremental", action="store_true",
+                    help="each seed a sequence of its objects put down one at a time, run as one")
     ap.add_argument("--wul3d", default="build/wul3d")
     ap.add_argument("--work", default="out/families", type=pathlib.Path)
     a = ap.parse_args(argv)
@@ -64,12 +87,15 @@ def main():
         first = SEEDS[family][a.set]
         seeds = f"{first}-{first + a.seeds - 1}"
         for sensor in sensors:
-            gen = generate(a.work, seeds, family, sensor)
+            gen = generate(a.work, seeds, family, sensor, incremental=a.incremental)
             out = gen.with_name(f"{gen.name}.{tag}")
-            run(a.wul3d, gen, out, flags)
+            if a.incremental:
+                gen, out = run_sequences(a.wul3d, gen, out, flags)
+            else:
+                run(a.wul3d, gen, out, flags)
             rows.append((family, sensor, seeds, score(a.wul3d, out, gen, where_depth=a.where_depth)))
-    print(f"set: {a.set}, flags: {' '.join(flags) if flags else '(default)'}"
-          f"{', scored where depth' if a.where_depth else ''}")
+    print(f"set: {a.set}{' (incremental sequences)' if a.incremental else ''}, "
+          f"flags: {' '.join(flags) if flags else '(default)'}{', scored where depth' if a.where_depth else ''}")
     print("| family | sensor | seeds | frames | objects | Overlap F | Boundary F | %>=75 |")
     print("|---|---|---|---|---|---|---|---|")
     for family, sensor, seeds, s in rows:

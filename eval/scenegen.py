@@ -1,11 +1,15 @@
 #!/usr/bin/env python3
 """Procedural labelled RGB-D scenes: a table in a whole room, ray-cast in numpy.
 
-Usage: eval/scenegen.py --out DIR --seeds A-B [--width W --height H]
+Usage: eval/scenegen.py --out DIR --seeds A-B [--width W --height H] [--family F]
+                        [--sensor S] [--incremental]
 
 Writes DIR/scene_SSSSS/{color.png, depth.png, intrinsics.json, label.png} for every seed in
 [A, B] (the layout of ../shared/data; label.png: 16-bit, the objects on the table 1..n, 0 the
-table, the room and everything else). The same seed gives the same frame.
+table, the room and everything else). The same seed gives the same frame. With
+--incremental each seed is a sequence, DIR/seq_SSSSS/step_NN: step N shows the scene once its
+first N objects were put down, in the order the generator placed them (each on the support
+or on one before it), as OCID's sequences grow a pile one object at a time.
 
 What a scene holds (docs/EVAL.md, "Generated scenes"): a table (top and legs) on a floor,
 two walls, chairs, a second table with things on it, pictures on the walls; on the table 2-20
@@ -604,16 +608,13 @@ FAMILIES = ["tabletop", "pile", "floor"]
 
 
 
-def render(seed, width=640, height=480, truth=None, family="tabletop", sensor="structured_light"):
-    """The frame of `seed` in `family` seen by `sensor`: colour, depth (mm), labels,
-    intrinsics. `truth`, a dict, gets the exact depth (`z`, metres), each pixel's world point
-    (`world`), its part's label before the visibility rule (`raw_labels`), each label's kind of
-    group (`kinds`, label -> kind) and the sensor model's `clean` pixels (their depth is the
-    ray cast's within `bound`, metres) and masks, for the tests and eval/kinds.py."""
+def scene(seed, family="tabletop"):
+    """The scene of `seed` in `family`: its parts (primitive, label, material; the objects'
+    labels 1..n in the order they were put down, each on the support or on one put down
+    before), the camera's position and rotation, each label's kind of group, and the
+    generator, whose next numbers draw the frame's noise."""
     if family not in FAMILIES:
         raise ValueError(f"unknown family {family!r} (one of {', '.join(FAMILIES)})")
-    if sensor not in SENSORS:
-        raise ValueError(f"unknown sensor {sensor!r} (one of {', '.join(SENSORS)})")
     rng = np.random.default_rng(seed)
     kind_of = {}
     prints = np.random.default_rng([seed, 1])
@@ -624,6 +625,23 @@ def render(seed, width=640, height=480, truth=None, family="tabletop", sensor="s
         parts, pos, Rc = build_pile(rng, prints, kind_of)
     else:
         parts, pos, Rc = build_floor(rng, prints, kind_of)
+    return parts, pos, Rc, kind_of, rng
+
+
+def render(seed, width=640, height=480, truth=None, family="tabletop", sensor="structured_light", upto=None):
+    """The frame of `seed` in `family` seen by `sensor`: colour, depth (mm), labels,
+    intrinsics. With `upto`, the scene as it stood once its object `upto` was put down (the
+    objects after it left out), with a sensor noise of its own. `truth`, a dict, gets the
+    exact depth (`z`, metres), each pixel's world point (`world`), its part's label before the
+    visibility rule (`raw_labels`), each label's kind of group (`kinds`, label -> kind) and
+    the sensor model's `clean` pixels (their depth is the ray cast's within `bound`, metres)
+    and masks, for the tests and eval/kinds.py."""
+    if sensor not in SENSORS:
+        raise ValueError(f"unknown sensor {sensor!r} (one of {', '.join(SENSORS)})")
+    parts, pos, Rc, kind_of, rng = scene(seed, family)
+    if upto is not None:
+        parts = [p for p in parts if p[1] <= upto]
+        rng = np.random.default_rng([seed, 2, upto])
     s = width / 640.0
     f, cx, cy = SENSORS[sensor]["focal"] * s, (width - 1) / 2.0, (height - 1) / 2.0
     u, v = np.meshgrid(np.arange(width), np.arange(height))
@@ -713,6 +731,8 @@ def main(argv=None):
                     help="the kind of scene (default tabletop: a table in a room)")
     ap.add_argument("--sensor", default="structured_light", choices=list(SENSORS),
                     help="the depth sensor's model (default structured_light: Kinect v1)")
+    ap.add_argument("--incremental", action="store_true",
+                    help="each seed a sequence, DIR/seq_SSSSS/step_NN: its objects put down one at a time")
     a = ap.parse_args(argv)
     try:
         seeds = parse_seeds(a.seeds)
@@ -720,13 +740,22 @@ def main(argv=None):
         sys.exit(f"scenegen.py: {e}")
     if a.width < 32 or a.height < 24:
         sys.exit("scenegen.py: --width and --height must be at least 32 and 24")
+    frames = 0
     for seed in seeds:
-        write(a.out / f"scene_{seed:05d}", *render(seed, a.width, a.height, family=a.family, sensor=a.sensor))
+        if not a.incremental:
+            write(a.out / f"scene_{seed:05d}", *render(seed, a.width, a.height, family=a.family, sensor=a.sensor))
+            frames += 1
+            continue
+        n = max(label for _, label, _ in scene(seed, a.family)[0])
+        for step in range(1, n + 1):
+            write(a.out / f"seq_{seed:05d}" / f"step_{step:02d}",
+                  *render(seed, a.width, a.height, family=a.family, sensor=a.sensor, upto=step))
+            frames += 1
     # Last, so that a folder with it is whole: eval/benchmark.py reuses only such a folder.
     (a.out / "scenegen.json").write_text(json.dumps(
         {"version": VERSION, "seeds": a.seeds, "width": a.width, "height": a.height,
-         "family": a.family, "sensor": a.sensor}) + "\n")
-    print(f"scenegen.py: {len(seeds)} scenes -> {a.out}")
+         "family": a.family, "sensor": a.sensor, "incremental": a.incremental}) + "\n")
+    print(f"scenegen.py: {len(seeds)} scenes, {frames} frames -> {a.out}")
 
 
 if __name__ == "__main__":
