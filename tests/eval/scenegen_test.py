@@ -301,6 +301,32 @@ class FamiliesAndSensors(unittest.TestCase):
         kinds = {k for ks in counts["pile"] for k in ks.values()}
         self.assertLessEqual({"box", "can", "bottle", "sphere", "stack", "lean"}, kinds)
 
+    def test_incremental_puts_the_objects_down_one_at_a_time(self):
+        seed, family = 10003, "pile"
+        n = max(label for _, label, _ in scenegen.scene(seed, family)[0])
+        whole = {}
+        scenegen.render(seed, self.W, self.H, whole, family=family)
+        before = None
+        for step in range(1, n + 1):
+            truth = {}
+            scenegen.render(seed, self.W, self.H, truth, family=family, upto=step)
+            raw = truth["raw_labels"]
+            self.assertLessEqual(raw.max(), step)
+            if before is not None:
+                # Putting object `step` down changes only the pixels where it is now seen.
+                np.testing.assert_array_equal(raw[raw != step], before[raw != step])
+            before = raw
+        np.testing.assert_array_equal(truth["z"], whole["z"])  # the last step is the whole scene
+        np.testing.assert_array_equal(before, whole["raw_labels"])
+        with tempfile.TemporaryDirectory() as tmp:
+            scenegen.main(["--out", tmp, "--seeds", str(seed), "--width", "64", "--height", "48",
+                           "--family", family, "--incremental"])
+            seq = pathlib.Path(tmp) / f"seq_{seed:05d}"
+            self.assertEqual(sorted(p.name for p in seq.iterdir()), [f"step_{i:02d}" for i in range(1, n + 1)])
+            self.assertTrue(json.loads((pathlib.Path(tmp) / "scenegen.json").read_text())["incremental"])
+            _, depth, _, _ = scenegen.render(seed, 64, 48, family=family, upto=2)
+            np.testing.assert_array_equal(np.array(Image.open(seq / "step_02" / "depth.png")), depth)
+
     def test_family_and_sensor_are_written_and_unknown_ones_refused(self):
         with tempfile.TemporaryDirectory() as tmp:
             scenegen.main(["--out", tmp, "--seeds", "11000", "--width", "64", "--height", "48",
