@@ -108,6 +108,8 @@ private:
     void measure_segments(const OrganizedCloud& cloud, const LabelImage& segments, int n_segments);
     void match_by_overlap(int n_segments);
     void match_by_distance_or_start(int n_segments);
+    void hold_covered_tracks();
+    void start_arrivals(int n_segments);
     void weigh_pixels(const OrganizedCloud& cloud, const LabelImage& segments);
     void sum_objects(const OrganizedCloud& cloud);
     void describe_objects(std::vector<DetectedObject>& out);

@@ -299,6 +299,36 @@ LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column
     return objects;
 }
 
+// The label of column u on row 10 (track_inner_frames' objects cover it).
+std::uint16_t at_row10(const LabelImage& objects, int u) {
+    return objects.labels[static_cast<std::size_t>(10 * objects.width + u)];
+}
+
+// track_column_frames for objects that do not reach the frame's border: the same columns on
+// rows 2-17 of 20, the table (1.1 m, no segment) on the rows above and below.
+template <class Column>
+LabelImage track_inner_frames(ObjectTracker& tracker, int W, int frames, Column column,
+                              std::vector<DetectedObject>& list) {
+    OrganizedCloud cloud;
+    cloud.resize(W, 20);
+    const std::size_t N = static_cast<std::size_t>(W) * 20;
+    LabelImage segments{W, 20, std::vector<std::uint16_t>(N, 0)}, objects;
+    for (int frame = 0; frame < frames; ++frame) {
+        int n = 0;
+        for (std::size_t p = 0; p < N; ++p) {
+            const int v = static_cast<int>(p / static_cast<std::size_t>(W));
+            auto [z, label] = column(frame, static_cast<int>(p % static_cast<std::size_t>(W)));
+            if (v < 2 || v >= 18) z = 1.1f, label = 0;
+            cloud.valid[p] = 1;
+            cloud.z[p] = z;
+            segments.labels[p] = label;
+            n = std::max<int>(n, label);
+        }
+        tracker.step(cloud, segments, n, LabelImage{}, objects, list);
+    }
+    return objects;
+}
+
 }  // namespace
 
 // A pixel whose surface changed forgets its weights: with psi = 0.5 a pixel that held the
@@ -345,4 +375,88 @@ TEST(ObjectTracker, ObjectPutDownOnAnother_BothKeepTheirOwnTracks) {
     EXPECT_EQ(board, 2) << "the board keeps its track";
     EXPECT_EQ(on_top, 3) << "the box starts a track of its own";
     for (int u = 10; u < 20; ++u) EXPECT_EQ(objects.labels[static_cast<std::size_t>(u)], board) << u;
+}
+
+// Objects put down one at a time against a pile (OCID's sequences): the segmentation joins
+// the newcomer to the object it touches, but its surface came nearer (the table was there)
+// while the old object lost nothing, so it starts a track of its own; in the frames after,
+// the old object's track continues the joined segment and the newcomer's is held where its
+// pixels' weights favour it.
+TEST(ObjectTracker, ObjectPutDownAgainstAnother_StartsItsOwnTrackThoughOneSegment) {
+    ObjectTracker tracker(ObjectParams{});
+    std::vector<DetectedObject> list;
+    std::vector<LabelImage> frames;
+    // The table at 1.1 m; an object over columns 10-39 at 1 m; from frame 5 on another
+    // against it over columns 40-59, both one segment.
+    for (int frame = 0; frame < 9; ++frame) {
+        const LabelImage objects = track_inner_frames(tracker, 100, 1, [frame](int, int u) {
+            const bool old_one = u >= 10 && u < 40, newcomer = frame >= 5 && u >= 40 && u < 60;
+            return std::pair<float, std::uint16_t>(old_one || newcomer ? 1.0f : 1.1f, old_one || newcomer ? 1 : 0);
+        }, list);
+        if (frame >= 5) frames.push_back(objects);
+    }
+    EXPECT_EQ(tracker.scene_cuts(), 0);
+    for (std::size_t f = 0; f < frames.size(); ++f) {
+        SCOPED_TRACE(f);
+        const LabelImage& objects = frames[f];
+        const std::uint16_t old_one = at_row10(objects, 20), newcomer = at_row10(objects, 50);
+        EXPECT_NE(old_one, 0);
+        EXPECT_NE(newcomer, 0);
+        EXPECT_NE(newcomer, old_one) << "the newcomer is an object of its own";
+        for (int u = 10; u < 40; ++u) EXPECT_EQ(at_row10(objects, u), old_one) << u;
+        for (int u = 40; u < 60; ++u) EXPECT_EQ(at_row10(objects, u), newcomer) << u;
+        if (f > 0) {
+            EXPECT_EQ(newcomer, at_row10(frames[0], 50)) << "and keeps its track";
+        }
+    }
+}
+
+// An object that slides within its segment gains surface on one side (nearer than the table
+// it covers) and vacates as much on the other: no arrival, one track.
+TEST(ObjectTracker, ObjectSlidingInOneSegment_KeepsOneTrack) {
+    ObjectTracker tracker(ObjectParams{});
+    std::vector<DetectedObject> list;
+    std::uint16_t first = 0;
+    for (int frame = 0; frame < 8; ++frame) {
+        SCOPED_TRACE(frame);
+        const int left = 10 + 8 * frame;  // 8 columns (160 pixels) a frame
+        const LabelImage objects = track_inner_frames(tracker, 120, 1, [left](int, int u) {
+            const bool on = u >= left && u < left + 30;
+            return std::pair<float, std::uint16_t>(on ? 1.0f : 1.1f, on ? 1 : 0);
+        }, list);
+        ASSERT_EQ(list.size(), 1u);
+        if (frame == 0) first = at_row10(objects, left);
+        for (int u = left; u < left + 30; ++u) EXPECT_EQ(at_row10(objects, u), first) << u;
+    }
+    EXPECT_EQ(tracker.tracks_started(), 1);
+}
+
+// An object in front of another is taken away: the surface behind it comes back, farther
+// than the object was. That is no arrival: the object behind stays one.
+TEST(ObjectTracker, SurfaceSeenAgainBehindARemovedObject_IsNoArrival) {
+    ObjectTracker tracker(ObjectParams{});
+    std::vector<DetectedObject> list;
+    // The table at 1.1 m; a board over columns 10-59 at 1 m, and until frame 5 a box in front
+    // of it over columns 25-44 at 0.9 m.
+    const LabelImage objects = track_inner_frames(tracker, 100, 8, [](int frame, int u) {
+        const bool box = frame < 5 && u >= 25 && u < 45, board = u >= 10 && u < 60 && !box;
+        return std::pair<float, std::uint16_t>(box ? 0.9f : (board ? 1.0f : 1.1f), box ? 2 : (board ? 1 : 0));
+    }, list);
+    ASSERT_EQ(list.size(), 1u);
+    for (int u = 10; u < 60; ++u) EXPECT_EQ(at_row10(objects, u), at_row10(objects, 10)) << u;
+    EXPECT_EQ(tracker.tracks_started(), 2) << "the board and the box, no third";
+}
+
+// An object coming into view at the frame's border grows by a surface nearer than the table
+// without vacating any: its segment, cut by the border, is left as it is.
+TEST(ObjectTracker, ObjectComingIntoView_KeepsOneTrack) {
+    ObjectTracker tracker(ObjectParams{});
+    std::vector<DetectedObject> list;
+    const LabelImage objects = track_inner_frames(tracker, 100, 6, [](int frame, int u) {
+        const bool on = u < 10 + 10 * frame;  // 10 columns (200 pixels) more a frame
+        return std::pair<float, std::uint16_t>(on ? 1.0f : 1.1f, on ? 1 : 0);
+    }, list);
+    ASSERT_EQ(list.size(), 1u);
+    EXPECT_EQ(tracker.tracks_started(), 1);
+    for (int u = 0; u < 60; ++u) EXPECT_EQ(at_row10(objects, u), at_row10(objects, 0)) << u;
 }
