@@ -272,14 +272,14 @@ TEST(ObjectTracker, ObjectsRearranged_StartNewTracks_ASlidingObjectDoesNot) {
 
 namespace {
 
-// `frames` frames of a W x 20 scene whose depth and segment label depend on the column only
-// (column(frame, u) -> {z, label}; every pixel has depth; the segments are counted as the
-// largest label), through `tracker`. Returns the last frame's object labels, its objects in
-// `list`. `observe_ahead`: each frame's surfaces observed (ObjectTracker::observe) before
-// step(), as the pipeline does beside the segmentation.
-template <class Column>
-LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column column,
-                               std::vector<DetectedObject>& list, bool observe_ahead = false) {
+// `frames` frames of a W x 20 scene, pixel(frame, u, v) -> {z, segment label} (every pixel
+// has depth; the segments are counted as the largest label), through `tracker`. Returns the
+// last frame's object labels, its objects in `list`. `observe_ahead`: each frame's surfaces
+// observed (ObjectTracker::observe) before step(), as the pipeline does beside the
+// segmentation.
+template <class Pixel>
+LabelImage track_frames(ObjectTracker& tracker, int W, int frames, Pixel pixel, std::vector<DetectedObject>& list,
+                        bool observe_ahead) {
     OrganizedCloud cloud;
     cloud.resize(W, 20);
     const std::size_t N = static_cast<std::size_t>(W) * 20;
@@ -287,7 +287,8 @@ LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column
     for (int frame = 0; frame < frames; ++frame) {
         int n = 0;
         for (std::size_t p = 0; p < N; ++p) {
-            const auto [z, label] = column(frame, static_cast<int>(p % static_cast<std::size_t>(W)));
+            const auto [z, label] = pixel(frame, static_cast<int>(p % static_cast<std::size_t>(W)),
+                                          static_cast<int>(p / static_cast<std::size_t>(W)));
             cloud.valid[p] = 1;
             cloud.z[p] = z;
             segments.labels[p] = label;
@@ -299,34 +300,27 @@ LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column
     return objects;
 }
 
+// track_frames of a scene that depends on the column only: column(frame, u) -> {z, label}.
+template <class Column>
+LabelImage track_column_frames(ObjectTracker& tracker, int W, int frames, Column column,
+                               std::vector<DetectedObject>& list, bool observe_ahead = false) {
+    return track_frames(tracker, W, frames, [&](int frame, int u, int) { return column(frame, u); }, list,
+                        observe_ahead);
+}
+
 // The label of column u on row 10 (track_inner_frames' objects cover it).
 std::uint16_t at_row10(const LabelImage& objects, int u) {
     return objects.labels[static_cast<std::size_t>(10 * objects.width + u)];
 }
 
-// track_column_frames for objects that do not reach the frame's border: the same columns on
-// rows 2-17 of 20, the table (1.1 m, no segment) on the rows above and below.
+// track_column_frames for objects that do not reach the frame's border: the columns on rows
+// 2-17, the table (1.1 m, no segment) on the rows above and below.
 template <class Column>
 LabelImage track_inner_frames(ObjectTracker& tracker, int W, int frames, Column column,
                               std::vector<DetectedObject>& list) {
-    OrganizedCloud cloud;
-    cloud.resize(W, 20);
-    const std::size_t N = static_cast<std::size_t>(W) * 20;
-    LabelImage segments{W, 20, std::vector<std::uint16_t>(N, 0)}, objects;
-    for (int frame = 0; frame < frames; ++frame) {
-        int n = 0;
-        for (std::size_t p = 0; p < N; ++p) {
-            const int v = static_cast<int>(p / static_cast<std::size_t>(W));
-            auto [z, label] = column(frame, static_cast<int>(p % static_cast<std::size_t>(W)));
-            if (v < 2 || v >= 18) z = 1.1f, label = 0;
-            cloud.valid[p] = 1;
-            cloud.z[p] = z;
-            segments.labels[p] = label;
-            n = std::max<int>(n, label);
-        }
-        tracker.step(cloud, segments, n, LabelImage{}, objects, list);
-    }
-    return objects;
+    return track_frames(tracker, W, frames, [&](int frame, int u, int v) {
+        return v < 2 || v >= 18 ? std::pair<float, std::uint16_t>(1.1f, 0) : column(frame, u);
+    }, list, false);
 }
 
 }  // namespace
