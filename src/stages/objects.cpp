@@ -128,8 +128,7 @@ struct ObjectTracker::Scratch {
     std::vector<std::uint8_t> changed;      ///< per pixel, kForget and kNearer: how its surface moved
     std::vector<double> votes, seg_sums;   ///< per segment: weight mass per slot; count, x, y, z
     std::vector<int> seg_slot;              ///< per segment, its slot (-1: none)
-    std::vector<std::uint8_t> slot_taken;   ///< per slot, 1 where a segment took it (or held)
-    std::vector<std::uint8_t> slot_held;    ///< per slot, 1 where held inside other tracks' segments
+    std::vector<std::uint8_t> slot_taken;   ///< per slot, 1 where a segment took it (or it is held)
     std::vector<double> slot_mass;          ///< per slot, its weight mass over the unchanged pixels
     std::vector<double> seg_nearer;         ///< per segment, its pixels whose surface came nearer;
                                             ///< -1 at the frame's border
@@ -481,22 +480,19 @@ void ObjectTracker::match_by_distance_or_start(int n_segments) {
     }
 }
 
-// In and out: s_->slot_taken. Out: s_->slot_held (K). A live track that no segment continues,
-// but whose unchanged pixels still hold min_overlap of its size inside other tracks' segments
-// (an object that a neighbour's segment took in: two objects touching in a pile), is held:
-// those of its pixels whose weights favour it keep it (weigh_pixels). Without this the
-// larger track's segment would take them over in a frame or two.
+// In and out: s_->slot_taken. A live track that no segment continues, but whose unchanged
+// pixels still hold min_overlap of its size inside other tracks' segments (an object that a
+// neighbour's segment took in: two objects touching in a pile), is held: taken this frame,
+// so that its pixels keep it (weigh_pixels). Without this the larger track's segment would
+// take them over in a frame or two.
 // Cost: O(K).
 void ObjectTracker::hold_covered_tracks() {
     const std::size_t Kz = static_cast<std::size_t>(params_.max_tracks);
-    s_->slot_held.assign(Kz, 0);
     for (std::size_t j = 0; j < Kz; ++j) {
         const Track& t = tracks_[j];
-        if (t.id == 0 || t.lost > 0 || s_->slot_taken[j]) continue;
-        if (s_->slot_mass[j] >= params_.min_overlap * static_cast<double>(t.pixels)) {
+        if (t.id != 0 && t.lost == 0 && !s_->slot_taken[j] &&
+            s_->slot_mass[j] >= params_.min_overlap * static_cast<double>(t.pixels))
             s_->slot_taken[j] = 1;
-            s_->slot_held[j] = 1;
-        }
     }
 }
 
@@ -532,12 +528,16 @@ void ObjectTracker::start_arrivals(int n_segments) {
     }
 }
 
-// The paper's weights on objects. In: segments, s_->seg_slot, s_->slot_taken, s_->slot_held,
-// s_->seg_arrival, s_->changed, the cloud's validity. Out: mu_ and has_mu_ (each segment
-// pixel adds psi to its slot's weight: eq. 2, 7, 8, the same update_weights as the clusters;
-// its segment's arrival's where its surface came nearer, a held track's where its weights
-// favour one; a changed pixel forgets first; a pixel with depth outside every segment forgets),
-// s_->slot_of (arg-max slot + 1 among the slots taken this frame, 0 none).
+// The paper's weights on objects. In: segments, s_->seg_slot, s_->slot_taken,
+// s_->seg_arrival, s_->changed, the cloud's validity, tracks_. Out: mu_ and has_mu_ (each
+// segment pixel adds psi to a track's weight: eq. 2, 7, 8, the same update_weights as the
+// clusters; a changed pixel forgets first; a pixel with depth outside every segment
+// forgets), s_->slot_of (arg-max slot + 1 among the slots taken this frame, 0 none). The
+// track a pixel adds to: its segment's arrival's where its surface came nearer; else, in a
+// segment that continues a track, the one its weights favour where that one is seen this
+// frame (an unchanged surface stays with its object, whichever segment it falls in: objects
+// in a pile are told apart by their history where the segmentation joins them); else its
+// segment's. A segment that starts a track (split off) takes its pixels.
 // Cost: one pass over N pixels, no allocation.
 void ObjectTracker::weigh_pixels(const OrganizedCloud& cloud, const LabelImage& segments) {
     const std::size_t N = cloud.size();
@@ -545,9 +545,8 @@ void ObjectTracker::weigh_pixels(const OrganizedCloud& cloud, const LabelImage& 
     const std::uint16_t* const seg = segments.labels.data();
     const int* const seg_slot = s_->seg_slot.data();
     const std::uint8_t* const taken = s_->slot_taken.data();
-    const std::uint8_t* const held = s_->slot_held.data();
     const int* const arrival = s_->seg_arrival.data();
-    const bool any_held = std::find(s_->slot_held.begin(), s_->slot_held.end(), 1) != s_->slot_held.end();
+    const Track* const tracks = tracks_.data();
     const std::uint8_t* const valid = cloud.valid.data();
     std::uint8_t* const changed = s_->changed.data();
     std::uint8_t* const has_mu = has_mu_.data();
@@ -565,14 +564,12 @@ void ObjectTracker::weigh_pixels(const OrganizedCloud& cloud, const LabelImage& 
             has_mu[p] = 0;
         }
         if (slot >= 0) {
-            // The segment's track; its arrival's for the pixels that came nearer; a held
-            // track's for the pixels whose weights favour it.
             int winner = slot;
             if ((changed[p] & kNearer) && arrival[s] >= 0)
                 winner = arrival[s];
-            else if (any_held && has_mu[p]) {
+            else if (has_mu[p] && tracks[slot].pixels > 0) {
                 const int favoured = favoured_track(mu[p]);
-                if (held[favoured]) winner = favoured;
+                if (taken[favoured]) winner = favoured;
             }
             int label = update_weights(mu[p], winner, psi);
             // The arg-max runs over the objects seen in this frame: a track with no

@@ -454,3 +454,34 @@ TEST(ObjectTracker, ObjectComingIntoView_KeepsOneTrack) {
     EXPECT_EQ(tracker.tracks_started(), 1);
     for (int u = 0; u < 60; ++u) EXPECT_EQ(at_row10(objects, u), at_row10(objects, 0)) << u;
 }
+
+// Two objects seen apart, then joined by the segmentation (touching in a pile): each keeps
+// its track, their unchanged pixels staying with the object their weights favour. Seen
+// joined first and then apart, the part that splits off starts a track of its own: a
+// segment that starts a track takes its pixels.
+TEST(ObjectTracker, ObjectsJoinedBySegmentation_KeepTheirTracks_PartedStartOne) {
+    for (const bool apart_first : {true, false}) {
+        SCOPED_TRACE(apart_first);
+        ObjectTracker tracker(ObjectParams{});
+        std::vector<DetectedObject> list;
+        std::uint16_t left = 0, right = 0;
+        for (int frame = 0; frame < 9; ++frame) {
+            const bool apart = (frame < 5) == apart_first;
+            const LabelImage objects = track_inner_frames(tracker, 100, 1, [apart](int, int u) {
+                const bool on = u >= 10 && u < 60;
+                return std::pair<float, std::uint16_t>(on ? 1.0f : 1.1f, on ? (apart && u >= 35 ? 2 : 1) : 0);
+            }, list);
+            if (frame == 4 && apart_first) left = at_row10(objects, 20), right = at_row10(objects, 50);
+            // Parted, from the frame after (psi = 0.5 asks two frames of evidence).
+            if (frame < 5 || (!apart_first && frame == 5)) continue;
+            SCOPED_TRACE(frame);
+            EXPECT_NE(at_row10(objects, 20), at_row10(objects, 50));
+            for (int u = 10; u < 35; ++u) EXPECT_EQ(at_row10(objects, u), at_row10(objects, 20)) << u;
+            for (int u = 35; u < 60; ++u) EXPECT_EQ(at_row10(objects, u), at_row10(objects, 50)) << u;
+            if (apart_first) {
+                EXPECT_EQ(at_row10(objects, 20), left);
+                EXPECT_EQ(at_row10(objects, 50), right);
+            }
+        }
+    }
+}
