@@ -90,10 +90,11 @@ def main():
             gen = generate(a.work, seeds, family, sensor, incremental=a.incremental)
             out = gen.with_name(f"{gen.name}.{tag}")
             if a.incremental:
-                gen, out = run_sequences(a.wul3d, gen, out, flags)
+                truth, pred = run_sequences(a.wul3d, gen, out, flags)
             else:
                 run(a.wul3d, gen, out, flags)
-            rows.append((family, sensor, seeds, score(a.wul3d, out, gen, where_depth=a.where_depth)))
+                truth, pred = gen, out
+            rows.append((family, sensor, seeds, score(a.wul3d, pred, truth, where_depth=a.where_depth)))
     print(f"set: {a.set}{' (incremental sequences)' if a.incremental else ''}, "
           f"flags: {' '.join(flags) if flags else '(default)'}{', scored where depth' if a.where_depth else ''}")
     print("| family | sensor | seeds | frames | objects | Overlap F | Boundary F | %>=75 |")
