@@ -18,8 +18,11 @@ enum class Spread { kStatic, kDynamic };
 template <class Part>
 void for_each_part(std::ptrdiff_t n, Spread spread, Part&& part) {
     if (omp_in_parallel()) {
+        // An unsigned counter: clang compares a signed one with its unsigned trip count
+        // (-Wsign-compare in its taskloop's code).
+        const auto parts = static_cast<std::size_t>(n > 0 ? n : 0);
 #pragma omp taskloop grainsize(1)
-        for (std::ptrdiff_t i = 0; i < n; ++i) part(i);
+        for (std::size_t i = 0; i < parts; ++i) part(static_cast<std::ptrdiff_t>(i));
     } else if (spread == Spread::kDynamic) {
 #pragma omp parallel for schedule(dynamic, 1)
         for (std::ptrdiff_t i = 0; i < n; ++i) part(i);

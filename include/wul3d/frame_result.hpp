@@ -23,6 +23,8 @@ struct StageTimes {
     double registration = 0, decimation = 0, backprojection = 0, normals = 0, background = 0,
            clustering = 0, colors = 0, plane = 0, segmentation = 0, objects = 0;
     double overlap = 0;  ///< counted in two stages above: total() takes it off once
+    bool side_by_side = false;  ///< the two ran side by side on this frame (`overlap` is then
+                                ///< their shared time, 0 where the system ran them in turn)
     /// The frame's time.
     double total() const {
         return registration + decimation + backprojection + normals + background + clustering +

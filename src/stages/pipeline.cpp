@@ -284,6 +284,7 @@ void Pipeline::Impl::run_on(const RgbdView& frame, FrameResult& r) {
     const double both_ms = ms_since(t);
     throw_if_stop_requested("the segmentation");
     if (may_overlap) side_by_side_.record(side_by_side, both_ms);
+    r.times.side_by_side = side_by_side;
     if (side_by_side)
         r.times.overlap = std::max(0.0, r.times.clustering + r.times.colors + r.times.plane +
                                             r.times.segmentation + r.times.objects - both_ms);

@@ -201,16 +201,21 @@ TEST(Pipeline, ClusteringBesideTheObjectStages_SameResultsAsOneAfterTheOther) {
     omp_set_num_threads(2);
     Pipeline two(params);
     SourceItem item;
-    double overlap = 0;
+    int side_by_side = 0;
     for (std::size_t i = 0; i < source->size(); ++i) {
         source->read(i, item);
         SCOPED_TRACE(item.frame.name);
         omp_set_num_threads(1);
         const FrameResult a = one.process(item.frame);
         EXPECT_EQ(a.times.overlap, 0.0);
+        EXPECT_FALSE(a.times.side_by_side);
         omp_set_num_threads(2);
         const FrameResult& b = two.process(item.frame);
-        overlap += b.times.overlap;
+        side_by_side += b.times.side_by_side;
+        EXPECT_GE(b.times.overlap, 0.0);
+        if (!b.times.side_by_side) {
+            EXPECT_EQ(b.times.overlap, 0.0);
+        }
         EXPECT_EQ(a.labels.labels, b.labels.labels);
         EXPECT_EQ(a.colors.rgb, b.colors.rgb);
         EXPECT_EQ(a.segments.labels, b.segments.labels);
@@ -227,7 +232,8 @@ TEST(Pipeline, ClusteringBesideTheObjectStages_SameResultsAsOneAfterTheOther) {
                     1e-9);
     }
     omp_set_num_threads(threads);
-    EXPECT_GT(overlap, 0.0) << "the stages did not run side by side (test premise)";
+    // The premise, whatever the machine's load: a period starts with frames each way.
+    EXPECT_GT(side_by_side, 0) << "the stages did not run side by side (test premise)";
 }
 
 // Without render_colors the colours are left empty and everything else is the same, at every
