@@ -96,7 +96,9 @@ def main(argv=None):
         pred = read_objects(a.out, scene, a.generated, truth)
         before = read_objects(a.against, scene, a.generated, truth) if a.against else None
         drawn = {}
-        _, _, labels, _ = scenegen.render(int(scene.name.split("_")[1]), meta["width"], meta["height"], drawn)
+        _, _, labels, _ = scenegen.render(int(scene.name.split("_")[1]), meta["width"], meta["height"], drawn,
+                                          family=meta.get("family", "tabletop"),
+                                          sensor=meta.get("sensor", "structured_light"))
         if not np.array_equal(labels, truth):
             sys.exit(f"kinds.py: {scene}: its labels are not the ones its seed draws")
         for label, kind in drawn["kinds"].items():
