@@ -34,6 +34,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
         sum.pieces += stats.ms.pieces;
         sum.gaps += stats.ms.gaps;
         sum.occluded += stats.ms.occluded;
+        sum.necks += stats.ms.necks;
         sum.scope += stats.ms.scope;
         sum.compact += stats.ms.compact;
     }
@@ -50,6 +51,7 @@ static void BM_SegmentObjects(benchmark::State& state, Segmenter segmenter) {
     state.counters["pieces_ms"] = Counter(sum.pieces, Counter::kAvgIterations);
     state.counters["gaps_ms"] = Counter(sum.gaps, Counter::kAvgIterations);
     state.counters["occluded_ms"] = Counter(sum.occluded, Counter::kAvgIterations);
+    state.counters["necks_ms"] = Counter(sum.necks, Counter::kAvgIterations);
     state.counters["scope_ms"] = Counter(sum.scope, Counter::kAvgIterations);
     state.counters["compact_ms"] = Counter(sum.compact, Counter::kAvgIterations);
 }

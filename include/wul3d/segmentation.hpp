@@ -257,17 +257,21 @@ struct SegmentStats {
     struct OcclusionCounts {
         int joins = 0;  ///< parts of one surface joined across the object before them
     } occlusion;
+    struct NeckCounts {
+        int joins = 0;  ///< necks (and caps) joined to the round body they stand on
+    } necks;
     struct ScopeCounts {
         bool applied = false;  ///< Scope::Support was applied (a support was found)
         int out_of_scope = 0;  ///< segments of min_points or more the scope left out
     } scope;
     /// Milliseconds in each phase: normal smoothing, crease cuts (seedable pixels),
     /// components, re-attachment, convexity merge, container rule, colour cue, stack rule,
-    /// pieces, floor gaps, occlusion, the scope, and the renumbering passes with the output. For the
-    /// profile in bench/.
+    /// pieces, floor gaps, occlusion, necks, the scope, and the renumbering passes with the output.
+    /// For the profile in bench/.
     struct Phases {
         double smoothing = 0, cuts = 0, components = 0, reattach = 0, merge = 0, containers = 0,
-               color = 0, stacks = 0, pieces = 0, gaps = 0, occluded = 0, scope = 0, compact = 0;
+               color = 0, stacks = 0, pieces = 0, gaps = 0, occluded = 0, necks = 0, scope = 0,
+               compact = 0;
     } ms;
 };
 

@@ -185,6 +185,7 @@ py::dict stats_dict(const Result& r) {
     out["merges"] = r.segment_stats.merge.joins;
     out["containers"] = r.segment_stats.containers.joins;
     out["occluded_joins"] = r.segment_stats.occlusion.joins;
+    out["neck_joins"] = r.segment_stats.necks.joins;
     out["gaps_filled"] = r.segment_stats.containers.gaps_filled;
     out["color_splits"] = r.segment_stats.colour.splits;
     out["texture_splits"] = r.segment_stats.colour.texture_splits;

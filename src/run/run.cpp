@@ -75,6 +75,7 @@ nlohmann::json frame_json(const std::string& name, const FrameResult& r) {
             {"merges", r.segment_stats.merge.joins},
             {"containers", r.segment_stats.containers.joins},
             {"occluded_joins", r.segment_stats.occlusion.joins},
+            {"neck_joins", r.segment_stats.necks.joins},
             {"gaps_filled", r.segment_stats.containers.gaps_filled},
             {"color_splits", r.segment_stats.colour.splits},
             {"texture_splits", r.segment_stats.colour.texture_splits},

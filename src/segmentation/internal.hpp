@@ -75,6 +75,31 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::pair<std::uint64_t, float>> occluded_lines;  ///< occlusion: segment pair,
                                                                   ///< offset per line (steps)
     std::vector<std::uint8_t> occluded_outline;  ///< occlusion: 1 = outline pixel, one row
+    // The neck rule (necks.cpp): segment pairs in contact in view and their contacts, the pairs
+    // that touch; the segments of those given slots, and per slot its points' summed height,
+    // count and greatest height; the pairs whose upper segment stands on the lower (NeckPair);
+    // per slot whether a pass wants its pixels, its lines' sums (NeckLines) and, as an upper
+    // one, its first pair.
+    struct NeckLines {
+        double a11 = 0, a12 = 0, a22 = 0, r1 = 0, r2 = 0, c4 = 0, s4 = 0;
+        int lines = 0;
+    };
+    struct NeckPair {
+        int upper = 0, lower = 0;
+        double axis[2] = {0, 0};   ///< the lower one's axis on the support plane
+        int points = 0, near = 0;  ///< the upper one's points, and those near the axis
+    };
+    std::vector<std::uint8_t> neck_outline;  ///< one row's outline pixels and run ends
+    std::vector<std::array<int, 3>> neck_runs;  ///< runs of one label: label, first pixel, length
+    std::vector<std::pair<std::uint64_t, int>> neck_pairs;
+    std::vector<int> neck_slot;      ///< per label its slot, -1 none (so between frames)
+    std::vector<int> neck_segments;  ///< per slot its label
+    std::vector<std::array<int, 2>> neck_touching;  ///< in slots
+    std::vector<std::array<float, 3>> neck_heights;
+    std::vector<NeckPair> neck_stand;  ///< in slots
+    std::vector<std::uint8_t> neck_wanted;
+    std::vector<NeckLines> neck_lines;
+    std::vector<int> neck_first;
     // Containers:
     std::vector<detail::BoundaryStep> steps;   ///< boundary pairs of two segments
     std::vector<int> rim_rows;         ///< first and last row of each segment
@@ -416,6 +441,10 @@ void fill_floor_gaps(const Ctx& x, const Plane* support, SegmentBuffers& ws, int
 /// Occlusion (occlusion.cpp; SegmentParams, "Occlusion"): joins the two parts of a surface
 /// that a nearer object divides in view. stats.occluded.
 void join_occluded(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
+
+/// Necks (necks.cpp; docs/DESIGN.md, "Necks"; `support` not null): a narrow segment standing
+/// on the axis of a round one joins it (a bottle's neck and cap on its body). stats.necks.
+void join_necks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats);
 
 /// Scope::Support (scope.cpp; docs/DESIGN.md, "Scope"; `support` not null): clears the
 /// labels of the segments the support does not hold. stats.support_scope, out_of_scope.

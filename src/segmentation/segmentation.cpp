@@ -72,6 +72,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     rule(geometric, ms.pieces, split_pieces);
     rule(geometric, ms.gaps, fill_floor_gaps);
     rule(geometric, ms.occluded, join_occluded);
+    rule(geometric && support, ms.necks, join_necks);
     rule(support && params.scope.mode == Scope::Support, ms.scope, restrict_to_support);
     out.width = W;
     out.height = H;

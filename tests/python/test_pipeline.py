@@ -79,7 +79,7 @@ def test_result_fields():
     assert r.times["total"] > 0 and set(r.times) >= {"clustering", "segmentation", "objects"}
     assert r.stats["active_points"] > 0
     assert r.stats["segments"] >= len(r.instances) > 0
-    assert {"merges", "containers", "occluded_joins", "gaps_filled", "color_splits", "texture_splits", "stack_splits",
+    assert {"merges", "containers", "occluded_joins", "neck_joins", "gaps_filled", "color_splits", "texture_splits", "stack_splits",
             "piece_splits", "low_support"} <= set(r.stats)
     assert pipeline.params["k"] == 7 and pipeline.params["decimate"] == 2
     # The result owns its arrays: the next frame does not change it.

@@ -1,0 +1,302 @@
+// The neck rule of segment_objects (docs/DESIGN.md, "Necks"): a bottle's neck and cap, which
+// the crease cuts part from its shoulder, stand on the axis of its round body: they are the
+// bottle.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "internal.hpp"
+
+namespace wul3d::detail {
+namespace {
+
+/// Two segments touch in view where a pixel of one has one of the other to its right or
+/// below, or past up to kReachPx unlabelled pixels (a depth edge's mixed points: a cap seen
+/// from above stands in front of the shoulder round it), at kMinContacts such pairs or more.
+constexpr int kReachPx = 3;
+constexpr int kMinContacts = 6;
+/// The upper segment stands on the lower: its mean height over the support at least the
+/// lower's top less this (a neck rises from the shoulder's top).
+constexpr float kAboveM = 0.01f;
+/// The lower segment is round about an upright axis where the normals of its pixels that do
+/// not face up (walls, a shoulder), laid on the support plane, meet: at least kMinLines of
+/// them, and not a box's faces, whose directions agree at four times their angle (mean
+/// resultant over kMaxBoxAxes; stacks.cpp measures boxes' walls at 0.56-0.99 and cans'
+/// at 0.07-0.13). The normals of a small box, smoothed across its edges, can pass that; then
+/// only an upper object as narrow as a neck joins it.
+constexpr int kMinLines = 20;
+constexpr double kMaxBoxAxes = 0.25;
+/// A neck: nine tenths of the upper segment's points within this of the axis on the
+/// support plane. A bottle's neck and cap are 1-3 cm across in radius; a box or a can
+/// standing on a can is wider.
+constexpr double kNeckRadiusM = 0.03;
+constexpr double kNeckShare = 0.9;
+
+/// The pairs of segments that touch in view into ws.neck_pairs: (lower label << 32 | higher,
+/// contacts), sorted by pair, a pair's contacts over one entry or more; and the runs of one
+/// label, row by row, into ws.neck_runs (label, first pixel, length). Cost: branch-free passes
+/// over the rows with labels for where the label changes, then the runs and contacts from
+/// those.
+void find_contacts(const Ctx& x, SegmentBuffers& ws) {
+    const int W = x.W, H = x.H;
+    const int* const label = ws.label.data();
+    auto& pairs = ws.neck_pairs;
+    pairs.clear();
+    auto touch = [&](int a, int b) {  // neighbouring contacts are mostly of one pair: counted in place
+        const auto lo = static_cast<std::uint64_t>(std::min(a, b)), hi = static_cast<std::uint64_t>(std::max(a, b));
+        const std::uint64_t key = (lo << 32) | hi;
+        if (!pairs.empty() && pairs.back().first == key)
+            ++pairs.back().second;
+        else
+            pairs.push_back({key, 1});
+    };
+    auto& outline = ws.neck_outline;
+    outline.resize(2 * static_cast<std::size_t>(W));
+    std::uint8_t* const edge = outline.data();
+    std::uint8_t* const ends = edge + W;  // 1 where a run of one label ends
+    auto& runs = ws.neck_runs;
+    runs.clear();
+    for (int v = 0; v < H; ++v) {
+        const int* const row = label + static_cast<std::ptrdiff_t>(v) * W;
+        if (!row_has_label(row, 0, W)) continue;
+        // The row's runs of one label (0 left out), found where the label changes.
+        for (int u = 0; u + 1 < W; ++u) ends[u] = static_cast<std::uint8_t>(row[u + 1] != row[u]);
+        ends[W - 1] = 1;
+        for (int u0 = 0; u0 < W;) {
+            const auto* end = static_cast<const std::uint8_t*>(std::memchr(ends + u0, 1, static_cast<std::size_t>(W - u0)));
+            const int u1 = static_cast<int>(end - ends) + 1;
+            if (row[u0]) runs.push_back({row[u0], v * W + u0, u1 - u0});
+            u0 = u1;
+        }
+        // Outline pixels, whose right or lower neighbour is another label, in a branch-free
+        // pass (as the occlusion rule finds them); the contacts start from those few.
+        const int* const below = v + 1 < H ? row + W : row;
+        for (int u = 0; u + 1 < W; ++u)
+            edge[u] = static_cast<std::uint8_t>((row[u] != 0) & ((row[u + 1] != row[u]) | (below[u] != row[u])));
+        edge[W - 1] = static_cast<std::uint8_t>((row[W - 1] != 0) & (below[W - 1] != row[W - 1]));
+        for (int u = 0;; ++u) {
+            const void* next = std::memchr(edge + u, 1, static_cast<std::size_t>(W - u));
+            if (!next) break;
+            u = static_cast<int>(static_cast<const std::uint8_t*>(next) - edge);
+            const int a = row[u];
+            if (u + 1 < W && row[u + 1] != a)
+                for (int k = 1; k <= kReachPx + 1 && u + k < W; ++k)  // right
+                    if (const int b = row[u + k]) {
+                        if (b != a) touch(a, b);
+                        break;
+                    }
+            if (v + 1 < H && below[u] != a)
+                for (int k = 1; k <= kReachPx + 1 && v + k < H; ++k)  // down
+                    if (const int b = row[static_cast<std::ptrdiff_t>(k) * W + u]) {
+                        if (b != a) touch(a, b);
+                        break;
+                    }
+        }
+    }
+    std::sort(pairs.begin(), pairs.end());
+}
+
+/// Sums of the lines through a segment's points along their normals laid on the support
+/// plane, for upright_axis: sum (I - d d^T) (a11, a12, a22) and its product with the points
+/// (r1, r2), the directions at four times their angle (c4, s4), the lines counted.
+using AxisSums = SegmentBuffers::NeckLines;
+
+/// The support plane's frame for add_line, in floats: its axes (PlaneAxes) and its normal.
+struct PlaneFrame {
+    float e1[3], e2[3], up[3];
+    explicit PlaneFrame(const Plane& pl) {
+        const PlaneAxes axes(pl);
+        for (int i = 0; i < 3; ++i) e1[i] = static_cast<float>(axes.e1[i]), e2[i] = static_cast<float>(axes.e2[i]);
+        up[0] = pl.nx, up[1] = pl.ny, up[2] = pl.nz;
+    }
+};
+
+/// Adds pixel p's line to `s` when it has a normal that does not face up (walls, a shoulder):
+/// d d^T and the angle doubled from the normal laid on the plane, (nu, nv), over its squared
+/// length, without a square root. Cost: about 40 operations.
+void add_line(const Ctx& x, const PlaneFrame& f, float cos_up, std::size_t p, AxisSums& s) {
+    if (!x.c.valid[p] || !x.n.valid[p]) return;
+    const float nx = x.n.nx[p], ny = x.n.ny[p], nz = x.n.nz[p];
+    if (nx * f.up[0] + ny * f.up[1] + nz * f.up[2] >= cos_up) return;  // faces up
+    const float nu = nx * f.e1[0] + ny * f.e1[1] + nz * f.e1[2], nv = nx * f.e2[0] + ny * f.e2[1] + nz * f.e2[2];
+    const double len2 = static_cast<double>(nu) * nu + static_cast<double>(nv) * nv;
+    if (!(len2 > 0.1)) return;  // facing down: no direction on the plane
+    const double inv = 1.0 / len2;
+    const double uu = nu * nu * inv, uv = nu * nv * inv, vv = nv * nv * inv;  // d d^T
+    const double Pu = x.c.x[p] * f.e1[0] + x.c.y[p] * f.e1[1] + x.c.z[p] * f.e1[2];
+    const double Pv = x.c.x[p] * f.e2[0] + x.c.y[p] * f.e2[1] + x.c.z[p] * f.e2[2];
+    const double m11 = 1 - uu, m12 = -uv, m22 = 1 - vv;  // I - d d^T
+    s.a11 += m11, s.a12 += m12, s.a22 += m22;
+    s.r1 += m11 * Pu + m12 * Pv;
+    s.r2 += m12 * Pu + m22 * Pv;
+    const double cos2 = uu - vv, sin2 = 2 * uv;  // the angle doubled, twice
+    s.c4 += cos2 * cos2 - sin2 * sin2;
+    s.s4 += 2 * sin2 * cos2;
+    ++s.lines;
+}
+
+/// Where a segment's lines (AxisSums) meet on the support plane (PlaneAxes coordinates),
+/// least squares: sum (I - d d^T) c = sum (I - d d^T) P. A solid of revolution's normals
+/// all cross its axis. Nothing with fewer than kMinLines lines or where their directions
+/// agree as a box's faces do (kMaxBoxAxes), which also keeps the system well-posed. O(1).
+std::optional<Eigen::Vector2d> upright_axis(const AxisSums& s) {
+    if (s.lines < kMinLines || std::hypot(s.c4, s.s4) > kMaxBoxAxes * s.lines) return std::nullopt;
+    const double det = s.a11 * s.a22 - s.a12 * s.a12;
+    if (!(det > 0)) return std::nullopt;
+    return Eigen::Vector2d((s.a22 * s.r1 - s.a12 * s.r2) / det, (s.a11 * s.r2 - s.a12 * s.r1) / det);
+}
+
+/// Calls visit(s, p, run) for each run label[p, p + run) of ws.neck_runs whose segment's slot
+/// s is wanted (s >= 0, wanted[s] != 0). Cost: one pass over the runs.
+template <class Visit>
+void for_wanted_runs(const SegmentBuffers& ws, const int* slot, const std::uint8_t* wanted, Visit&& visit) {
+    for (const auto& r : ws.neck_runs) {
+        const int s = slot[r[0]];
+        if (s >= 0 && wanted[s]) visit(s, static_cast<std::size_t>(r[1]), static_cast<std::size_t>(r[2]));
+    }
+}
+
+/// The neck rule's decisions (join_necks) on the segments of ws.neck_segments, slot s for
+/// segment ws.neck_segments[s] (ws.neck_slot), and the pairs of ws.neck_touching in slots.
+/// Returns the joins made in ws.parent.
+int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
+    const auto& segments = ws.neck_segments;
+    const int* const slot = ws.neck_slot.data();
+    const std::size_t S = segments.size();
+    auto& wanted = ws.neck_wanted;
+    wanted.assign(S, 1);
+    // Each segment's heights over the support: summed, counted, greatest.
+    auto& heights = ws.neck_heights;
+    heights.assign(S, {0.0f, 0.0f, -1e9f});
+    for_wanted_runs(ws, slot, wanted.data(), [&](int s, std::size_t p, std::size_t run) {
+        // The run's, in four lanes (the additions do not wait on each other).
+        float sum[4] = {0, 0, 0, 0}, count[4] = {0, 0, 0, 0}, top[4] = {-1e9f, -1e9f, -1e9f, -1e9f};
+        for (std::size_t q = p; q < p + run; ++q) {
+            const float z = pl.height(x.c.x[q], x.c.y[q], x.c.z[q]);
+            const bool in = x.c.valid[q] != 0;
+            const std::size_t k = q & 3;
+            sum[k] += in ? z : 0.0f, count[k] += in ? 1.0f : 0.0f, top[k] = std::max(top[k], in ? z : -1e9f);
+        }
+        auto& h = heights[static_cast<std::size_t>(s)];
+        h[0] += (sum[0] + sum[1]) + (sum[2] + sum[3]), h[1] += (count[0] + count[1]) + (count[2] + count[3]);
+        h[2] = std::max({h[2], top[0], top[1], top[2], top[3]});
+    });
+    auto mean = [&](int s) {
+        const auto& h = heights[static_cast<std::size_t>(s)];
+        return h[1] > 0 ? h[0] / h[1] : 0.0f;
+    };
+    // The pairs whose upper segment stands on the lower.
+    auto& stand = ws.neck_stand;
+    stand.clear();
+    for (const auto& [lo, hi] : ws.neck_touching) {
+        const int a = mean(lo) > mean(hi) ? lo : hi, b = a == lo ? hi : lo;
+        if (heights[static_cast<std::size_t>(a)][1] > 0 && mean(a) >= heights[static_cast<std::size_t>(b)][2] - kAboveM)
+            stand.push_back({a, b});
+    }
+    if (stand.empty()) return 0;
+    // The lower segments' axes; the pairs whose lower one has none dropped.
+    auto& sums = ws.neck_lines;
+    sums.assign(S, AxisSums{});
+    std::fill(wanted.begin(), wanted.end(), 0);
+    for (const auto& pair : stand) wanted[static_cast<std::size_t>(pair.lower)] = 1;
+    const PlaneFrame frame(pl);
+    const float cos_up = std::cos(kUprightDeg * kDegToRad);
+    for_wanted_runs(ws, slot, wanted.data(), [&](int s, std::size_t p, std::size_t run) {
+        auto& sum = sums[static_cast<std::size_t>(s)];
+        for (std::size_t q = p; q < p + run; ++q) add_line(x, frame, cos_up, q, sum);
+    });
+    std::size_t kept = 0;
+    for (auto pair : stand)
+        if (const auto axis = upright_axis(sums[static_cast<std::size_t>(pair.lower)])) {
+            pair.axis[0] = axis->x(), pair.axis[1] = axis->y();
+            stand[kept++] = pair;
+        }
+    stand.resize(kept);
+    if (stand.empty()) return 0;
+    // The upper segments' points near the axis of each lower one they stand on, in one pass:
+    // the pairs sorted by upper segment, first[s] its first pair.
+    std::sort(stand.begin(), stand.end(),
+              [](const auto& p, const auto& q) { return p.upper != q.upper ? p.upper < q.upper : p.lower < q.lower; });
+    auto& first = ws.neck_first;
+    first.assign(S, -1);
+    std::fill(wanted.begin(), wanted.end(), 0);
+    for (std::size_t k = stand.size(); k-- > 0;) {
+        first[static_cast<std::size_t>(stand[k].upper)] = static_cast<int>(k);
+        wanted[static_cast<std::size_t>(stand[k].upper)] = 1;
+    }
+    for_wanted_runs(ws, slot, wanted.data(), [&](int s, std::size_t p, std::size_t run) {
+        for (std::size_t q = p; q < p + run; ++q) {
+            if (!x.c.valid[q]) continue;
+            const double u = x.c.x[q] * frame.e1[0] + x.c.y[q] * frame.e1[1] + x.c.z[q] * frame.e1[2];
+            const double v = x.c.x[q] * frame.e2[0] + x.c.y[q] * frame.e2[1] + x.c.z[q] * frame.e2[2];
+            for (auto k = static_cast<std::size_t>(first[static_cast<std::size_t>(s)]); k < stand.size() && stand[k].upper == s;
+                 ++k) {
+                auto& pair = stand[k];
+                const double du = u - pair.axis[0], dv = v - pair.axis[1];
+                ++pair.points;
+                pair.near += du * du + dv * dv <= kNeckRadiusM * kNeckRadiusM;
+            }
+        }
+    });
+    int joins = 0;
+    for (const auto& pair : stand)
+        if (pair.points > 0 && pair.near >= kNeckShare * pair.points &&
+            join_sets(ws.parent, segments[static_cast<std::size_t>(pair.upper)], segments[static_cast<std::size_t>(pair.lower)]))
+            ++joins;
+    return joins;
+}
+
+}  // namespace
+
+/// The neck rule: of two segments that touch in view, the upper, standing on the lower
+/// (kAboveM), joins it when the lower is round about an upright axis (upright_axis) and
+/// kNeckShare of the upper's points lie within kNeckRadiusM of that axis. In: ws.label (1..n
+/// with gaps). Out: ws.label with the pairs joined; stats.necks.joins. Cost: find_contacts'
+/// passes over the rows with labels; where some pairs touch, three passes over the runs of
+/// their segments (heights, the lower ones' lines, the upper ones' points near the axes).
+void join_necks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
+    if (!support || n < 2) return;
+    find_contacts(x, ws);
+    // The pairs that touch at kMinContacts pairs or more, their segments given slots (-1 for
+    // the others, and again for these once done: no pass over every label number).
+    auto& slot = ws.neck_slot;
+    if (slot.size() < static_cast<std::size_t>(n) + 1) slot.resize(static_cast<std::size_t>(n) + 1, -1);
+    auto& segments = ws.neck_segments;
+    segments.clear();
+    auto slot_of = [&](int l) {
+        int& s = slot[static_cast<std::size_t>(l)];
+        if (s < 0) {
+            s = static_cast<int>(segments.size());
+            segments.push_back(l);
+        }
+        return s;
+    };
+    auto& touching = ws.neck_touching;
+    touching.clear();
+    const auto& pairs = ws.neck_pairs;
+    for (std::size_t i = 0; i < pairs.size();) {
+        std::size_t j = i;
+        int contacts = 0;
+        for (; j < pairs.size() && pairs[j].first == pairs[i].first; ++j) contacts += pairs[j].second;
+        if (contacts >= kMinContacts)
+            touching.push_back({slot_of(static_cast<int>(pairs[i].first >> 32)),
+                                slot_of(static_cast<int>(pairs[i].first & 0xffffffffu))});
+        i = j;
+    }
+    int joins = 0;
+    if (!touching.empty()) {
+        reset_sets(ws.parent, n);
+        joins = join_standing_necks(x, *support, ws);
+    }
+    for (const int l : segments) slot[static_cast<std::size_t>(l)] = -1;
+    if (joins > 0) relabel_to_roots(ws);
+    stats.necks.joins = joins;
+}
+
+}  // namespace wul3d::detail
