@@ -6,8 +6,9 @@ Usage: eval/kinds.py GENERATED OUT [--against BEFORE [--min-change 0.02]]
 GENERATED: a folder eval/scenegen.py wrote (scene_SSSSS frames and scenegen.json); OUT: what
 `wul3d run GENERATED --out OUT` wrote (OUT/scene_SSSSS/objects.png). Each scene is built again
 from its seed (the generator draws the same scene) to learn the kind of group each labelled
-object was drawn in: a box standing alone, a stack, a flat box lying on a box, a box leaning on
-another, boxes flush side by side, a cylinder, a cup, a bowl. Per kind it prints the objects,
+object was drawn in: on the tabletop a box standing alone, a stack, a flat box lying on a box,
+a box leaning on another, boxes flush side by side, a cylinder, a cup, a bowl; in the pile and
+floor families a box, a can, a bottle, a sphere, a can or bottle lying down, a stack, a lean. Per kind it prints the objects,
 their mean best IoU with any output object (IoU), what the kind loses of the mean IoU over all
 objects (its 1 - IoU summed, over all objects, in points), and how each object fared: good (IoU >= 0.75), missed (over
 half its pixels in no object), merged (its best object over 1.5 times its size) or split.
