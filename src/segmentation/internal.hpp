@@ -194,6 +194,16 @@ inline bool row_has_label(const int* row, int from, int to) {
     return any != 0;
 }
 
+/// Marks out[u] = 1 where row[u] is labelled and its right neighbour or the one below
+/// (`below`, the next row; the row itself on the last) is another label, else 0: a segment
+/// outline's pixels, in a branch-free pass that vectorizes (the occlusion and neck rules
+/// then visit those few).
+inline void mark_outline_row(const int* row, const int* below, int W, std::uint8_t* out) {
+    for (int u = 0; u + 1 < W; ++u)
+        out[u] = static_cast<std::uint8_t>((row[u] != 0) & ((row[u + 1] != row[u]) | (below[u] != row[u])));
+    out[W - 1] = static_cast<std::uint8_t>((row[W - 1] != 0) & (below[W - 1] != row[W - 1]));
+}
+
 /// The 4-neighbours of pixel p = v W + u in a W x H image (left, right, up, down); -1 where
 /// one lies past the frame.
 inline std::array<int, 4> four_neighbours(int p, int u, int v, int W, int H) {

@@ -74,12 +74,9 @@ void find_contacts(const Ctx& x, SegmentBuffers& ws) {
             if (row[u0]) runs.push_back({row[u0], v * W + u0, u1 - u0});
             u0 = u1;
         }
-        // Outline pixels, whose right or lower neighbour is another label, in a branch-free
-        // pass (as the occlusion rule finds them); the contacts start from those few.
+        // The contacts start from the outline's pixels.
         const int* const below = v + 1 < H ? row + W : row;
-        for (int u = 0; u + 1 < W; ++u)
-            edge[u] = static_cast<std::uint8_t>((row[u] != 0) & ((row[u + 1] != row[u]) | (below[u] != row[u])));
-        edge[W - 1] = static_cast<std::uint8_t>((row[W - 1] != 0) & (below[W - 1] != row[W - 1]));
+        mark_outline_row(row, below, W, edge);
         for (int u = 0;; ++u) {
             const void* next = std::memchr(edge + u, 1, static_cast<std::size_t>(W - u));
             if (!next) break;
@@ -115,6 +112,10 @@ struct PlaneFrame {
         for (int i = 0; i < 3; ++i) e1[i] = static_cast<float>(axes.e1[i]), e2[i] = static_cast<float>(axes.e2[i]);
         up[0] = pl.nx, up[1] = pl.ny, up[2] = pl.nz;
     }
+    /// Point p's coordinates on the plane (PlaneAxes').
+    std::array<double, 2> at(const OrganizedCloud& c, std::size_t p) const {
+        return {c.x[p] * e1[0] + c.y[p] * e1[1] + c.z[p] * e1[2], c.x[p] * e2[0] + c.y[p] * e2[1] + c.z[p] * e2[2]};
+    }
 };
 
 /// Adds pixel p's line to `s` when it has a normal that does not face up (walls, a shoulder):
@@ -129,8 +130,7 @@ void add_line(const Ctx& x, const PlaneFrame& f, float cos_up, std::size_t p, Ax
     if (!(len2 > 0.1)) return;  // facing down: no direction on the plane
     const double inv = 1.0 / len2;
     const double uu = nu * nu * inv, uv = nu * nv * inv, vv = nv * nv * inv;  // d d^T
-    const double Pu = x.c.x[p] * f.e1[0] + x.c.y[p] * f.e1[1] + x.c.z[p] * f.e1[2];
-    const double Pv = x.c.x[p] * f.e2[0] + x.c.y[p] * f.e2[1] + x.c.z[p] * f.e2[2];
+    const auto [Pu, Pv] = f.at(x.c, p);
     const double m11 = 1 - uu, m12 = -uv, m22 = 1 - vv;  // I - d d^T
     s.a11 += m11, s.a12 += m12, s.a22 += m22;
     s.r1 += m11 * Pu + m12 * Pv;
@@ -233,8 +233,7 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     for_wanted_runs(ws, slot, wanted.data(), [&](int s, std::size_t p, std::size_t run) {
         for (std::size_t q = p; q < p + run; ++q) {
             if (!x.c.valid[q]) continue;
-            const double u = x.c.x[q] * frame.e1[0] + x.c.y[q] * frame.e1[1] + x.c.z[q] * frame.e1[2];
-            const double v = x.c.x[q] * frame.e2[0] + x.c.y[q] * frame.e2[1] + x.c.z[q] * frame.e2[2];
+            const auto [u, v] = frame.at(x.c, q);
             for (auto k = static_cast<std::size_t>(first[static_cast<std::size_t>(s)]); k < stand.size() && stand[k].upper == s;
                  ++k) {
                 auto& pair = stand[k];

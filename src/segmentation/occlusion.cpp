@@ -111,9 +111,7 @@ void collect_lines(const Ctx& x, SegmentBuffers& ws, float cos_max) {
         // Outline pixels, whose right or lower neighbour is not of their segment, in a
         // branch-free pass; the lines start from those few.
         const int* const below = v + 1 < H ? row + W : row;
-        for (int u = 0; u + 1 < W; ++u)
-            outline[u] = static_cast<std::uint8_t>((row[u] != 0) & ((row[u + 1] != row[u]) | (below[u] != row[u])));
-        outline[W - 1] = static_cast<std::uint8_t>((row[W - 1] != 0) & (below[W - 1] != row[W - 1]));
+        mark_outline_row(row, below, W, outline);
         for (int u = 0;; ++u) {  // right, then down; each pair is met from one side
             const void* next = std::memchr(outline + u, 1, static_cast<std::size_t>(W - u));
             if (!next) break;
