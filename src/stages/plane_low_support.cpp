@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "plane_internal.hpp"
@@ -22,9 +23,17 @@ constexpr float kMaxHeightM = 0.05f;
 /// a book or a box lying flat, less than a board that holds several objects (the floor
 /// family's are 0.12-0.48 m^2).
 constexpr float kMinAreaM2 = 0.1f;
-/// A tray's rim stands round its bottom: up to kMaxHeightM over the bottom, within this many
-/// grid cells outside the convex hull of the bottom's visible piece (a rim is 1-2 cm wide).
+/// The low support's extent in the image: the convex hull of its top's visible piece on the
+/// grid, this many cells wider (its edge).
 constexpr int kRimCells = 2;
+/// A tray's rim stands round its bottom: up to kMaxHeightM over the bottom, its foot within
+/// this of the convex hull of the bottom's visible piece on the plane (a rim is 1.6 cm wide,
+/// and a noisy camera's piece stops short of it). On the plane, not in the image: a camera
+/// looking down sees a rim's outer wall spread in the image by its height, over more than
+/// kRimCells in front (active stereo's holes then broke it into pieces too small for the
+/// scope's low supports), while an object on the floor has its foot off the tray. The same
+/// 5 cm as the height (first 60 floor tune seeds: 3, 4, 5 and 7 cm tried, 4 and 5 best).
+constexpr float kRimM = kMaxHeightM;
 /// The layer counts points from this share of the support's band over it, not from the band
 /// itself: the band is the noise's tolerance at a point's depth (17 mm at 1.5 m), and a board
 /// 1.5-2 cm thick seen that far has its top in the band's upper part, too few of its points
@@ -140,23 +149,68 @@ void join_across_objects(const Grid& grid, const PlaneWorkspace::Buffers::GridPo
         });
 }
 
+/// Two orthogonal axes in the plane `pl`: a point's coordinates on them are those of its foot.
+struct FootAxes {
+    cv::Vec3f e1, e2;
+    explicit FootAxes(const Plane& pl) {
+        const cv::Vec3f n(pl.nx, pl.ny, pl.nz);
+        const cv::Vec3f a = std::fabs(n[0]) < 0.9f ? cv::Vec3f(1, 0, 0) : cv::Vec3f(0, 1, 0);
+        e1 = cv::normalize(a - n * a.dot(n));
+        e2 = n.cross(e1);
+    }
+    cv::Point2f foot(float x, float y, float z) const {
+        return {x * e1[0] + y * e1[1] + z * e1[2], x * e2[0] + y * e2[1] + z * e2[2]};
+    }
+};
+
+/// The convex hull of `piece`'s points moved onto the plane `pl` (FootAxes' coordinates);
+/// empty under three points.
+std::vector<cv::Point2f> hull_on_plane(const PlaneWorkspace::Buffers::GridPoints& gp, const std::vector<int>& piece,
+                                       const Plane& pl) {
+    const FootAxes axes(pl);
+    std::vector<cv::Point2f> points, hull;
+    points.reserve(piece.size());
+    for (const int g : piece) points.push_back(axes.foot(gp.x[g], gp.y[g], gp.z[g]));
+    if (points.size() >= 3) cv::convexHull(points, hull);
+    return hull;
+}
+
 /// The area of the convex hull of `piece`'s points moved onto the plane `pl`, in m^2.
 double area_on_plane(const PlaneWorkspace::Buffers::GridPoints& gp, const std::vector<int>& piece,
                      const Plane& pl) {
-    // Two axes in the plane: any direction not along the normal, made orthogonal.
-    const cv::Vec3f n(pl.nx, pl.ny, pl.nz);
-    const cv::Vec3f a = std::fabs(n[0]) < 0.9f ? cv::Vec3f(1, 0, 0) : cv::Vec3f(0, 1, 0);
-    const cv::Vec3f e1 = cv::normalize(a - n * a.dot(n)), e2 = n.cross(e1);
-    std::vector<cv::Point2f> points, hull;
-    points.reserve(piece.size());
-    for (const int g : piece) {
-        const cv::Vec3f p(gp.x[g], gp.y[g], gp.z[g]);
-        points.emplace_back(p.dot(e1), p.dot(e2));
-    }
-    if (points.size() < 3) return 0;
-    cv::convexHull(points, hull);
-    return cv::contourArea(hull);
+    const std::vector<cv::Point2f> hull = hull_on_plane(gp, piece, pl);
+    return hull.size() < 3 ? 0.0 : cv::contourArea(hull);
 }
+
+/// A convex polygon and its edges' lines (outward unit normal and offset), to tell cheaply
+/// whether a point lies within a distance of it.
+struct Outline {
+    std::vector<cv::Point2f> corners;
+    std::vector<cv::Point3f> edges;  ///< (nx, ny, offset): n . q - offset is q's signed distance
+
+    explicit Outline(std::vector<cv::Point2f> polygon) : corners(std::move(polygon)) {
+        cv::Point2f centre(0, 0);
+        for (const cv::Point2f& q : corners) centre += q;
+        centre *= 1.0f / static_cast<float>(corners.size());
+        for (std::size_t i = 0; i < corners.size(); ++i) {
+            const cv::Point2f a = corners[i], b = corners[(i + 1) % corners.size()];
+            cv::Point2f n(b.y - a.y, a.x - b.x);
+            const float length = std::hypot(n.x, n.y);
+            if (length <= 0.0f) continue;
+            n *= 1.0f / length;
+            if (n.dot(centre - a) > 0.0f) n = -n;
+            edges.emplace_back(n.x, n.y, n.dot(a));
+        }
+    }
+    /// Whether `q` lies within `r` of the polygon. More than `r` beyond one edge's line, it does
+    /// not (most points far from it stop there); otherwise the exact distance. O(edges).
+    bool within(cv::Point2f q, float r) const {
+        float beyond = -1e30f;
+        for (const cv::Point3f& e : edges) beyond = std::max(beyond, e.x * q.x + e.y * q.y - e.z);
+        if (beyond > r) return false;
+        return beyond <= 0.0f || cv::pointPolygonTest(corners, q, true) >= -r;
+    }
+};
 
 }  // namespace
 
@@ -217,6 +271,10 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     cv::Mat hull = cv::Mat::zeros(grid.h, grid.w, CV_8U), extent;
     cv::fillConvexPoly(hull, corners, cv::Scalar(1));
     cv::dilate(hull, extent, cv::Mat::ones(2 * kRimCells + 1, 2 * kRimCells + 1, CV_8U));
+    // ... and on the plane, where a tray's rim stands round it.
+    const Outline outline(hull_on_plane(gp, ws.low_piece, low));
+    if (outline.corners.size() < 3) return 0;
+    const FootAxes axes(low);
     // 4. It holds objects: min_region_points grid points stand over its extent, clear of its
     // band (books lying side by side, with nothing on them, are objects, not a support).
     int standing = 0;
@@ -231,7 +289,8 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     // the board (a tray under active stereo at 1.5 m). So is every pixel the support's
     // classes took for a container's inside there: a board whose top lies in the support's
     // band, enclosed by its own edge, looks like one, and the segmentation would join it to
-    // that edge, the objects on it with it.
+    // that edge, the objects on it with it. Off the hull, a tray's rim is removed whole
+    // (kRimM).
     const int W = cloud.width, H = cloud.height;
     std::size_t removed = 0;
     for (int v = 0; v < H; ++v) {
@@ -239,10 +298,11 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
         const std::uint8_t* const hull_row = hull.ptr<std::uint8_t>(v / grid.s);
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
-            if ((classes[p] != kPlaneObject && classes[p] != kPlaneInside) || !cell_row[u / grid.s]) continue;
+            if (classes[p] != kPlaneObject && classes[p] != kPlaneInside) continue;
             const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z), band = removal_band(z);
-            const bool rim = !hull_row[u / grid.s] && hl <= kMaxHeightM;  // round the bottom: a tray's rim
-            if (hl > band && !rim) continue;
+            const bool rim = !hull_row[u / grid.s] && hl <= kMaxHeightM &&  // round the bottom: a tray's rim
+                             outline.within(axes.foot(cloud.x[p], cloud.y[p], z), kRimM);
+            if (!rim && (hl > band || !cell_row[u / grid.s])) continue;
             const bool facing = normals.valid[p] &&
                                 normals.nx[p] * low.nx + normals.ny[p] * low.ny + normals.nz[p] * low.nz >=
                                     inliers.cos_inlier;
