@@ -190,9 +190,9 @@ bool fit_grid_points(const InlierTest& grid, int min_points, const std::uint8_t*
 /// image, every object pixel (or container's inside) not above the low support's band is
 /// removed (its top, its sides, what lies under it), but those on its band facing otherwise,
 /// which become candidate feet; off it, those up to 5 cm over the low support whose foot lies
-/// within 5 cm of the piece's hull on the plane (a tray's rim). The layer and its plane take `inliers`' band (the given
-/// one); the pixels take `removal_band` (the frame's, widened with its noise as the
-/// support's pixels' is). Out: `classes`, `low` (its plane, when found); returns the pixels
+/// within 5 cm of the piece's hull on the plane (a tray's rim). The layer and its plane take
+/// `inliers`' band (the given one); the pixels take `removal_band` (the frame's, widened with
+/// its noise as the support's pixels' is). Out: `classes`, `low` (its plane, when found); returns the pixels
 /// removed (0: none found).
 /// O(G) for the layer and its pieces, O(N) for the pixels and a test against the hull's edges
 /// for each pixel low enough to be a rim; OpenCV allocates the hulls.

@@ -32,7 +32,7 @@ constexpr int kRimCells = 2;
 /// looking down sees a rim's outer wall spread in the image by its height, over more than
 /// kRimCells in front (active stereo's holes then broke it into pieces too small for the
 /// scope's low supports), while an object on the floor has its foot off the tray. The same
-/// 5 cm as the height (first 60 floor tune seeds: 3, 4, 5 and 7 cm tried, 4 and 5 best).
+/// 5 cm as the height (first 60 floor tune seeds: 3, 4, 5 and 7 cm tried, 5 best, 4 close).
 constexpr float kRimM = kMaxHeightM;
 /// The layer counts points from this share of the support's band over it, not from the band
 /// itself: the band is the noise's tolerance at a point's depth (17 mm at 1.5 m), and a board
