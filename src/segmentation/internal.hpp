@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "../plane_axes.hpp"
 #include "wul3d/cloud.hpp"
 #include "wul3d/normals.hpp"
 #include "wul3d/plane.hpp"
@@ -272,24 +273,6 @@ inline bool faces_sideways(const Ctx& x, const Plane& pl, std::size_t p, float s
 inline bool faces_up(const Ctx& x, const Plane& pl, std::size_t p, float cos_min) {
     return x.n.valid[p] && x.n.nx[p] * pl.nx + x.n.ny[p] * pl.ny + x.n.nz[p] * pl.nz >= cos_min;
 }
-
-/// Coordinates on the support plane: e1, e2 orthogonal to its normal (a foot's position is
-/// the point's).
-struct PlaneAxes {
-    Eigen::Vector3d e1, e2;
-
-    explicit PlaneAxes(const Plane& pl) {
-        const Eigen::Vector3d nrm(pl.nx, pl.ny, pl.nz);
-        int least = 0;  // the axis least aligned with the normal: a well-conditioned cross product
-        nrm.cwiseAbs().minCoeff(&least);
-        e1 = nrm.cross(Eigen::Vector3d::Unit(least)).normalized();
-        e2 = nrm.cross(e1);
-    }
-    Eigen::Vector2d operator()(const OrganizedCloud& c, std::size_t p) const {
-        const Eigen::Vector3d X(c.x[p], c.y[p], c.z[p]);
-        return Eigen::Vector2d(X.dot(e1), X.dot(e2));
-    }
-};
 
 /// The points `for_pixels` visits (it calls its argument with each pixel) on the support
 /// plane, less `mean` (for the circle fit's conditioning): what fit_circle takes.

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "plane_axes.hpp"
 #include "plane_internal.hpp"
 
 namespace wul3d::detail {
@@ -149,28 +150,20 @@ void join_across_objects(const Grid& grid, const PlaneWorkspace::Buffers::GridPo
         });
 }
 
-/// Two orthogonal axes in the plane `pl`: a point's coordinates on them are those of its foot.
-struct FootAxes {
-    cv::Vec3f e1, e2;
-    explicit FootAxes(const Plane& pl) {
-        const cv::Vec3f n(pl.nx, pl.ny, pl.nz);
-        const cv::Vec3f a = std::fabs(n[0]) < 0.9f ? cv::Vec3f(1, 0, 0) : cv::Vec3f(0, 1, 0);
-        e1 = cv::normalize(a - n * a.dot(n));
-        e2 = n.cross(e1);
-    }
-    cv::Point2f foot(float x, float y, float z) const {
-        return {x * e1[0] + y * e1[1] + z * e1[2], x * e2[0] + y * e2[1] + z * e2[2]};
-    }
-};
+/// A point's foot on the plane of `axes`, in floats for OpenCV's polygons.
+cv::Point2f foot(const PlaneAxes& axes, float x, float y, float z) {
+    const Eigen::Vector2d q = axes(x, y, z);
+    return {static_cast<float>(q.x()), static_cast<float>(q.y())};
+}
 
-/// The convex hull of `piece`'s points moved onto the plane `pl` (FootAxes' coordinates);
+/// The convex hull of `piece`'s points moved onto the plane `pl` (PlaneAxes' coordinates);
 /// empty under three points.
 std::vector<cv::Point2f> hull_on_plane(const PlaneWorkspace::Buffers::GridPoints& gp, const std::vector<int>& piece,
                                        const Plane& pl) {
-    const FootAxes axes(pl);
+    const PlaneAxes axes(pl);
     std::vector<cv::Point2f> points, hull;
     points.reserve(piece.size());
-    for (const int g : piece) points.push_back(axes.foot(gp.x[g], gp.y[g], gp.z[g]));
+    for (const int g : piece) points.push_back(foot(axes, gp.x[g], gp.y[g], gp.z[g]));
     if (points.size() >= 3) cv::convexHull(points, hull);
     return hull;
 }
@@ -274,7 +267,7 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
     // ... and on the plane, where a tray's rim stands round it.
     const Outline outline(hull_on_plane(gp, ws.low_piece, low));
     if (outline.corners.size() < 3) return 0;
-    const FootAxes axes(low);
+    const PlaneAxes axes(low);
     // 4. It holds objects: min_region_points grid points stand over its extent, clear of its
     // band (books lying side by side, with nothing on them, are objects, not a support).
     int standing = 0;
@@ -299,10 +292,12 @@ std::size_t remove_low_support(const PlaneParams& params, const Grid& grid, cons
         for (int u = 0; u < W; ++u) {
             const std::size_t p = static_cast<std::size_t>(v) * W + u;
             if (classes[p] != kPlaneObject && classes[p] != kPlaneInside) continue;
-            const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z), band = removal_band(z);
+            const float z = cloud.z[p], hl = low.height(cloud.x[p], cloud.y[p], z);
             const bool rim = !hull_row[u / grid.s] && hl <= kMaxHeightM &&  // round the bottom: a tray's rim
-                             outline.within(axes.foot(cloud.x[p], cloud.y[p], z), kRimM);
-            if (!rim && (hl > band || !cell_row[u / grid.s])) continue;
+                             outline.within(foot(axes, cloud.x[p], cloud.y[p], z), kRimM);
+            if (!rim && !cell_row[u / grid.s]) continue;
+            const float band = removal_band(z);
+            if (!rim && hl > band) continue;
             const bool facing = normals.valid[p] &&
                                 normals.nx[p] * low.nx + normals.ny[p] * low.ny + normals.nz[p] * low.nz >=
                                     inliers.cos_inlier;
