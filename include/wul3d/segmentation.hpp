@@ -281,10 +281,12 @@ struct SegmentStats {
 /// points it removed (PlaneResult::low_support; nullptr when none), which the scope counts
 /// inside the support's volume. `clusters` are the ClusterState labels of the same
 /// frame (used by kmeans; may be empty for geometric and hybrid). `out` gets 0 =
-/// background, 1..n = segment.
+/// background, 1..n = segment. `depth_noise_rel` is the depth's measured noise relative to
+/// depth, sigma_z / z (the pipeline passes measure_depth_noise's noise_px over fx; 0: none):
+/// the colour cue's round test allows for the scatter it gives the walls of a can.
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
                              const Plane* support, const Plane* low_support, const LabelImage& clusters,
-                             SegmentWorkspace& ws, LabelImage& out);
+                             SegmentWorkspace& ws, LabelImage& out, float depth_noise_rel = 0.0f);
 
 }  // namespace wul3d

@@ -329,11 +329,20 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, cons
 /// share the top one.
 constexpr double kRoundLayerM = 0.01;
 constexpr int kRoundLayers = 48;
+/// The depth's noise scatters a wall's points along their rays; stands_round's residual
+/// allows this many times the scatter the frame's measured noise (Ctx::depth_noise_rel)
+/// gives each wall point across its circle. The measure leaves out the noisiest tenth of
+/// its samples, and an active-stereo camera's error grows with z^2 from the frame's typical
+/// depth. First 60 family tune seeds, the nine sets summed: 1 / 1.25 / 1.5 / 1.75 / 2 / 3
+/// times 808.1 / 808.6 / 809.0 / 809.1 / 808.8 / 807.5, 807.8 without (docs/ABLATION.md,
+/// "Colour cue"); the least on the plateau kept.
+constexpr double kRoundNoiseScale = 1.5;
 
 /// Whether the pixels px[0, m) of one segment stand round on the support pl: a quarter of
 /// them or more are walls (normals within colour.round_deg of the plane), the walls lie on
 /// upright circles about one axis, one per layer of height (fit_coaxial on the plane: RMS
-/// within containers.max_residual_m at any depth, as the containers' rims, spanning
+/// within containers.max_residual_m, or, added in quadrature, kRoundNoiseScale times the
+/// scatter across the circle that the measured depth noise gives the walls' points; spanning
 /// containers.min_arc of the mean diameter, radii up to colour.round_max_radius_m) and three
 /// quarters of them face within colour.round_deg of their radii. A can, a bottle or a cup
 /// is one solid of revolution; two objects flush in view show flat faces. Cost: two passes
@@ -371,22 +380,30 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     R /= walls;
     if (!(R > 0) || widest > prm.colour.round_max_radius_m) return false;
     const double cos_radial = std::cos(prm.colour.round_deg * kDegToRad);
-    // Residual, the walls' extent (the diagonal of their box on the plane) and how many
-    // face along a radius (either way: a cup's inside faces in).
-    double res = 0, radial = 0;
+    // Residual, the noise's share of it, the walls' extent (the diagonal of their box on the
+    // plane) and how many face along a radius (either way: a cup's inside faces in).
+    double res = 0, noise = 0, radial = 0;
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::max()), hi = -lo;
     for_walls([&](std::size_t p) {
         const Eigen::Vector2d d = plane_xy(x.c, p) - mean - fit.centre;
         const double r = d.norm(), off = r - fit.radius[layer_of(p)];
         res += off * off;
+        // A depth error of sigma_z = depth_noise_rel z moves the point along its ray by
+        // depth_noise_rel times its position, so across the circle by depth_noise_rel times
+        // the position's component along the radius (on the plane: the camera at its origin).
+        if (r > 0) {
+            const double across = x.depth_noise_rel * plane_xy(x.c, p).dot(d) / r;
+            noise += across * across;
+        }
         const Eigen::Vector3d nrm(x.n.nx[p], x.n.ny[p], x.n.nz[p]);
         const Eigen::Vector2d n2(nrm.dot(plane_xy.e1), nrm.dot(plane_xy.e2));  // the normal on the plane
         radial += std::fabs(n2.dot(d)) >= cos_radial * n2.norm() * r;
         lo = lo.cwiseMin(d);
         hi = hi.cwiseMax(d);
     });
-    return std::sqrt(res / walls) <= prm.containers.max_residual_m && (hi - lo).norm() >= prm.containers.min_arc * 2 * R &&
-           4 * radial >= 3 * walls;
+    const double on_circle = prm.containers.max_residual_m;
+    return res <= on_circle * on_circle * walls + kRoundNoiseScale * kRoundNoiseScale * noise &&
+           (hi - lo).norm() >= prm.containers.min_arc * 2 * R && 4 * radial >= 3 * walls;
 }
 
 /// Boundary pairs on one plane that a brightness step needs: as many as the convexity

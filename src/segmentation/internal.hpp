@@ -245,6 +245,7 @@ struct Ctx {
     const std::vector<std::uint8_t>& cls;
     int W, H;
     const Plane* low_support = nullptr;
+    float depth_noise_rel = 0.0f;  ///< the depth's measured noise over depth, sigma_z / z
 
     /// sensor_depth_step with this frame's parameters.
     float depth_step(float z) const { return sensor_depth_step(prm.depth_jump_m, prm.depth_jump_rel, z); }

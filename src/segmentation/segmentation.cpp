@@ -42,14 +42,15 @@ SegmentWorkspace::Buffers& SegmentWorkspace::buffers() {
 SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& cloud,
                              const NormalMap& normals, const std::vector<std::uint8_t>& classes,
                              const Plane* support, const Plane* low_support, const LabelImage& clusters,
-                             SegmentWorkspace& workspace, LabelImage& out) {
+                             SegmentWorkspace& workspace, LabelImage& out, float depth_noise_rel) {
     using namespace detail;
     SegmentBuffers& ws = workspace.buffers();
     const int W = cloud.width, H = cloud.height;
     SegmentStats stats;
     SegmentStats::Phases& ms = stats.ms;
     Lap lap;
-    const Ctx x{params, cloud, crease_normals(params, normals, classes, W, H, ws), classes, W, H, low_support};
+    const Ctx x{params, cloud, crease_normals(params, normals, classes, W, H, ws), classes, W, H, low_support,
+                depth_noise_rel};
     ms.smoothing = lap();
     find_seeds(x, normals.valid.data(), clusters, ws);
     ms.cuts = lap();

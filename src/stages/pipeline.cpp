@@ -410,7 +410,8 @@ void Pipeline::Impl::plane_and_segments(const RgbdView& frame, FrameResult& r) {
     r.segment_stats = segment_objects(segmentation, cloud_, normals_, r.plane_classes,
                                       r.plane.found ? &r.plane.support : nullptr,
                                       r.plane.found && r.plane.low_found ? &r.plane.low_support : nullptr, r.labels,
-                                      segment_ws_, r.segments);
+                                      segment_ws_, r.segments,
+                                      r.depth_noise_px / static_cast<float>(frame.intrinsics.fx));
     r.times.segmentation = ms_since(t);
 }
 
