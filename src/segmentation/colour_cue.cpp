@@ -322,13 +322,6 @@ SplitBoundary split_boundary(const Ctx& x, const SegmentBuffers& ws, int l, cons
     return sb;
 }
 
-/// The layers of stands_round's walls: kRoundLayerM of height over the support each, so that a
-/// bottle's neck and its body, narrower and wider, are circles about one axis. 0.5, 1 and
-/// 2 cm scored alike on the generated tune seeds (docs/ABLATION.md, "Colour cue"). The
-/// layers reach 48 cm, about the scope's height limit (scope.max_height_m); walls higher
-/// share the top one.
-constexpr double kRoundLayerM = 0.01;
-constexpr int kRoundLayers = 48;
 /// The depth's noise scatters a wall's points along their rays; stands_round's residual
 /// allows this many times the scatter the frame's measured noise (Ctx::depth_noise_rel)
 /// gives each wall point across its circle. The measure leaves out the noisiest tenth of
@@ -364,10 +357,7 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     });
     if (walls < 3 || 4 * walls < m) return false;
     mean /= walls;
-    auto layer_of = [&](std::size_t p) {
-        const double h = pl.height(x.c.x[p], x.c.y[p], x.c.z[p]);
-        return std::clamp(static_cast<int>(std::floor(h / kRoundLayerM)), 0, kRoundLayers - 1);
-    };
+    auto layer_of = [&](std::size_t p) { return round_layer(pl.height(x.c.x[p], x.c.y[p], x.c.z[p])); };
     const auto fit = fit_coaxial<kRoundLayers>([&](auto&& visit) {
         for_walls([&](std::size_t p) { visit(Eigen::Vector2d(plane_xy(x.c, p) - mean), layer_of(p)); });
     });

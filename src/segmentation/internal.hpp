@@ -79,11 +79,15 @@ struct SegmentWorkspace::Buffers {
     // The neck rule (necks.cpp): segment pairs in contact in view and their contacts, the pairs
     // that touch; the segments of those given slots, and per slot its points' summed height,
     // count and greatest height; the pairs whose upper segment stands on the lower (NeckPair);
-    // per slot whether a pass wants its pixels, its lines' sums (NeckLines) and, as an upper
-    // one, its first pair.
-    struct NeckLines {
-        double a11 = 0, a12 = 0, a22 = 0, r1 = 0, r2 = 0, c4 = 0, s4 = 0;
-        int lines = 0;
+    // per slot whether a pass wants its pixels, its walls' sums (NeckWallSums), as a lower one
+    // its walls (NeckWall) and axis, and as an upper one its first pair.
+    struct NeckWallSums {
+        double c4 = 0, s4 = 0;  ///< the normals' directions on the plane at four times their angle
+        int walls = 0;
+    };
+    struct NeckWall {
+        int slot, layer;  ///< layer: round_layer of its height
+        double u, v;      ///< on the support plane (PlaneAxes)
     };
     struct NeckPair {
         int upper = 0, lower = 0;
@@ -99,7 +103,9 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::array<float, 3>> neck_heights;
     std::vector<NeckPair> neck_stand;  ///< in slots
     std::vector<std::uint8_t> neck_wanted;
-    std::vector<NeckLines> neck_lines;
+    std::vector<NeckWallSums> neck_wall_sums;
+    std::vector<NeckWall> neck_walls, neck_walls_by_slot;  ///< the lower segments' walls, then by slot
+    std::vector<std::array<double, 3>> neck_axes;  ///< per slot: a round body's axis (u, v), 1 where found
     std::vector<int> neck_first;
     // Containers:
     std::vector<detail::BoundaryStep> steps;   ///< boundary pairs of two segments
@@ -234,6 +240,20 @@ inline void chromaticity(const OrganizedCloud& c, std::size_t p, float (&out)[3]
 /// normal lies within this of the support plane, and up when within this of its normal.
 /// Shared by the round test, the scope and the stack rule.
 constexpr float kUprightDeg = 25.0f;
+
+/// The walls of a solid of revolution are fitted with circles about one axis, one per layer
+/// of height over the support (fit_coaxial), so that a bottle's neck and its body, narrower
+/// and wider, share their centre: kRoundLayerM of height each. 0.5, 1 and 2 cm scored alike
+/// on the generated tune seeds (docs/ABLATION.md, "Colour cue"). The layers reach 48 cm,
+/// about the scope's height limit (scope.max_height_m); walls higher share the top one.
+/// Shared by the round test and the neck rule.
+constexpr double kRoundLayerM = 0.01;
+constexpr int kRoundLayers = 48;
+
+/// The layer of kRoundLayerM that height h over the support falls in.
+inline int round_layer(double h) {
+    return std::clamp(static_cast<int>(std::floor(h / kRoundLayerM)), 0, kRoundLayers - 1);
+}
 
 /// What every phase reads: the parameters, the frame and the normals of the crease tests
 /// (smoothed when cuts.normal_smooth_px > 0), the plane's classes per pixel, and the top of

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "../circle_fit.hpp"
 #include "internal.hpp"
 
 namespace wul3d::detail {
@@ -24,13 +25,14 @@ constexpr int kMinContacts = 6;
 /// The upper segment stands on the lower: its mean height over the support at least the
 /// lower's top less this (a neck rises from the shoulder's top).
 constexpr float kAboveM = 0.01f;
-/// The lower segment is round about an upright axis where the normals of its pixels that do
-/// not face up (walls, a shoulder), laid on the support plane, meet: at least kMinLines of
-/// them, and not a box's faces, whose directions agree at four times their angle (mean
-/// resultant over kMaxBoxAxes; stacks.cpp measures boxes' walls at 0.56-0.99 and cans'
-/// at 0.07-0.13). The normals of a small box, smoothed across its edges, can pass that; then
-/// only an upper object as narrow as a neck joins it.
-constexpr int kMinLines = 20;
+/// The lower segment is round about an upright axis: its walls (pixels whose normal does not
+/// face up: a body's sides, a shoulder) are kMinWalls or more and not a box's faces, whose
+/// normals laid on the support plane agree at four times their angle (mean resultant over
+/// kMaxBoxAxes; stacks.cpp measures boxes' walls at 0.56-0.99 and cans' at 0.07-0.13). The
+/// normals of a small box, smoothed across its edges, can pass that; then only an upper
+/// object as narrow as a neck joins it. The axis is the centre of circles fitted to the
+/// walls' points on the plane, one per layer of height (fit_coaxial, as the round test's).
+constexpr int kMinWalls = 20;
 constexpr double kMaxBoxAxes = 0.25;
 /// A neck: nine tenths of the upper segment's points within this of the axis on the
 /// support plane. A bottle's neck and cap are 1-3 cm across in radius; a box or a can
@@ -99,12 +101,12 @@ void find_contacts(const Ctx& x, SegmentBuffers& ws) {
     std::sort(pairs.begin(), pairs.end());
 }
 
-/// Sums of the lines through a segment's points along their normals laid on the support
-/// plane, for upright_axis: sum (I - d d^T) (a11, a12, a22) and its product with the points
-/// (r1, r2), the directions at four times their angle (c4, s4), the lines counted.
-using AxisSums = SegmentBuffers::NeckLines;
+/// A segment's walls' normals laid on the support plane, for round_body: their directions at
+/// four times their angle (c4, s4), the walls counted.
+using WallSums = SegmentBuffers::NeckWallSums;
+using Wall = SegmentBuffers::NeckWall;
 
-/// The support plane's frame for add_line, in floats: its axes (PlaneAxes) and its normal.
+/// The support plane's frame for add_wall, in floats: its axes (PlaneAxes) and its normal.
 struct PlaneFrame {
     float e1[3], e2[3], up[3];
     explicit PlaneFrame(const Plane& pl) {
@@ -118,10 +120,12 @@ struct PlaneFrame {
     }
 };
 
-/// Adds pixel p's line to `s` when it has a normal that does not face up (walls, a shoulder):
-/// d d^T and the angle doubled from the normal laid on the plane, (nu, nv), over its squared
-/// length, without a square root. Cost: about 40 operations.
-void add_line(const Ctx& x, const PlaneFrame& f, float cos_up, std::size_t p, AxisSums& s) {
+/// Adds pixel p of the segment in `slot` to `s` and to `walls` when it is a wall, a normal
+/// that does not face up (a body's side, a shoulder): the angle doubled twice of the normal
+/// laid on the plane, (nu, nv), from its squared length without a square root; the point on
+/// the plane and its layer of height (round_layer). Cost: about 40 operations.
+void add_wall(const Ctx& x, const Plane& pl, const PlaneFrame& f, float cos_up, std::size_t p, int slot, WallSums& s,
+              std::vector<Wall>& walls) {
     if (!x.c.valid[p] || !x.n.valid[p]) return;
     const float nx = x.n.nx[p], ny = x.n.ny[p], nz = x.n.nz[p];
     if (nx * f.up[0] + ny * f.up[1] + nz * f.up[2] >= cos_up) return;  // faces up
@@ -129,27 +133,36 @@ void add_line(const Ctx& x, const PlaneFrame& f, float cos_up, std::size_t p, Ax
     const double len2 = static_cast<double>(nu) * nu + static_cast<double>(nv) * nv;
     if (!(len2 > 0.1)) return;  // facing down: no direction on the plane
     const double inv = 1.0 / len2;
-    const double uu = nu * nu * inv, uv = nu * nv * inv, vv = nv * nv * inv;  // d d^T
-    const auto [Pu, Pv] = f.at(x.c, p);
-    const double m11 = 1 - uu, m12 = -uv, m22 = 1 - vv;  // I - d d^T
-    s.a11 += m11, s.a12 += m12, s.a22 += m22;
-    s.r1 += m11 * Pu + m12 * Pv;
-    s.r2 += m12 * Pu + m22 * Pv;
-    const double cos2 = uu - vv, sin2 = 2 * uv;  // the angle doubled, twice
+    const double cos2 = (nu * nu - nv * nv) * inv, sin2 = 2 * nu * nv * inv;  // the angle doubled
     s.c4 += cos2 * cos2 - sin2 * sin2;
     s.s4 += 2 * sin2 * cos2;
-    ++s.lines;
+    ++s.walls;
+    const auto [Pu, Pv] = f.at(x.c, p);
+    walls.push_back({slot, round_layer(pl.height(x.c.x[p], x.c.y[p], x.c.z[p])), Pu, Pv});
 }
 
-/// Where a segment's lines (AxisSums) meet on the support plane (PlaneAxes coordinates),
-/// least squares: sum (I - d d^T) c = sum (I - d d^T) P. A solid of revolution's normals
-/// all cross its axis. Nothing with fewer than kMinLines lines or where their directions
-/// agree as a box's faces do (kMaxBoxAxes), which also keeps the system well-posed. O(1).
-std::optional<Eigen::Vector2d> upright_axis(const AxisSums& s) {
-    if (s.lines < kMinLines || std::hypot(s.c4, s.s4) > kMaxBoxAxes * s.lines) return std::nullopt;
-    const double det = s.a11 * s.a22 - s.a12 * s.a12;
-    if (!(det > 0)) return std::nullopt;
-    return Eigen::Vector2d((s.a22 * s.r1 - s.a12 * s.r2) / det, (s.a11 * s.r2 - s.a12 * s.r1) / det);
+/// Whether a segment's walls (WallSums) may be a round body: kMinWalls or more, their
+/// directions not agreeing as a box's faces do (kMaxBoxAxes). O(1).
+bool round_body(const WallSums& s) {
+    return s.walls >= kMinWalls && std::hypot(s.c4, s.s4) <= kMaxBoxAxes * s.walls;
+}
+
+/// The upright axis of a round body on the support plane (PlaneAxes coordinates): the centre
+/// of circles about one axis fitted to its walls' points, one per layer (fit_coaxial). The
+/// normals' lines, which a solid of revolution's all cross at its axis, were the first way:
+/// a noisy camera's normals, estimated over a wider radius, bend towards the camera at a
+/// body's outline, and under active stereo they met 2-3 cm off a bottle's axis, where its
+/// walls' points scatter either side of their circles. Nothing where the fit fails. Cost:
+/// fit_coaxial's passes over the walls.
+std::optional<Eigen::Vector2d> body_axis(const Wall* walls, std::size_t n) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();  // the fit's origin, for its conditioning
+    for (std::size_t i = 0; i < n; ++i) mean += Eigen::Vector2d(walls[i].u, walls[i].v);
+    mean /= static_cast<double>(n);
+    const auto fit = fit_coaxial<kRoundLayers>([&](auto&& visit) {
+        for (std::size_t i = 0; i < n; ++i) visit(Eigen::Vector2d(walls[i].u - mean.x(), walls[i].v - mean.y()), walls[i].layer);
+    });
+    if (!fit.fitted) return std::nullopt;
+    return Eigen::Vector2d(fit.centre + mean);
 }
 
 /// Calls visit(s, p, run) for each run label[p, p + run) of ws.neck_runs whose segment's slot
@@ -201,22 +214,41 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     }
     if (stand.empty()) return 0;
     // The lower segments' axes; the pairs whose lower one has none dropped.
-    auto& sums = ws.neck_lines;
-    sums.assign(S, AxisSums{});
+    auto& sums = ws.neck_wall_sums;
+    sums.assign(S, WallSums{});
     std::fill(wanted.begin(), wanted.end(), 0);
     for (const auto& pair : stand) wanted[static_cast<std::size_t>(pair.lower)] = 1;
     const PlaneFrame frame(pl);
     const float cos_up = std::cos(kUprightDeg * kDegToRad);
+    auto& walls = ws.neck_walls;
+    walls.clear();
     for_wanted_runs(ws, slot, wanted.data(), [&](int s, std::size_t p, std::size_t run) {
         auto& sum = sums[static_cast<std::size_t>(s)];
-        for (std::size_t q = p; q < p + run; ++q) add_line(x, frame, cos_up, q, sum);
+        for (std::size_t q = p; q < p + run; ++q) add_wall(x, pl, frame, cos_up, q, s, sum, walls);
     });
+    // The walls by slot (a counting sort: raster order kept within a slot), then each round
+    // body's axis from its own.
+    auto& first_wall = ws.neck_first;  // reused: the upper segments' first pairs come later
+    first_wall.assign(S + 1, 0);
+    for (const Wall& w : walls) ++first_wall[static_cast<std::size_t>(w.slot) + 1];
+    for (std::size_t s = 0; s < S; ++s) first_wall[s + 1] += first_wall[s];
+    auto& by_slot = ws.neck_walls_by_slot;
+    by_slot.resize(walls.size());
+    for (const Wall& w : walls) by_slot[static_cast<std::size_t>(first_wall[static_cast<std::size_t>(w.slot)]++)] = w;
+    auto& axes = ws.neck_axes;
+    axes.assign(S, {0.0, 0.0, 0.0});  // u, v, 1 where found
+    for (std::size_t s = 0, begin = 0; s < S; begin = static_cast<std::size_t>(first_wall[s++])) {
+        const auto end = static_cast<std::size_t>(first_wall[s]);  // the placing moved it to the slot's end
+        if (end == begin || !round_body(sums[s])) continue;
+        if (const auto axis = body_axis(by_slot.data() + begin, end - begin)) axes[s] = {axis->x(), axis->y(), 1.0};
+    }
     std::size_t kept = 0;
-    for (auto pair : stand)
-        if (const auto axis = upright_axis(sums[static_cast<std::size_t>(pair.lower)])) {
-            pair.axis[0] = axis->x(), pair.axis[1] = axis->y();
-            stand[kept++] = pair;
-        }
+    for (auto pair : stand) {
+        const auto& axis = axes[static_cast<std::size_t>(pair.lower)];
+        if (axis[2] == 0) continue;
+        pair.axis[0] = axis[0], pair.axis[1] = axis[1];
+        stand[kept++] = pair;
+    }
     stand.resize(kept);
     if (stand.empty()) return 0;
     // The upper segments' points near the axis of each lower one they stand on, in one pass:
@@ -254,11 +286,12 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
 }  // namespace
 
 /// The neck rule: of two segments that touch in view, the upper, standing on the lower
-/// (kAboveM), joins it when the lower is round about an upright axis (upright_axis) and
+/// (kAboveM), joins it when the lower is round about an upright axis (round_body, body_axis) and
 /// kNeckShare of the upper's points lie within kNeckRadiusM of that axis. In: ws.label (1..n
 /// with gaps). Out: ws.label with the pairs joined; stats.necks.joins. Cost: find_contacts'
 /// passes over the rows with labels; where some pairs touch, three passes over the runs of
-/// their segments (heights, the lower ones' lines, the upper ones' points near the axes).
+/// their segments (heights, the lower ones' walls, the upper ones' points near the axes), and
+/// fit_coaxial's over each round lower one's walls.
 void join_necks(const Ctx& x, const Plane* support, SegmentBuffers& ws, int& n, SegmentStats& stats) {
     if (!support || n < 2) return;
     find_contacts(x, ws);
