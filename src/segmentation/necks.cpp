@@ -159,7 +159,8 @@ std::optional<Eigen::Vector2d> body_axis(const Wall* walls, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) mean += Eigen::Vector2d(walls[i].u, walls[i].v);
     mean /= static_cast<double>(n);
     const auto fit = fit_coaxial<kRoundLayers>([&](auto&& visit) {
-        for (std::size_t i = 0; i < n; ++i) visit(Eigen::Vector2d(walls[i].u - mean.x(), walls[i].v - mean.y()), walls[i].layer);
+        for (std::size_t i = 0; i < n; ++i)
+            visit(Eigen::Vector2d(walls[i].u - mean.x(), walls[i].v - mean.y()), walls[i].layer);
     });
     if (!fit.fitted) return std::nullopt;
     return Eigen::Vector2d(fit.centre + mean);
@@ -172,6 +173,39 @@ void for_wanted_runs(const SegmentBuffers& ws, const int* slot, const std::uint8
     for (const auto& r : ws.neck_runs) {
         const int s = slot[r[0]];
         if (s >= 0 && wanted[s]) visit(s, static_cast<std::size_t>(r[1]), static_cast<std::size_t>(r[2]));
+    }
+}
+
+/// The axis of each round body among the segments of ws.neck_segments whose slot is wanted:
+/// their walls (add_wall) grouped by slot (a counting sort: raster order kept within a
+/// slot), then, where round_body holds, body_axis. Out: ws.neck_axes per slot (u, v, 1 where
+/// found, else 0s). Cost: one pass over the wanted segments' runs, two over their walls, and
+/// fit_coaxial's passes over each round one's.
+void find_body_axes(const Ctx& x, const Plane& pl, SegmentBuffers& ws, const std::uint8_t* wanted) {
+    const std::size_t S = ws.neck_segments.size();
+    auto& sums = ws.neck_wall_sums;
+    sums.assign(S, WallSums{});
+    const PlaneFrame frame(pl);
+    const float cos_up = std::cos(kUprightDeg * kDegToRad);
+    auto& walls = ws.neck_walls;
+    walls.clear();
+    for_wanted_runs(ws, ws.neck_slot.data(), wanted, [&](int s, std::size_t p, std::size_t run) {
+        auto& sum = sums[static_cast<std::size_t>(s)];
+        for (std::size_t q = p; q < p + run; ++q) add_wall(x, pl, frame, cos_up, q, s, sum, walls);
+    });
+    auto& first_wall = ws.neck_first;  // reused: the upper segments' first pairs come later
+    first_wall.assign(S + 1, 0);
+    for (const Wall& w : walls) ++first_wall[static_cast<std::size_t>(w.slot) + 1];
+    for (std::size_t s = 0; s < S; ++s) first_wall[s + 1] += first_wall[s];
+    auto& by_slot = ws.neck_walls_by_slot;
+    by_slot.resize(walls.size());
+    for (const Wall& w : walls) by_slot[static_cast<std::size_t>(first_wall[static_cast<std::size_t>(w.slot)]++)] = w;
+    auto& axes = ws.neck_axes;
+    axes.assign(S, {0.0, 0.0, 0.0});
+    for (std::size_t s = 0, begin = 0; s < S; begin = static_cast<std::size_t>(first_wall[s++])) {
+        const auto end = static_cast<std::size_t>(first_wall[s]);  // placing moved it to the slot's end
+        if (end == begin || !round_body(sums[s])) continue;
+        if (const auto axis = body_axis(by_slot.data() + begin, end - begin)) axes[s] = {axis->x(), axis->y(), 1.0};
     }
 }
 
@@ -214,34 +248,10 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     }
     if (stand.empty()) return 0;
     // The lower segments' axes; the pairs whose lower one has none dropped.
-    auto& sums = ws.neck_wall_sums;
-    sums.assign(S, WallSums{});
     std::fill(wanted.begin(), wanted.end(), 0);
     for (const auto& pair : stand) wanted[static_cast<std::size_t>(pair.lower)] = 1;
-    const PlaneFrame frame(pl);
-    const float cos_up = std::cos(kUprightDeg * kDegToRad);
-    auto& walls = ws.neck_walls;
-    walls.clear();
-    for_wanted_runs(ws, slot, wanted.data(), [&](int s, std::size_t p, std::size_t run) {
-        auto& sum = sums[static_cast<std::size_t>(s)];
-        for (std::size_t q = p; q < p + run; ++q) add_wall(x, pl, frame, cos_up, q, s, sum, walls);
-    });
-    // The walls by slot (a counting sort: raster order kept within a slot), then each round
-    // body's axis from its own.
-    auto& first_wall = ws.neck_first;  // reused: the upper segments' first pairs come later
-    first_wall.assign(S + 1, 0);
-    for (const Wall& w : walls) ++first_wall[static_cast<std::size_t>(w.slot) + 1];
-    for (std::size_t s = 0; s < S; ++s) first_wall[s + 1] += first_wall[s];
-    auto& by_slot = ws.neck_walls_by_slot;
-    by_slot.resize(walls.size());
-    for (const Wall& w : walls) by_slot[static_cast<std::size_t>(first_wall[static_cast<std::size_t>(w.slot)]++)] = w;
-    auto& axes = ws.neck_axes;
-    axes.assign(S, {0.0, 0.0, 0.0});  // u, v, 1 where found
-    for (std::size_t s = 0, begin = 0; s < S; begin = static_cast<std::size_t>(first_wall[s++])) {
-        const auto end = static_cast<std::size_t>(first_wall[s]);  // the placing moved it to the slot's end
-        if (end == begin || !round_body(sums[s])) continue;
-        if (const auto axis = body_axis(by_slot.data() + begin, end - begin)) axes[s] = {axis->x(), axis->y(), 1.0};
-    }
+    find_body_axes(x, pl, ws, wanted.data());
+    const auto& axes = ws.neck_axes;
     std::size_t kept = 0;
     for (auto pair : stand) {
         const auto& axis = axes[static_cast<std::size_t>(pair.lower)];
@@ -251,6 +261,7 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     }
     stand.resize(kept);
     if (stand.empty()) return 0;
+    const PlaneFrame frame(pl);
     // The upper segments' points near the axis of each lower one they stand on, in one pass:
     // the pairs sorted by upper segment, first[s] its first pair.
     std::sort(stand.begin(), stand.end(),
