@@ -469,6 +469,28 @@ FrameResult process_default(const GeneratedFrame& g) {
     return pipeline.process(g.frame);
 }
 
+/// A generated scene: eval/scenegen.py's seed, sensor and family.
+struct SceneSeed {
+    int seed;
+    const char* sensor;
+    const char* family;
+};
+
+/// The share of truth label t that one object holds (dominant_object) when the default
+/// pipeline runs on `scene`, whose truth label t must hold `pixels` pixels (the premise that
+/// the generator drew the object a test names; a failure and 0 otherwise), and whose depth
+/// noise must be measured.
+double one_object_share(const SceneSeed& scene, int t, long pixels) {
+    TempDir dir;
+    const GeneratedFrame g = render_generated(dir, scene.seed, scene.sensor, scene.family);
+    const long drawn = std::count(g.truth.labels.begin(), g.truth.labels.end(), t);
+    EXPECT_EQ(drawn, pixels) << "premise: the object of truth label " << t;
+    if (drawn != pixels) return 0.0;
+    const FrameResult r = process_default(g);
+    EXPECT_GT(r.depth_noise_px, 0.0f);
+    return dominant_object(r.objects, g.truth, t).second;
+}
+
 /// g's frame through a pipeline whose default segmentation parameters `set` changed.
 template <class Set>
 FrameResult process_with(const GeneratedFrame& g, Set&& set) {
@@ -653,13 +675,8 @@ TEST(GeneratedScene, NoisyActiveStereoPile_TheCreaseStepWidensWithTheNormalsRadi
 // their rays. The test allows for the scatter the frame's measured noise gives the walls,
 // and the can is one object (four before).
 TEST(GeneratedScene, LabelledCanUnderActiveStereo_RoundWithinTheMeasuredNoise) {
-    TempDir dir;
-    const GeneratedFrame g = render_generated(dir, 20043, "active_stereo", "floor");
-    constexpr int kCan = 4;  // its truth label
-    ASSERT_EQ(std::count(g.truth.labels.begin(), g.truth.labels.end(), kCan), 3014) << "premise: the can";
-    const FrameResult r = process_default(g);
-    ASSERT_GT(r.depth_noise_px, 0.0f);
-    EXPECT_GT(dominant_object(r.objects, g.truth, kCan).second, 0.9);  // 0.40 before
+    // Truth label 4, 3,014 pixels: the can.
+    EXPECT_GT(one_object_share({20043, "active_stereo", "floor"}, 4, 3014), 0.9);  // 0.40 before
 }
 
 // A generated floor scene (eval/scenegen.py floor tune seed 20004) under the active-stereo
@@ -668,12 +685,8 @@ TEST(GeneratedScene, LabelledCanUnderActiveStereo_RoundWithinTheMeasuredNoise) {
 // that axis 2.5 cm off (half the cap within 3 cm of it), the bottle's normals bending
 // towards the camera at its outline. Circles fitted to its walls find the axis.
 TEST(GeneratedScene, BottleUnderActiveStereo_ItsNeckOnTheAxisOfItsWalls) {
-    TempDir dir;
-    const GeneratedFrame g = render_generated(dir, 20004, "active_stereo", "floor");
-    constexpr int kBottle = 4;  // its truth label
-    ASSERT_EQ(std::count(g.truth.labels.begin(), g.truth.labels.end(), kBottle), 1136) << "premise: the bottle";
-    const FrameResult r = process_default(g);
-    EXPECT_GT(dominant_object(r.objects, g.truth, kBottle).second, 0.85);  // 0.66 before
+    // Truth label 4, 1,136 pixels: the bottle.
+    EXPECT_GT(one_object_share({20004, "active_stereo", "floor"}, 4, 1136), 0.85);  // 0.66 before
 }
 
 // A generated scene (eval/scenegen.py tune seed 23): two plain boxes flush side by side, one
