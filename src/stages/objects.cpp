@@ -128,6 +128,7 @@ struct ObjectTracker::Scratch {
     std::vector<std::uint8_t> changed;      ///< per pixel, kForget and kNearer: how its surface moved
     std::vector<double> votes, seg_sums;   ///< per segment: weight mass per slot; count, x, y, z
     std::vector<int> seg_slot;              ///< per segment, its slot (-1: none)
+    std::vector<int> seg_left;              ///< the segments no track continues, in the order they start one
     std::vector<std::uint8_t> slot_taken;   ///< per slot, 1 where a segment took it (or it is held)
     std::vector<double> slot_mass;          ///< per slot, its weight mass over the unchanged pixels
     std::vector<double> seg_nearer;         ///< per segment, its pixels whose surface came nearer;
@@ -436,12 +437,27 @@ void ObjectTracker::match_by_overlap(int n_segments) {
 // In and out: s_->seg_slot, s_->slot_taken, tracks_. Each segment left over, in order, takes the
 // nearest untaken track within max_jump_m of its centroid and of a similar size (an object
 // that moved faster than its overlap), else a new track id in a free slot, else in the
-// slot lost longest (whose weights are forgotten); with no slot left it is dropped.
-// Cost: O(S x K), and O(N) per slot taken over; no allocation.
+// slot lost longest (whose weights are forgotten); with no slot left it is dropped. When
+// more are left over than slots untaken, the largest go first (ties: in order): a crowded
+// frame (many small segments, a low min_points) drops its smallest, not whatever lies low
+// in the image.
+// Cost: O(S x K), O(S log S) when crowded, and O(N) per slot taken over; no allocation once
+// the buffers have grown.
 void ObjectTracker::match_by_distance_or_start(int n_segments) {
     const int S = n_segments, K = params_.max_tracks;
-    for (int s = 1; s <= S; ++s) {
-        if (s_->seg_slot[static_cast<std::size_t>(s)] >= 0) continue;
+    auto& left = s_->seg_left;
+    left.clear();
+    for (int s = 1; s <= S; ++s)
+        if (s_->seg_slot[static_cast<std::size_t>(s)] < 0) left.push_back(s);
+    const auto untaken = std::count(s_->slot_taken.begin(), s_->slot_taken.end(), std::uint8_t{0});
+    if (static_cast<std::ptrdiff_t>(left.size()) > untaken) {
+        const double* sums = s_->seg_sums.data();
+        std::sort(left.begin(), left.end(), [sums](int a, int b) {
+            const double na = sums[static_cast<std::size_t>(a) * kSegSums], nb = sums[static_cast<std::size_t>(b) * kSegSums];
+            return na != nb ? na > nb : a < b;
+        });
+    }
+    for (const int s : left) {
         const double* ss = s_->seg_sums.data() + static_cast<std::size_t>(s) * kSegSums;
         const double cx = ss[1] / ss[0], cy = ss[2] / ss[0], cz = ss[3] / ss[0];
         int best = -1;

@@ -485,3 +485,22 @@ TEST(ObjectTracker, ObjectsJoinedBySegmentation_KeepTheirTracks_PartedStartOne) 
         }
     }
 }
+
+// More segments than track slots (a crowded frame, or a low min_points): the largest start
+// tracks, the smallest are dropped. Here two slots, and two narrow segments on the left
+// before a wide one in the order segments are numbered; the wide one took no slot before.
+TEST(ObjectTracker, MoreSegmentsThanSlots_TheLargestStartTracks) {
+    ObjectParams params;
+    params.max_tracks = 2;
+    params.min_points = 1;
+    ObjectTracker tracker(params);
+    std::vector<DetectedObject> list;
+    const LabelImage objects = track_inner_frames(tracker, 60, 1, [](int, int u) {
+        const std::uint16_t label = u >= 2 && u < 4 ? 1 : u >= 6 && u < 9 ? 2 : u >= 20 && u < 50 ? 3 : 0;
+        return std::pair<float, std::uint16_t>(label ? 1.0f : 1.1f, label);
+    }, list);
+    ASSERT_EQ(list.size(), 2u);
+    EXPECT_NE(at_row10(objects, 35), 0) << "the wide segment";
+    EXPECT_NE(at_row10(objects, 7), 0) << "the wider of the narrow two";
+    EXPECT_EQ(at_row10(objects, 2), 0) << "the narrowest, dropped";
+}
