@@ -375,14 +375,14 @@ bool stands_round(const Ctx& x, const PlaneAxes& plane_xy, const Plane& pl, cons
     double res = 0, noise = 0, radial = 0;
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::max()), hi = -lo;
     for_walls([&](std::size_t p) {
-        const Eigen::Vector2d d = plane_xy(x.c, p) - mean - fit.centre;
+        const Eigen::Vector2d at = plane_xy(x.c, p), d = at - mean - fit.centre;
         const double r = d.norm(), off = r - fit.radius[layer_of(p)];
         res += off * off;
         // A depth error of sigma_z = depth_noise_rel z moves the point along its ray by
         // depth_noise_rel times its position, so across the circle by depth_noise_rel times
         // the position's component along the radius (on the plane: the camera at its origin).
         if (r > 0) {
-            const double across = x.depth_noise_rel * plane_xy(x.c, p).dot(d) / r;
+            const double across = x.depth_noise_rel * at.dot(d) / r;
             noise += across * across;
         }
         const Eigen::Vector3d nrm(x.n.nx[p], x.n.ny[p], x.n.nz[p]);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -105,7 +106,7 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::uint8_t> neck_wanted;
     std::vector<NeckWallSums> neck_wall_sums;
     std::vector<NeckWall> neck_walls, neck_walls_by_slot;  ///< the lower segments' walls, then by slot
-    std::vector<std::array<double, 3>> neck_axes;  ///< per slot: a round body's axis (u, v), 1 where found
+    std::vector<std::optional<Eigen::Vector2d>> neck_axes;  ///< per slot: a round body's axis on the plane
     std::vector<int> neck_first;
     // Containers:
     std::vector<detail::BoundaryStep> steps;   ///< boundary pairs of two segments

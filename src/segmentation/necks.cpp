@@ -178,8 +178,8 @@ void for_wanted_runs(const SegmentBuffers& ws, const int* slot, const std::uint8
 
 /// The axis of each round body among the segments of ws.neck_segments whose slot is wanted:
 /// their walls (add_wall) grouped by slot (a counting sort: raster order kept within a
-/// slot), then, where round_body holds, body_axis. Out: ws.neck_axes per slot (u, v, 1 where
-/// found, else 0s). Cost: one pass over the wanted segments' runs, two over their walls, and
+/// slot), then, where round_body holds, body_axis. Out: ws.neck_axes per slot (none where
+/// not round or not fitted). Cost: one pass over the wanted segments' runs, two over their walls, and
 /// fit_coaxial's passes over each round one's.
 void find_body_axes(const Ctx& x, const Plane& pl, SegmentBuffers& ws, const std::uint8_t* wanted) {
     const std::size_t S = ws.neck_segments.size();
@@ -201,11 +201,11 @@ void find_body_axes(const Ctx& x, const Plane& pl, SegmentBuffers& ws, const std
     by_slot.resize(walls.size());
     for (const Wall& w : walls) by_slot[static_cast<std::size_t>(first_wall[static_cast<std::size_t>(w.slot)]++)] = w;
     auto& axes = ws.neck_axes;
-    axes.assign(S, {0.0, 0.0, 0.0});
+    axes.assign(S, std::nullopt);
     for (std::size_t s = 0, begin = 0; s < S; begin = static_cast<std::size_t>(first_wall[s++])) {
         const auto end = static_cast<std::size_t>(first_wall[s]);  // placing moved it to the slot's end
         if (end == begin || !round_body(sums[s])) continue;
-        if (const auto axis = body_axis(by_slot.data() + begin, end - begin)) axes[s] = {axis->x(), axis->y(), 1.0};
+        axes[s] = body_axis(by_slot.data() + begin, end - begin);
     }
 }
 
@@ -255,8 +255,8 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     std::size_t kept = 0;
     for (auto pair : stand) {
         const auto& axis = axes[static_cast<std::size_t>(pair.lower)];
-        if (axis[2] == 0) continue;
-        pair.axis[0] = axis[0], pair.axis[1] = axis[1];
+        if (!axis) continue;
+        pair.axis[0] = axis->x(), pair.axis[1] = axis->y();
         stand[kept++] = pair;
     }
     stand.resize(kept);
