@@ -331,6 +331,67 @@ std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
     return near + reattach(x, ws, x.W + x.H, true);
 }
 
+/// An orphan region becomes a segment when at least this share of its pixels lie inside it
+/// (their four neighbours in it): a small object seen whole is a blob; a band of table behind
+/// an object's top edge, object pixels by their height that no segment reaches, is a line
+/// two or three pixels thick (a RealSense frame, `uois_realsense_tabletop` image_0003: 254
+/// pixels along a drill's top).
+constexpr float kOrphanInnerShare = 0.5f;
+
+int seed_orphans(const Ctx& x, SegmentBuffers& ws, int n) {
+    const int W = x.W, H = x.H;
+    int* const label = ws.label.data();
+    int* const pixels = ws.queue.data();  // every region flooded, one after another
+    constexpr int kFlooding = -2, kLeft = -1;  // the region being flooded; regions left out
+    int end = 0;
+    constexpr int kRun = 32;  // pixels tested at once: a run without an orphan pixel is skipped
+    for (int seed = 0; seed < W * H; ++seed) {
+        if (seed % kRun == 0) {
+            const int m = std::min(kRun, W * H - seed);
+            int any = 0;
+            for (int i = 0; i < m; ++i) any |= (label[seed + i] == 0) & (x.cls[seed + i] == kPlaneObject);
+            if (!any) {
+                seed += m - 1;
+                continue;
+            }
+        }
+        if (label[seed] || x.cls[seed] != kPlaneObject) continue;
+        const int first = end;
+        bool reached = false;  // a segment continues into the region: its cut band, not an object
+        pixels[end++] = seed;
+        label[seed] = kFlooding;
+        for (int k = first; k < end; ++k) {
+            const int p = pixels[k];
+            for (const int q : four_neighbours(p, p % W, p / W, W, H)) {
+                if (q < 0 || label[q] < 0) continue;
+                const bool continuous = x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q));
+                if (label[q] > 0) {
+                    reached |= continuous;
+                } else if (x.cls[q] == kPlaneObject && continuous) {
+                    label[q] = kFlooding;
+                    pixels[end++] = q;
+                }
+            }
+        }
+        bool object = !reached && end - first >= x.prm.cuts.min_seed_points;
+        if (object) {
+            int inner = 0;  // pixels whose four neighbours the region holds
+            for (int k = first; k < end; ++k) {
+                const int p = pixels[k];
+                bool all = true;
+                for (const int q : four_neighbours(p, p % W, p / W, W, H)) all &= q >= 0 && label[q] == kFlooding;
+                inner += all;
+            }
+            object = static_cast<float>(inner) >= kOrphanInnerShare * static_cast<float>(end - first);
+        }
+        if (object) ++n;
+        for (int k = first; k < end; ++k) label[pixels[k]] = object ? n : kLeft;
+    }
+    for (int k = 0; k < end; ++k)
+        if (label[pixels[k]] == kLeft) label[pixels[k]] = 0;
+    return n;
+}
+
 /// Drops labels with fewer than min_points pixels and writes the rest to `out` renumbered
 /// 1..n in order of first appearance (raster order); ws.label keeps the old numbers. Returns
 /// n. Each band of the image (a band per thread, in parallel) counts its labels' pixels and

@@ -417,6 +417,16 @@ int label_components(const Ctx& x, const std::uint8_t* seedable, SegmentBuffers&
 /// wide (components.cpp). Returns the pixels added.
 std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws);
 
+/// Orphans (components.cpp): object pixels that no seed reached, after the re-attachment,
+/// whose region (4-neighbours, depth-continuous) holds cuts.min_seed_points or more and
+/// touches no segment where depth is continuous, become segments n + 1, n + 2, ... in raster
+/// order of their first pixel. A small object seen far off by a noisy camera is cut through
+/// by creases a wide crease step apart: no seed is left in it, and the segments beside it,
+/// apart in depth, cannot reach it. A region that a segment reaches is that segment's cut
+/// band, left over past cuts.reattach_px. Returns the new n. Cost: one pass over the labels,
+/// a search over the orphan pixels; ws.queue holds them.
+int seed_orphans(const Ctx& x, SegmentBuffers& ws, int n);
+
 /// The segments of min_points or more into `out`, renumbered 1..n (components.cpp). Returns n.
 int compact(SegmentBuffers& ws, int n, int min_points, std::uint16_t* out);
 

@@ -57,6 +57,7 @@ SegmentStats segment_objects(const SegmentParams& params, const OrganizedCloud& 
     int n = seed_components(x, ws);
     ms.components = lap();
     stats.reattached = reattach_foreground(x, ws);
+    n = seed_orphans(x, ws, n);
     ms.reattach = lap();
     // The rules on segments (docs/DESIGN.md, "Objects", a section each), in this order. One
     // that does not run leaves its time to the next that does.
