@@ -331,6 +331,8 @@ std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
     return near + reattach(x, ws, x.W + x.H, true);
 }
 
+namespace {
+
 /// An orphan region becomes a segment when at least this share of its pixels lie inside it
 /// (their four neighbours in it): a small object seen whole is a blob; a band of table behind
 /// an object's top edge, object pixels by their height that no segment reaches, is a line
@@ -338,57 +340,82 @@ std::size_t reattach_foreground(const Ctx& x, SegmentBuffers& ws) {
 /// pixels along a drill's top).
 constexpr float kOrphanInnerShare = 0.5f;
 
+// Marks in ws.label while seed_orphans runs: the region being flooded, regions left out.
+constexpr int kFlooding = -2, kLeftOut = -1;
+
+bool is_orphan(const Ctx& x, const int* label, int p) { return label[p] == 0 && x.cls[p] == kPlaneObject; }
+
+/// The first pixel at or after `p` that may be an orphan: runs of 32 pixels without one are
+/// skipped with a test the compiler vectorizes (most of a frame is labelled or not an object).
+int next_orphan_candidate(const Ctx& x, const int* label, int p, int n_px) {
+    constexpr int kRun = 32;
+    while (p % kRun == 0 && p < n_px) {
+        const int m = std::min(kRun, n_px - p);
+        int any = 0;
+        for (int i = 0; i < m; ++i) any |= (label[p + i] == 0) & (x.cls[p + i] == kPlaneObject);
+        if (any) break;
+        p += m;
+    }
+    return p;
+}
+
+/// Floods the orphan region of `seed` (4-neighbours, depth-continuous) into pixels[first..),
+/// marking it kFlooding. Returns its end in `pixels`; `reached` says whether a segment
+/// continues into it where depth is continuous (its cut band, not an object).
+/// Cost: O(region pixels).
+int flood_orphan_region(const Ctx& x, int* label, int* pixels, int first, int seed, bool& reached) {
+    int end = first;
+    reached = false;
+    pixels[end++] = seed;
+    label[seed] = kFlooding;
+    for (int k = first; k < end; ++k) {
+        const int p = pixels[k];
+        for (const int q : four_neighbours(p, p % x.W, p / x.W, x.W, x.H)) {
+            if (q < 0 || label[q] < 0) continue;
+            const bool continuous = x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q));
+            if (label[q] > 0) {
+                reached |= continuous;
+            } else if (x.cls[q] == kPlaneObject && continuous) {
+                label[q] = kFlooding;
+                pixels[end++] = q;
+            }
+        }
+    }
+    return end;
+}
+
+/// Whether the flooded region pixels[first..end) is a blob: kOrphanInnerShare of its pixels
+/// or more have their four neighbours in it. Cost: O(region pixels).
+bool is_blob(const Ctx& x, const int* label, const int* pixels, int first, int end) {
+    int inner = 0;
+    for (int k = first; k < end; ++k) {
+        const int p = pixels[k];
+        bool all = true;
+        for (const int q : four_neighbours(p, p % x.W, p / x.W, x.W, x.H)) all &= q >= 0 && label[q] == kFlooding;
+        inner += all;
+    }
+    return static_cast<float>(inner) >= kOrphanInnerShare * static_cast<float>(end - first);
+}
+
+}  // namespace
+
 int seed_orphans(const Ctx& x, SegmentBuffers& ws, int n) {
-    const int W = x.W, H = x.H;
+    const int n_px = x.W * x.H;
     int* const label = ws.label.data();
     int* const pixels = ws.queue.data();  // every region flooded, one after another
-    constexpr int kFlooding = -2, kLeft = -1;  // the region being flooded; regions left out
     int end = 0;
-    constexpr int kRun = 32;  // pixels tested at once: a run without an orphan pixel is skipped
-    for (int seed = 0; seed < W * H; ++seed) {
-        if (seed % kRun == 0) {
-            const int m = std::min(kRun, W * H - seed);
-            int any = 0;
-            for (int i = 0; i < m; ++i) any |= (label[seed + i] == 0) & (x.cls[seed + i] == kPlaneObject);
-            if (!any) {
-                seed += m - 1;
-                continue;
-            }
-        }
-        if (label[seed] || x.cls[seed] != kPlaneObject) continue;
+    for (int seed = next_orphan_candidate(x, label, 0, n_px); seed < n_px;
+         seed = next_orphan_candidate(x, label, seed + 1, n_px)) {
+        if (!is_orphan(x, label, seed)) continue;
         const int first = end;
-        bool reached = false;  // a segment continues into the region: its cut band, not an object
-        pixels[end++] = seed;
-        label[seed] = kFlooding;
-        for (int k = first; k < end; ++k) {
-            const int p = pixels[k];
-            for (const int q : four_neighbours(p, p % W, p / W, W, H)) {
-                if (q < 0 || label[q] < 0) continue;
-                const bool continuous = x.connected(static_cast<std::size_t>(p), static_cast<std::size_t>(q));
-                if (label[q] > 0) {
-                    reached |= continuous;
-                } else if (x.cls[q] == kPlaneObject && continuous) {
-                    label[q] = kFlooding;
-                    pixels[end++] = q;
-                }
-            }
-        }
-        bool object = !reached && end - first >= x.prm.cuts.min_seed_points;
-        if (object) {
-            int inner = 0;  // pixels whose four neighbours the region holds
-            for (int k = first; k < end; ++k) {
-                const int p = pixels[k];
-                bool all = true;
-                for (const int q : four_neighbours(p, p % W, p / W, W, H)) all &= q >= 0 && label[q] == kFlooding;
-                inner += all;
-            }
-            object = static_cast<float>(inner) >= kOrphanInnerShare * static_cast<float>(end - first);
-        }
+        bool reached = false;
+        end = flood_orphan_region(x, label, pixels, first, seed, reached);
+        const bool object = !reached && end - first >= x.prm.cuts.min_seed_points && is_blob(x, label, pixels, first, end);
         if (object) ++n;
-        for (int k = first; k < end; ++k) label[pixels[k]] = object ? n : kLeft;
+        for (int k = first; k < end; ++k) label[pixels[k]] = object ? n : kLeftOut;
     }
     for (int k = 0; k < end; ++k)
-        if (label[pixels[k]] == kLeft) label[pixels[k]] = 0;
+        if (label[pixels[k]] == kLeftOut) label[pixels[k]] = 0;
     return n;
 }
 
