@@ -33,6 +33,9 @@ struct PlaneWorkspace::Buffers {
     std::vector<std::uint8_t> tall_foot;  ///< per grid cell: something rises from it past
                                           ///< max_object_height_m over the candidate counted
     std::vector<std::uint8_t> on_band;  ///< per pixel: 1 = removed and on the plane's band
+    /// Per pixel (mark_over_most): its vote, 16 x (over the band) + (has depth); the votes of
+    /// its column's three rows summed; 1 = over the band, and so is most of its 3 x 3.
+    std::vector<std::uint8_t> band_votes, column_votes, over_most;
     std::vector<int> low_piece;         ///< grid points of a low support's top (remove_low_support)
     std::vector<std::uint8_t> low_mask; ///< per grid point: in the low support's layer, piece or plane
     std::vector<double> low_sums;       ///< per piece of low_mask: count, summed height and band
@@ -162,10 +165,12 @@ struct InlierTest {
 
 /// 6. Classify every pixel (plane_pixels.cpp): below or on the plane (and facing like it)
 /// is removed; on the band but facing otherwise is a candidate foot; above and over the
-/// support is object. In: the support `pl` and its extent `ws.hull`. Out: `classes` (N,
-/// PlaneClass), `ws.on_band` (N, 1 = removed and on the band) and `ws.row_first_run[v + 1]`
-/// (row v's number of runs of on-band pixels, for restore_islands); returns the pixels kept.
-/// O(N), one parallel pass, no allocation.
+/// support is object, where most of the pixels with depth in its 3 x 3 lie above the band
+/// too (mark_over_most: a lone pixel over the band is a depth error, and counts as on it).
+/// In: the support `pl` and its extent `ws.hull`. Out: `classes` (N, PlaneClass),
+/// `ws.on_band` (N, 1 = removed and on the band) and `ws.row_first_run[v + 1]` (row v's
+/// number of runs of on-band pixels, for restore_islands); returns the pixels kept. O(N),
+/// three parallel passes, no allocation once the buffers have the frame's size.
 std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const OrganizedCloud& cloud,
                             const NormalMap& normals, const std::vector<std::uint8_t>& active,
                             const Plane& pl, Band on_band, float cos_inlier,

@@ -25,7 +25,7 @@ namespace {
 /// pointers), the support and its band, and its extent.
 struct PixelTest {
     const float *xs, *ys, *zs, *nxs, *nys, *nzs;
-    const std::uint8_t *act, *has_normal;
+    const std::uint8_t *act, *has_normal, *over_most;
     Plane pl;
     Band on_band;
     float cos_inlier;
@@ -44,7 +44,7 @@ void hull_candidates(const PixelTest& t, std::size_t p0, int n, std::uint8_t* __
     // Locals: a byte store may alias `t` as far as the compiler knows.
     const float *const xs = t.xs, *const ys = t.ys, *const zs = t.zs;
     const float *const nxs = t.nxs, *const nys = t.nys, *const nzs = t.nzs;
-    const std::uint8_t *const act = t.act, *const has_normal = t.has_normal;
+    const std::uint8_t *const act = t.act, *const has_normal = t.has_normal, *const over_most = t.over_most;
     const float pnx = t.pl.nx, pny = t.pl.ny, pnz = t.pl.nz, pd = t.pl.d, cos_inlier = t.cos_inlier;
     const Band on_band = t.on_band;
     const HullMask hull = t.hull;
@@ -54,12 +54,74 @@ void hull_candidates(const PixelTest& t, std::size_t p0, int n, std::uint8_t* __
         const float h = pnx * x + pny * y + pnz * z + pd, band = on_band(z);
         const bool faces_otherwise = (h > -band) & (has_normal[p] != 0) &
                                      (nxs[p] * pnx + nys[p] * pny + nzs[p] * pnz < cos_inlier);
-        // Arithmetic, not `?:`, which GCC keeps as branches here.
-        const bool above = h > band;
+        // Arithmetic, not `?:`, which GCC keeps as branches here. A lone pixel over the
+        // band (mark_over_most) is taken as on it.
+        const bool above = over_most[p] != 0;
         const int makes = above * kPlaneObject + (!above & faces_otherwise) * kPlaneFoot;
         hull_makes[j] = static_cast<std::uint8_t>(makes * (act[p] != 0));
-        near[j] = (act[p] != 0) & (std::fabs(h) <= band);
+        near[j] = (act[p] != 0) & !above & (h >= -band);
         cell[j] = hull.foot_cell_or_none(x, y, z, h);
+    }
+}
+
+/// Per pixel, into ws.over_most: 1 where it lies over the band and so do most of the pixels
+/// with depth in its 3 x 3, itself counted (the median of their heights is over the band: of
+/// n such pixels, (n + 1) / 2 or more over it). A pixel over the band among pixels on it is a
+/// depth error, not an object: a time-of-flight camera's flying pixels, mixed between an
+/// object's edge and the floor behind; a noisy camera's spikes on the table. Left over the
+/// band, they seeded specks and bridged objects to the floor; taken as on it, they join the
+/// band's classes (feet, the islands of restore_islands) as its other pixels do. An object's
+/// pixels have their neighbours over the band, but where it is thinner than two pixels.
+/// Each pixel's vote is one byte, 16 x (over the band) + (has depth): three rows of them
+/// summed, then three columns, hold both counts (at most 9 each) in one byte. Cost: three
+/// parallel passes over the pixels, byte arithmetic that vectorizes.
+void mark_over_most(const OrganizedCloud& cloud, const Plane& pl, Band on_band, PlaneBuffers& ws) {
+    const int W = cloud.width, H = cloud.height;
+    ws.band_votes.resize(cloud.size());
+    ws.column_votes.resize(cloud.size());
+    ws.over_most.resize(cloud.size());
+    const float *const xs = cloud.x.data(), *const ys = cloud.y.data(), *const zs = cloud.z.data();
+    const std::uint8_t* const valid = cloud.valid.data();
+    std::uint8_t* const vote = ws.band_votes.data();
+    const auto n_px = static_cast<std::ptrdiff_t>(cloud.size());
+    const float pnx = pl.nx, pny = pl.ny, pnz = pl.nz, pd = pl.d;
+#pragma omp parallel for schedule(static)
+    for (std::ptrdiff_t p = 0; p < n_px; ++p) {
+        const float h = pnx * xs[p] + pny * ys[p] + pnz * zs[p] + pd;
+        const int has_depth = valid[p] != 0;
+        vote[p] = static_cast<std::uint8_t>(has_depth * (16 * (h > on_band(zs[p])) + 1));
+    }
+    std::uint8_t* const column = ws.column_votes.data();
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) {
+        // Rows off the image add nothing.
+        const std::uint8_t* const mid = vote + static_cast<std::size_t>(v) * W;
+        const std::uint8_t* const up = v > 0 ? mid - W : nullptr;
+        const std::uint8_t* const down = v + 1 < H ? mid + W : nullptr;
+        std::uint8_t* const out = column + static_cast<std::size_t>(v) * W;
+        for (int u = 0; u < W; ++u) out[u] = mid[u];
+        if (up)
+            for (int u = 0; u < W; ++u) out[u] = static_cast<std::uint8_t>(out[u] + up[u]);
+        if (down)
+            for (int u = 0; u < W; ++u) out[u] = static_cast<std::uint8_t>(out[u] + down[u]);
+    }
+    std::uint8_t* const most = ws.over_most.data();
+    auto decide = [](std::uint8_t own, int sum) {
+        const int over = sum >> 4, n = sum & 15;
+        return static_cast<std::uint8_t>((own >> 4) & (2 * over >= n + (n & 1)));
+    };
+#pragma omp parallel for schedule(static)
+    for (int v = 0; v < H; ++v) {
+        const std::size_t row = static_cast<std::size_t>(v) * W;
+        const std::uint8_t *const c = column + row, *const own = vote + row;
+        std::uint8_t* const out = most + row;
+        if (W == 1) {
+            out[0] = decide(own[0], c[0]);
+            continue;
+        }
+        out[0] = decide(own[0], c[0] + c[1]);
+        for (int u = 1; u + 1 < W; ++u) out[u] = decide(own[u], c[u - 1] + c[u] + c[u + 1]);
+        out[W - 1] = decide(own[W - 1], c[W - 2] + c[W - 1]);
     }
 }
 
@@ -83,7 +145,8 @@ std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const 
     // ... and the mask a local copy for the same reason. Per chunk of a row, the arithmetic
     // in hull_candidates (vectorized), then the hull lookups and counts here.
     const HullMask hull = make_hull_mask(grid, K, pl, ws.hull);
-    const PixelTest test{xs, ys, zs, nxs, nys, nzs, act, has_normal, pl, on_band, cos_inlier, hull};
+    mark_over_most(cloud, pl, on_band, ws);
+    const PixelTest test{xs, ys, zs, nxs, nys, nzs, act, has_normal, ws.over_most.data(), pl, on_band, cos_inlier, hull};
     constexpr int kChunk = 64;  // pixels per call of hull_candidates
 #pragma omp parallel for schedule(static) reduction(+ : kept)
     for (int v = 0; v < H; ++v) {
