@@ -242,6 +242,16 @@ inline void chromaticity(const OrganizedCloud& c, std::size_t p, float (&out)[3]
 /// Shared by the round test, the scope and the stack rule.
 constexpr float kUprightDeg = 25.0f;
 
+/// Walls face along a box's two axes when the mean of their normals' unit vectors on the
+/// support plane, at four times their angle, is this long or more: a box's walls, 90 degrees
+/// apart, add up; a round body's face every way and cancel. Boxes measure 0.56-0.99 (0.56
+/// seen steeply from above, `ocid_sample`), cans 0.07-0.13 seen whole (the shipped RealSense
+/// frames' soup can on a tin); on the generated piles and floors, where the normals' radius
+/// spans much of a narrow body, the bodies of bottles 0.29 and of boxes 0.64-0.72 at the
+/// median (docs/ABLATION.md, "Necks"). Set between them by hand, not tuned. Shared by the
+/// stack rule (a footprint with sides) and the neck rule (a body that is not a box).
+constexpr double kBoxAxes = 0.4;
+
 /// The walls of a solid of revolution are fitted with circles about one axis, one per layer
 /// of height over the support (fit_coaxial), so that a bottle's neck and its body, narrower
 /// and wider, share their centre: kRoundLayerM of height each. 0.5, 1 and 2 cm scored alike

@@ -26,14 +26,12 @@ constexpr int kMinContacts = 6;
 /// lower's top less this (a neck rises from the shoulder's top).
 constexpr float kAboveM = 0.01f;
 /// The lower segment is round about an upright axis: its walls (pixels whose normal does not
-/// face up: a body's sides, a shoulder) are kMinWalls or more and not a box's faces, whose
-/// normals laid on the support plane agree at four times their angle (mean resultant over
-/// kMaxBoxAxes; stacks.cpp measures boxes' walls at 0.56-0.99 and cans' at 0.07-0.13). The
-/// normals of a small box, smoothed across its edges, can pass that; then only an upper
-/// object as narrow as a neck joins it. The axis is the centre of circles fitted to the
-/// walls' points on the plane, one per layer of height (fit_coaxial, as the round test's).
+/// face up: a body's sides, a shoulder) are kMinWalls or more and not a box's faces (kBoxAxes,
+/// internal.hpp). The normals of a small box, smoothed across its edges, can pass that; then
+/// only an upper object as narrow as a neck joins it. The axis is the centre of circles
+/// fitted to the walls' points on the plane, one per layer of height (fit_coaxial, as the
+/// round test's).
 constexpr int kMinWalls = 20;
-constexpr double kMaxBoxAxes = 0.25;
 /// A neck: nine tenths of the upper segment's points within this of the axis on the
 /// support plane. A bottle's neck and cap are 1-3 cm across in radius; a box or a can
 /// standing on a can is wider.
@@ -142,9 +140,9 @@ void add_wall(const Ctx& x, const Plane& pl, const PlaneFrame& f, float cos_up, 
 }
 
 /// Whether a segment's walls (WallSums) may be a round body: kMinWalls or more, their
-/// directions not agreeing as a box's faces do (kMaxBoxAxes). O(1).
+/// directions not agreeing as a box's faces do (under kBoxAxes). O(1).
 bool round_body(const WallSums& s) {
-    return s.walls >= kMinWalls && std::hypot(s.c4, s.s4) <= kMaxBoxAxes * s.walls;
+    return s.walls >= kMinWalls && std::hypot(s.c4, s.s4) < kBoxAxes * s.walls;
 }
 
 /// The upright axis of a round body on the support plane (PlaneAxes coordinates): the centre

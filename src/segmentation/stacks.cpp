@@ -219,13 +219,6 @@ double colour_distance(const std::array<double, 4>& a, const std::array<double, 
 /// more (on a corner, flush with two of its edges: beside one side and behind). Chosen on
 /// the generated tune seeds (docs/ABLATION.md, "Stacks").
 constexpr double kOneSideShare = 0.9;
-/// A footprint has sides when its walls face along two axes: the mean of the unit vectors
-/// at four times their angles on the support plane is this long or more (a box's walls,
-/// 90 degrees apart, add up; a can's face every way and cancel). Boxes measure 0.56-0.99
-/// (0.56 seen steeply from above, `ocid_sample`), cans 0.07-0.13 (the shipped RealSense
-/// frames' soup can on a tin, which without this test loses its front wall to the can); set
-/// between them by hand, not tuned.
-constexpr double kBoxAxes = 0.4;
 
 /// Per cut segment whose footprint is wanted (colour cannot tell: keep_walls), into
 /// ws.footprints: its upper object's (above the cut) mean point on the support plane, its
