@@ -343,7 +343,8 @@ constexpr float kOrphanInnerShare = 0.5f;
 // Marks in ws.label while seed_orphans runs: the region being flooded, regions left out.
 constexpr int kFlooding = -2, kLeftOut = -1;
 
-bool is_orphan(const Ctx& x, const int* label, int p) { return label[p] == 0 && x.cls[p] == kPlaneObject; }
+/// An object pixel that no segment holds. Branch-free, so that the run test below vectorizes.
+bool is_orphan(const Ctx& x, const int* label, int p) { return (label[p] == 0) & (x.cls[p] == kPlaneObject); }
 
 /// The first pixel at or after `p` that may be an orphan: runs of 32 pixels without one are
 /// skipped with a test the compiler vectorizes (most of a frame is labelled or not an object).
@@ -352,7 +353,7 @@ int next_orphan_candidate(const Ctx& x, const int* label, int p, int n_px) {
     while (p % kRun == 0 && p < n_px) {
         const int m = std::min(kRun, n_px - p);
         int any = 0;
-        for (int i = 0; i < m; ++i) any |= (label[p + i] == 0) & (x.cls[p + i] == kPlaneObject);
+        for (int i = 0; i < m; ++i) any |= is_orphan(x, label, p + i);
         if (any) break;
         p += m;
     }

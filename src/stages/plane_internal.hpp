@@ -169,8 +169,9 @@ struct InlierTest {
 /// too (mark_over_most: a lone pixel over the band is a depth error, and counts as on it).
 /// In: the support `pl` and its extent `ws.hull`. Out: `classes` (N, PlaneClass),
 /// `ws.on_band` (N, 1 = removed and on the band) and `ws.row_first_run[v + 1]` (row v's
-/// number of runs of on-band pixels, for restore_islands); returns the pixels kept. O(N),
-/// three parallel passes, no allocation once the buffers have the frame's size.
+/// number of runs of on-band pixels, for restore_islands); returns the pixels kept. O(N):
+/// mark_over_most's three parallel passes, then one for the classes; no allocation once the
+/// buffers have the frame's size.
 std::size_t classify_pixels(const Grid& grid, const PinholeIntrinsics& K, const OrganizedCloud& cloud,
                             const NormalMap& normals, const std::vector<std::uint8_t>& active,
                             const Plane& pl, Band on_band, float cos_inlier,
