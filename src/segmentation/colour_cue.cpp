@@ -499,8 +499,10 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
 // colours beside a plain box put the stripes in two parts and the box with one of them.
 // More colours then: the texture's two, the plain one's, and one for the rest. Two colours
 // whose contact is far longer than any two objects' (they interleave) are one material; the
-// split is between the materials. Where the four make one material, the segment holds more
-// textures than four colours can tell apart, and eight are tried.
+// split is between the materials. Where the four make one material, or leave one too small
+// to be tried again, the segment holds more textures than four colours can tell apart (two
+// textured objects flush side by side need four for their checks alone), and eight are
+// tried.
 
 /// Colours per segment when 2-means followed a texture: a textured object's two, a plain
 /// one's beside it, and one more for what fits none (mixed pixels along edges, a third
@@ -508,11 +510,12 @@ Verdict judge_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_x
 /// every pixel (docs/ABLATION.md, "Colour cue").
 constexpr int kTextureColours = 4;
 
-/// Colours per segment where kTextureColours make one material: textured objects touching
-/// in a pile show more colours than four, and each of the four then spans several objects,
-/// so every pair interleaves. Generated tune seeds: 6 and 8 alike, 6 costing `osd_mosd` 0.1
-/// Overlap F; tried only there, since 5 or 6 colours everywhere split real prints
-/// (docs/ABLATION.md, "Colour cue").
+/// Colours per segment where kTextureColours make no split of two materials large enough:
+/// textured objects touching in a pile show more colours than four, and each of the four
+/// then spans several objects, so every pair interleaves, or one is left to the edges' mixed
+/// pixels. Generated tune seeds: 6 and 8 alike, 6 costing `osd_mosd` 0.1 Overlap F; tried
+/// only there, since 5 or 6 colours everywhere split real prints (docs/ABLATION.md, "Colour
+/// cue").
 constexpr int kMoreTextureColours = 8;
 
 /// k-means learns the colours from at most this many pixels per colour of kTextureColours
@@ -754,28 +757,22 @@ int texture_materials(const Ctx& x, const SegmentBuffers& ws, int l, const int* 
     return materials;
 }
 
-/// What split_by_materials found.
-enum class Materials {
-    kSplit,  ///< two materials, each large enough: ws.part, side, count and cen say them
-    kOne,    ///< the colours make one material
-    kSmall,  ///< two or more, one of them too small to be tried again
-};
-
 /// Segment l's split into two materials of K colours, when 2-means (parts in `side`, means
 /// in `cen`) followed a texture: texture_colours, texture_materials, then ws.part, side,
-/// `count` and `cen` say the materials (cen: their means) where it returns kSplit; else
-/// ws.part and side are not a split, and `cen` is as it came. Cost: texture_colours' passes
-/// and two more over the segment's pixels.
+/// `count` and `cen` say the materials (cen: their means) where it returns true: two
+/// materials, each large enough. False where the colours make one material or one of two
+/// or more is too small to be tried again; ws.part and side are then not a split, and `cen`
+/// is as it came. Cost: texture_colours' passes and two more over the segment's pixels.
 template <int K>
-Materials split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, const float* const* f, int m,
-                             std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
+bool split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int* px, const float* const* f, int m,
+                        std::uint8_t* side, float (&cen)[2][6], int (&count)[2]) {
     float colour[K][6];
     int colour_count[K];
     texture_colours(f, m, cen, side, colour, colour_count);
     std::uint8_t* const part = ws.part.data();
     for (int i = 0; i < m; ++i) part[px[i]] = side[i];
     std::uint8_t material[K];
-    if (texture_materials(x, ws, l, px, m, colour_count, material) < 2) return Materials::kOne;
+    if (texture_materials(x, ws, l, px, m, colour_count, material) < 2) return false;
     double sum[2][6] = {};
     count[0] = count[1] = 0;
     for (int i = 0; i < m; ++i) {
@@ -789,10 +786,10 @@ Materials split_by_materials(const Ctx& x, SegmentBuffers& ws, int l, const int*
     // grouping colours is weaker evidence than 2-means' own parts, and a print's block of
     // min_points split off a box seen in two pieces on osd_mosd's learn18 (docs/ABLATION.md,
     // "Textures").
-    if (std::min(count[0], count[1]) < 2 * x.prm.min_points) return Materials::kSmall;
+    if (std::min(count[0], count[1]) < 2 * x.prm.min_points) return false;
     for (int j = 0; j < 2; ++j)
         for (int q = 0; q < 6; ++q) cen[j][q] = static_cast<float>(sum[j][q] / count[j]);
-    return Materials::kSplit;
+    return true;
 }
 
 /// How a segment was split by the colour cue (ws.split).
@@ -801,10 +798,11 @@ enum Split : std::uint8_t { kNotSplit = 0, kSplitByColour = 1, kSplitByMaterial 
 /// Tries to split segment l in two: 2-means, then the tests of the colour cue (SegmentParams,
 /// "Colour cue"); where 2-means followed a texture, the segment's materials of
 /// kTextureColours (split_by_materials) and the same tests, or, where those colours make one
-/// material, of kMoreTextureColours and the same tests with more_colours_like_objects.
+/// material or leave one too small, of kMoreTextureColours and the same tests with
+/// more_colours_like_objects.
 /// Writes ws.part at the segment's pixels once 2-means ran. Cost: O(segment pixels) per
 /// 2-means iteration and for the boundary, the materials' passes when 2-means followed a
-/// texture (twice where four colours make one material); no allocation (called in parallel,
+/// texture (twice where four colours make no split); no allocation (called in parallel,
 /// one segment per call).
 Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plane_xy, const ColourFeatures& ft,
                        const ClusterParams& cp, float cos_crease, SegmentBuffers& ws, int l) {
@@ -826,11 +824,11 @@ Split try_colour_split(const Ctx& x, const Plane* support, const PlaneAxes* plan
     if (verdict == Verdict::kKept) return kSplitByColour;
     // kTexture: both parts passed the share test, so both hold pixels.
     if (verdict != Verdict::kTexture || !prm.colour.textures) return kNotSplit;
-    Materials found = split_by_materials<kTextureColours>(x, ws, l, px, f, m, side, cen, count);
+    bool found = split_by_materials<kTextureColours>(x, ws, l, px, f, m, side, cen, count);
     // Two materials of 2 x min_points each (split_by_materials) need 4 x min_points.
-    const bool more_colours = found == Materials::kOne && m >= 4 * prm.min_points;
+    const bool more_colours = !found && m >= 4 * prm.min_points;
     if (more_colours) found = split_by_materials<kMoreTextureColours>(x, ws, l, px, f, m, side, cen, count);
-    if (found != Materials::kSplit) return kNotSplit;
+    if (!found) return kNotSplit;
     return judge_split(x, support, plane_xy, cp, cos_crease, ws, l, px, m, count, cen, more_colours) == Verdict::kKept
                ? kSplitByMaterial
                : kNotSplit;
