@@ -93,7 +93,15 @@ struct SegmentWorkspace::Buffers {
     struct NeckPair {
         int upper = 0, lower = 0;
         double axis[2] = {0, 0};   ///< the lower one's axis on the support plane
+        double radius = 0;         ///< ... and its radius there (the widest layer's)
         int points = 0, near = 0;  ///< the upper one's points, and those near the axis
+        int in_body = 0;           ///< ... those within `radius` of it
+        int top = 0, top_near = 0;  ///< ... those of its top (kNeckTopM), and those near the axis
+    };
+    /// A round body's axis and radius on the support plane (the neck rule's body_axis).
+    struct BodyAxis {
+        Eigen::Vector2d centre;
+        double radius = 0;
     };
     std::vector<std::uint8_t> neck_outline;  ///< one row's outline pixels and run ends
     std::vector<std::array<int, 3>> neck_runs;  ///< runs of one label: label, first pixel, length
@@ -106,7 +114,7 @@ struct SegmentWorkspace::Buffers {
     std::vector<std::uint8_t> neck_wanted;
     std::vector<NeckWallSums> neck_wall_sums;
     std::vector<NeckWall> neck_walls, neck_walls_by_slot;  ///< the lower segments' walls, then by slot
-    std::vector<std::optional<Eigen::Vector2d>> neck_axes;  ///< per slot: a round body's axis on the plane
+    std::vector<std::optional<BodyAxis>> neck_axes;  ///< per slot: a round body's axis on the plane
     std::vector<int> neck_first;
     // Containers:
     std::vector<detail::BoundaryStep> steps;   ///< boundary pairs of two segments

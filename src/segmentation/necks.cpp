@@ -37,6 +37,13 @@ constexpr int kMinWalls = 20;
 /// standing on a can is wider.
 constexpr double kNeckRadiusM = 0.03;
 constexpr double kNeckShare = 0.9;
+/// Or a shoulder with its neck: where the crease cuts the body below its shoulder (a noisy
+/// camera's normals, smoothed over a wider radius, bend there little), the upper segment is
+/// wider than a neck, but it lies within the body's radius, and its top, its points within
+/// this of its highest, is the neck and cap (kNeckShare of them within kNeckRadiusM). A can
+/// or a box on a can is as wide at its top as below. The generated caps are 1.5 cm tall; 1
+/// and 3 cm scored alike on the tune seeds (docs/ABLATION.md, "Necks").
+constexpr float kNeckTopM = 0.02f;
 
 /// The pairs of segments that touch in view into ws.neck_pairs: (lower label << 32 | higher,
 /// contacts), sorted by pair, a pair's contacts over one entry or more; and the runs of one
@@ -150,9 +157,10 @@ bool round_body(const WallSums& s) {
 /// normals' lines, which a solid of revolution's all cross at its axis, were the first way:
 /// a noisy camera's normals, estimated over a wider radius, bend towards the camera at a
 /// body's outline, and under active stereo they met 2-3 cm off a bottle's axis, where its
-/// walls' points scatter either side of their circles. Nothing where the fit fails. Cost:
-/// fit_coaxial's passes over the walls.
-std::optional<Eigen::Vector2d> body_axis(const Wall* walls, std::size_t n) {
+/// walls' points scatter either side of their circles. Its radius: the widest layer's (the
+/// body, below its shoulder). Nothing where the fit fails. Cost: fit_coaxial's passes over the
+/// walls.
+std::optional<SegmentBuffers::BodyAxis> body_axis(const Wall* walls, std::size_t n) {
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();  // the fit's origin, for its conditioning
     for (std::size_t i = 0; i < n; ++i) mean += Eigen::Vector2d(walls[i].u, walls[i].v);
     mean /= static_cast<double>(n);
@@ -161,7 +169,10 @@ std::optional<Eigen::Vector2d> body_axis(const Wall* walls, std::size_t n) {
             visit(Eigen::Vector2d(walls[i].u - mean.x(), walls[i].v - mean.y()), walls[i].layer);
     });
     if (!fit.fitted) return std::nullopt;
-    return Eigen::Vector2d(fit.centre + mean);
+    SegmentBuffers::BodyAxis axis{fit.centre + mean, 0.0};
+    for (int l = 0; l < kRoundLayers; ++l)
+        if (fit.count[l] > 0) axis.radius = std::max(axis.radius, fit.radius[l]);
+    return axis;
 }
 
 /// Calls visit(s, p, run) for each run label[p, p + run) of ws.neck_runs whose segment's slot
@@ -254,14 +265,15 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     for (auto pair : stand) {
         const auto& axis = axes[static_cast<std::size_t>(pair.lower)];
         if (!axis) continue;
-        pair.axis[0] = axis->x(), pair.axis[1] = axis->y();
+        pair.axis[0] = axis->centre.x(), pair.axis[1] = axis->centre.y(), pair.radius = axis->radius;
         stand[kept++] = pair;
     }
     stand.resize(kept);
     if (stand.empty()) return 0;
     const PlaneFrame frame(pl);
-    // The upper segments' points near the axis of each lower one they stand on, in one pass:
-    // the pairs sorted by upper segment, first[s] its first pair.
+    // The upper segments' points near the axis of each lower one they stand on, within its
+    // radius, and at their own top, in one pass: the pairs sorted by upper segment, first[s]
+    // its first pair.
     std::sort(stand.begin(), stand.end(),
               [](const auto& p, const auto& q) { return p.upper != q.upper ? p.upper < q.upper : p.lower < q.lower; });
     auto& first = ws.neck_first;
@@ -275,18 +287,30 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
         for (std::size_t q = p; q < p + run; ++q) {
             if (!x.c.valid[q]) continue;
             const auto [u, v] = frame.at(x.c, q);
+            const bool at_top =
+                pl.height(x.c.x[q], x.c.y[q], x.c.z[q]) > heights[static_cast<std::size_t>(s)][2] - kNeckTopM;
             for (auto k = static_cast<std::size_t>(first[static_cast<std::size_t>(s)]); k < stand.size() && stand[k].upper == s;
                  ++k) {
                 auto& pair = stand[k];
-                const double du = u - pair.axis[0], dv = v - pair.axis[1];
+                const double du = u - pair.axis[0], dv = v - pair.axis[1], d2 = du * du + dv * dv;
+                const bool near = d2 <= kNeckRadiusM * kNeckRadiusM;
                 ++pair.points;
-                pair.near += du * du + dv * dv <= kNeckRadiusM * kNeckRadiusM;
+                pair.near += near;
+                pair.in_body += d2 <= pair.radius * pair.radius;
+                pair.top += at_top;
+                pair.top_near += at_top && near;
             }
         }
     });
+    // A neck and cap, or a shoulder within the body whose top is the neck (kNeckTopM).
+    const auto neck = [](const SegmentBuffers::NeckPair& pair) {
+        return pair.points > 0 &&
+               (pair.near >= kNeckShare * pair.points ||
+                (pair.in_body >= kNeckShare * pair.points && pair.top_near >= kNeckShare * pair.top && pair.top > 0));
+    };
     int joins = 0;
     for (const auto& pair : stand)
-        if (pair.points > 0 && pair.near >= kNeckShare * pair.points &&
+        if (neck(pair) &&
             join_sets(ws.parent, segments[static_cast<std::size_t>(pair.upper)], segments[static_cast<std::size_t>(pair.lower)]))
             ++joins;
     return joins;
@@ -296,7 +320,8 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
 
 /// The neck rule: of two segments that touch in view, the upper, standing on the lower
 /// (kAboveM), joins it when the lower is round about an upright axis (round_body, body_axis) and
-/// kNeckShare of the upper's points lie within kNeckRadiusM of that axis. In: ws.label (1..n
+/// kNeckShare of the upper's points lie within kNeckRadiusM of that axis, or within the body's
+/// radius with kNeckShare of its top's (kNeckTopM) within kNeckRadiusM. In: ws.label (1..n
 /// with gaps). Out: ws.label with the pairs joined; stats.necks.joins. Cost: find_contacts'
 /// passes over the rows with labels; where some pairs touch, three passes over the runs of
 /// their segments (heights, the lower ones' walls, the upper ones' points near the axes), and
