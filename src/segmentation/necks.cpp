@@ -37,12 +37,12 @@ constexpr int kMinWalls = 20;
 /// standing on a can is wider.
 constexpr double kNeckRadiusM = 0.03;
 constexpr double kNeckShare = 0.9;
-/// Or a shoulder with its neck: where the crease cuts the body below its shoulder (a noisy
-/// camera's normals, smoothed over a wider radius, bend there little), the upper segment is
-/// wider than a neck, but it lies within the body's radius, and its top, its points within
-/// this of its highest, is the neck and cap (kNeckShare of them within kNeckRadiusM). A can
-/// or a box on a can is as wide at its top as below. The generated caps are 1.5 cm tall; 1
-/// and 3 cm scored alike on the tune seeds (docs/ABLATION.md, "Necks").
+/// Or a shoulder with its neck: where the crease cuts the body below its shoulder (bottles in
+/// the generated piles and floors, most under active stereo), the upper segment is wider
+/// than a neck, but it lies within the body's radius, and its top, its points within this of
+/// its highest, is the neck and cap (kNeckShare of them within kNeckRadiusM). A can or a box
+/// on a can is as wide at its top as below. The generated caps are 1.5 cm tall; 1 and 3 cm
+/// scored alike on the tune seeds (docs/ABLATION.md, "Necks").
 constexpr float kNeckTopM = 0.02f;
 
 /// The pairs of segments that touch in view into ws.neck_pairs: (lower label << 32 | higher,
