@@ -512,8 +512,8 @@ constexpr int kTextureColours = 4;
 
 /// Colours per segment where kTextureColours make no split of two materials large enough:
 /// textured objects touching in a pile show more colours than four, and each of the four
-/// then spans several objects, so every pair interleaves, or one is left to the edges' mixed
-/// pixels. Generated tune seeds: 6 and 8 alike, 6 costing `osd_mosd` 0.1 Overlap F; tried
+/// then spans several objects, so every pair interleaves, or the fourth, the one for what
+/// fits none, is left a material of its own too small to be tried. Generated tune seeds: 6 and 8 alike, 6 costing `osd_mosd` 0.1 Overlap F; tried
 /// only there, since 5 or 6 colours everywhere split real prints (docs/ABLATION.md, "Colour
 /// cue").
 constexpr int kMoreTextureColours = 8;
