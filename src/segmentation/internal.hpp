@@ -90,18 +90,17 @@ struct SegmentWorkspace::Buffers {
         int slot, layer;  ///< layer: round_layer of its height
         double u, v;      ///< on the support plane (PlaneAxes)
     };
-    struct NeckPair {
-        int upper = 0, lower = 0;
-        double axis[2] = {0, 0};   ///< the lower one's axis on the support plane
-        double radius = 0;         ///< ... and its radius there (the widest layer's)
-        int points = 0, near = 0;  ///< the upper one's points, and those near the axis
-        int in_body = 0;           ///< ... those within `radius` of it
-        int top = 0, top_near = 0;  ///< ... those of its top (kNeckTopM), and those near the axis
-    };
     /// A round body's axis and radius on the support plane (the neck rule's body_axis).
     struct BodyAxis {
-        Eigen::Vector2d centre;
-        double radius = 0;
+        Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+        double radius = 0;  ///< the widest layer's
+    };
+    struct NeckPair {
+        int upper = 0, lower = 0;
+        BodyAxis body;              ///< the lower one's axis and radius
+        int points = 0, near = 0;   ///< the upper one's points, and those near the axis
+        int in_body = 0;            ///< ... those within the body's radius of it
+        int top = 0, top_near = 0;  ///< ... those of its top (kNeckTopM), and those near the axis
     };
     std::vector<std::uint8_t> neck_outline;  ///< one row's outline pixels and run ends
     std::vector<std::array<int, 3>> neck_runs;  ///< runs of one label: label, first pixel, length

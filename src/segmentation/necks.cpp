@@ -252,8 +252,10 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     stand.clear();
     for (const auto& [lo, hi] : ws.neck_touching) {
         const int a = mean(lo) > mean(hi) ? lo : hi, b = a == lo ? hi : lo;
-        if (heights[static_cast<std::size_t>(a)][1] > 0 && mean(a) >= heights[static_cast<std::size_t>(b)][2] - kAboveM)
-            stand.push_back({a, b});
+        if (!(heights[static_cast<std::size_t>(a)][1] > 0 && mean(a) >= heights[static_cast<std::size_t>(b)][2] - kAboveM))
+            continue;
+        SegmentBuffers::NeckPair& pair = stand.emplace_back();
+        pair.upper = a, pair.lower = b;
     }
     if (stand.empty()) return 0;
     // The lower segments' axes; the pairs whose lower one has none dropped.
@@ -265,7 +267,7 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
     for (auto pair : stand) {
         const auto& axis = axes[static_cast<std::size_t>(pair.lower)];
         if (!axis) continue;
-        pair.axis[0] = axis->centre.x(), pair.axis[1] = axis->centre.y(), pair.radius = axis->radius;
+        pair.body = *axis;
         stand[kept++] = pair;
     }
     stand.resize(kept);
@@ -292,21 +294,22 @@ int join_standing_necks(const Ctx& x, const Plane& pl, SegmentBuffers& ws) {
             for (auto k = static_cast<std::size_t>(first[static_cast<std::size_t>(s)]); k < stand.size() && stand[k].upper == s;
                  ++k) {
                 auto& pair = stand[k];
-                const double du = u - pair.axis[0], dv = v - pair.axis[1], d2 = du * du + dv * dv;
+                const double du = u - pair.body.centre.x(), dv = v - pair.body.centre.y(), d2 = du * du + dv * dv;
                 const bool near = d2 <= kNeckRadiusM * kNeckRadiusM;
                 ++pair.points;
                 pair.near += near;
-                pair.in_body += d2 <= pair.radius * pair.radius;
+                pair.in_body += d2 <= pair.body.radius * pair.body.radius;
                 pair.top += at_top;
                 pair.top_near += at_top && near;
             }
         }
     });
-    // A neck and cap, or a shoulder within the body whose top is the neck (kNeckTopM).
+    // A neck and cap, or a shoulder within the body whose top is the neck (kNeckTopM). The
+    // highest point is at the top, so `top` is at least 1 wherever `points` is.
     const auto neck = [](const SegmentBuffers::NeckPair& pair) {
         return pair.points > 0 &&
                (pair.near >= kNeckShare * pair.points ||
-                (pair.in_body >= kNeckShare * pair.points && pair.top_near >= kNeckShare * pair.top && pair.top > 0));
+                (pair.in_body >= kNeckShare * pair.points && pair.top_near >= kNeckShare * pair.top));
     };
     int joins = 0;
     for (const auto& pair : stand)
